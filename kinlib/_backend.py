@@ -1,0 +1,190 @@
+"""One API, two backends: decide SymPy or NumPy from the arguments, and check them.
+
+A SymPy object anywhere in the arguments (a Symbol, an expression, a Matrix) selects the exact
+backend: results are SymPy Matrices with no floats introduced. Plain numbers (ints, floats, NumPy
+arrays) select the numeric backend: results are NumPy float arrays.
+
+Every check raises ``ValueError``/``TypeError`` naming the argument, the expected shape or
+property, and what was given.
+"""
+from __future__ import annotations
+
+import numbers
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+__all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe"]
+
+_ZERO_TOL = 1e-9
+
+
+def describe(x: Any) -> str:
+    """A short description of ``x`` for error messages."""
+    if isinstance(x, sp.MatrixBase):
+        return f"a SymPy Matrix of shape {x.shape}"
+    if isinstance(x, np.ndarray):
+        return f"an array of shape {x.shape} and dtype {x.dtype}"
+    if isinstance(x, (str, bytes)):
+        return f"the string {x!r}"
+    if isinstance(x, (list, tuple)):
+        try:
+            shape = np.shape(np.asarray(x, dtype=object))
+        except Exception:  # ragged
+            shape = f"ragged, length {len(x)}"
+        return f"a {type(x).__name__} of shape {shape}"
+    r = repr(x)
+    return f"{type(x).__name__} {r[:60]}"
+
+
+def is_symbolic(*args: Any) -> bool:
+    """True when any argument holds a SymPy object (Symbol, expression or Matrix)."""
+    for a in args:
+        if isinstance(a, sp.Basic) or isinstance(a, sp.MatrixBase):
+            return True
+        if isinstance(a, np.ndarray):
+            if a.dtype == object and any(isinstance(e, sp.Basic) for e in a.flat):
+                return True
+        elif isinstance(a, (list, tuple)):
+            if is_symbolic(*a):
+                return True
+    return False
+
+
+def _check_scalar(e: Any, name: str, symbolic: bool):
+    if isinstance(e, (str, bytes)):
+        raise TypeError(f"{name} must hold numbers or SymPy expressions, got {describe(e)}")
+    if isinstance(e, bool):
+        raise TypeError(f"{name} must hold numbers or SymPy expressions, got the bool {e!r}")
+    if symbolic:
+        if isinstance(e, sp.Basic):
+            if not isinstance(e, sp.Expr):
+                raise TypeError(f"{name} must hold SymPy expressions, got {describe(e)}")
+            return e
+        if isinstance(e, numbers.Number) or isinstance(e, np.number):
+            return sp.sympify(e.item() if isinstance(e, np.generic) else e)
+        raise TypeError(f"{name} must hold numbers or SymPy expressions, got {describe(e)}")
+    if isinstance(e, (numbers.Real, np.integer, np.floating)):
+        return e
+    raise TypeError(f"{name} must hold real numbers, got {describe(e)}")
+
+
+def as_matrix(x: Any, name: str, shape: tuple[int | None, int | None] | None = None,
+              symbolic: bool | None = None):
+    """``x`` as a 2-D SymPy Matrix (symbolic) or float array (numeric), shape-checked.
+
+    ``shape`` entries of ``None`` accept any size along that axis.
+    """
+    if symbolic is None:
+        symbolic = is_symbolic(x)
+    if isinstance(x, (str, bytes)) or x is None or isinstance(x, numbers.Number):
+        raise TypeError(f"{name} must be a matrix of shape {_fmt_shape(shape)}, got {describe(x)}")
+    if isinstance(x, sp.MatrixBase):
+        rows = [[x[i, j] for j in range(x.cols)] for i in range(x.rows)]
+        got_shape = x.shape
+    else:
+        try:
+            arr = np.asarray(x, dtype=object)
+        except Exception:
+            raise TypeError(f"{name} must be a matrix of shape {_fmt_shape(shape)}, got {describe(x)}") from None
+        if arr.ndim != 2:
+            raise ValueError(f"{name} must be a matrix of shape {_fmt_shape(shape)}, got {describe(x)}")
+        rows = arr.tolist()
+        got_shape = arr.shape
+    if shape is not None:
+        for want, got in zip(shape, got_shape):
+            if want is not None and want != got:
+                raise ValueError(f"{name} must be a matrix of shape {_fmt_shape(shape)}, got {describe(x)}")
+    rows = [[_check_scalar(e, name, symbolic) for e in row] for row in rows]
+    if symbolic:
+        return sp.Matrix(rows) if rows else sp.zeros(*got_shape)
+    return np.array(rows, dtype=float).reshape(got_shape)
+
+
+def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None):
+    """``x`` as a column: SymPy Matrix (k×1) when symbolic, 1-D float array otherwise.
+
+    Accepts a flat sequence, a 1-D array, or a column/row matrix.
+    """
+    if symbolic is None:
+        symbolic = is_symbolic(x)
+    want = f"a vector of length {length}" if length is not None else "a vector"
+    if isinstance(x, (str, bytes)) or x is None or isinstance(x, (numbers.Number, sp.Basic)):
+        raise TypeError(f"{name} must be {want}, got {describe(x)}")
+    if isinstance(x, sp.MatrixBase):
+        if 1 not in x.shape:
+            raise ValueError(f"{name} must be {want}, got {describe(x)}")
+        items = list(x)
+    else:
+        try:
+            arr = np.asarray(x, dtype=object)
+        except Exception:
+            raise TypeError(f"{name} must be {want}, got {describe(x)}") from None
+        if arr.ndim == 2 and 1 in arr.shape:
+            arr = arr.reshape(-1)
+        if arr.ndim != 1:
+            raise ValueError(f"{name} must be {want}, got {describe(x)}")
+        items = arr.tolist()
+    if length is not None and len(items) != length:
+        raise ValueError(f"{name} must be {want}, got {describe(x)} with {len(items)} entries")
+    items = [_check_scalar(e, name, symbolic) for e in items]
+    if symbolic:
+        return sp.Matrix(items)
+    return np.array(items, dtype=float)
+
+
+def as_screw_list(Slist: Any, name: str = "Slist", symbolic: bool | None = None):
+    """A screw list as a 6×n matrix: accepts 6×n (one screw per column) or a sequence of n 6-vectors."""
+    if symbolic is None:
+        symbolic = is_symbolic(Slist)
+    want = "a 6×n matrix (one screw axis [ω; v] per column) or a sequence of n 6-vectors"
+    if isinstance(Slist, (str, bytes)) or Slist is None or isinstance(Slist, (numbers.Number, sp.Basic)):
+        raise TypeError(f"{name} must be {want}, got {describe(Slist)}")
+    if isinstance(Slist, sp.MatrixBase):
+        if Slist.rows != 6:
+            raise ValueError(f"{name} must be {want}, got {describe(Slist)}")
+        return as_matrix(Slist, name, (6, None), symbolic)
+    if isinstance(Slist, np.ndarray) and Slist.ndim == 2:
+        if Slist.shape[0] != 6:
+            raise ValueError(f"{name} must be {want}, got {describe(Slist)}")
+        return as_matrix(Slist, name, (6, None), symbolic)
+    if isinstance(Slist, (list, tuple)):
+        if len(Slist) == 0:
+            raise ValueError(f"{name} must be {want}, got an empty {type(Slist).__name__}")
+        cols = [as_vector(s, f"{name}[{i}]", 6, symbolic) for i, s in enumerate(Slist)]
+        if symbolic:
+            return sp.Matrix.hstack(*cols)
+        return np.column_stack(cols)
+    if isinstance(Slist, np.ndarray) and Slist.ndim == 1 and Slist.shape == (6,):
+        return as_matrix(Slist.reshape(6, 1), name, (6, 1), symbolic)
+    raise TypeError(f"{name} must be {want}, got {describe(Slist)}")
+
+
+def as_thetas(thetas: Any, n: int, name: str = "thetas", symbolic: bool | None = None):
+    """n joint values (numbers or SymPy expressions) as a flat list (symbolic) or float array."""
+    if symbolic is None:
+        symbolic = is_symbolic(thetas)
+    if isinstance(thetas, (numbers.Number, sp.Basic)) and not isinstance(thetas, bool) and n == 1:
+        thetas = [thetas]
+    v = as_vector(thetas, name, n, symbolic)
+    return list(v) if symbolic else v
+
+
+def _fmt_shape(shape) -> str:
+    if shape is None:
+        return "(any)"
+    return "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
+
+
+def is_zero(e: Any) -> bool:
+    """Exact zero test for a SymPy expression (simplifies only when needed)."""
+    if e == 0:
+        return True
+    if not isinstance(e, sp.Basic) or not e.free_symbols:
+        try:
+            return abs(complex(sp.N(e, 30))) < 1e-25
+        except (TypeError, ValueError):
+            pass
+    return sp.simplify(e) == 0
+

@@ -1,0 +1,219 @@
+"""Jacobians of an open chain: space J_s, body J_b and the problem set's geometric J.
+
+Three Jacobians, one twist convention [ω; v] (angular rows first):
+
+* space Jacobian   V_s = J_s(θ) θ̇,  column i = Ad_{e^{[S1]θ1}⋯e^{[S_{i−1}]θ_{i−1}}} S_i;
+* body Jacobian    V_b = J_b(θ) θ̇,  column i = Ad_{e^{−[B_n]θ_n}⋯e^{−[B_{i+1}]θ_{i+1}}} B_i;
+* geometric Jacobian [ω_s; ṗ] = J(θ) θ̇ with J = blockdiag(R, R) J_b = [[I, 0], [−[p], I]] J_s,
+  where T(θ) = [[R, p], [0, 1]]: angular velocity in the space frame, velocity of the
+  end-effector origin p in the space frame.
+
+Pinocchio and the Robotics Toolbox put the linear rows first: see :func:`linear_first`.
+"""
+from __future__ import annotations
+
+import numpy as np
+import sympy as sp
+
+from ._backend import as_matrix, as_screw_list, as_thetas, describe, is_symbolic
+from .rigid import check_se3, check_so3, cross, skew
+from .screws import _exp6, _screw_kind
+
+__all__ = [
+    "jacobian_space", "jacobian_body", "geometric_jacobian",
+    "space_to_body", "body_to_space", "body_to_geometric", "geometric_to_body",
+    "space_to_geometric", "geometric_to_space", "linear_first", "angular_first",
+    "position_jacobian",
+]
+
+
+def _prepare(Slist, thetas, name, symbolic=None):
+    """Validated (screws 6×n, thetas, joint kinds 'R'/'P', symbolic?) for a screw list and joint values."""
+    if symbolic is None:
+        symbolic = is_symbolic(Slist, thetas)
+    S = as_screw_list(Slist, name, symbolic)
+    n = S.shape[1]
+    th = as_thetas(thetas, n, "thetas", symbolic)
+    kinds = [_screw_kind(S[:, i], f"{name} column {i + 1}") for i in range(n)]
+    return S, th, kinds, symbolic
+
+
+def _ad_apply(T, S, symbolic):
+    """Ad_T S = [R ω; p × (R ω) + R v] without forming the 6×6 adjoint."""
+    if symbolic:
+        R, p = T[:3, :3], T[:3, 3]
+        w = R * S[:3, 0]
+        return sp.Matrix.vstack(w, cross(p, w) + R * S[3:, 0])
+    R, p = T[:3, :3], T[:3, 3]
+    w = R @ S[:3]
+    return np.concatenate([w, cross(p, w) + R @ S[3:]])
+
+
+def jacobian_space(Slist, thetas):
+    """Space Jacobian J_s(θ) (6×n, rows [ω; v]): V_s = J_s θ̇.
+
+    Column i is Ad_{e^{[S1]θ1}⋯e^{[S_{i−1}]θ_{i−1}}} S_i; the first column is S_1.
+    """
+    S, th, kinds, symbolic = _prepare(Slist, thetas, "Slist")
+    n = S.shape[1]
+    T = sp.eye(4) if symbolic else np.eye(4)
+    cols = []
+    for i in range(n):
+        Si = S[:, i]
+        cols.append(Si if i == 0 else _ad_apply(T, Si, symbolic))
+        E = _exp6(Si, th[i], kinds[i], symbolic)
+        T = T * E if symbolic else T @ E
+    return sp.Matrix.hstack(*cols) if symbolic else np.column_stack(cols)
+
+
+def jacobian_body(Blist, thetas):
+    """Body Jacobian J_b(θ) (6×n, rows [ω; v]): V_b = J_b θ̇.
+
+    Column i is Ad_{e^{−[B_n]θ_n}⋯e^{−[B_{i+1}]θ_{i+1}}} B_i; the last column is B_n.
+    """
+    B, th, kinds, symbolic = _prepare(Blist, thetas, "Blist")
+    n = B.shape[1]
+    T = sp.eye(4) if symbolic else np.eye(4)
+    cols = [None] * n
+    for i in range(n - 1, -1, -1):
+        Bi = B[:, i]
+        cols[i] = Bi if i == n - 1 else _ad_apply(T, Bi, symbolic)
+        E = _exp6(-Bi, th[i], kinds[i], symbolic)
+        T = T * E if symbolic else T @ E
+    return sp.Matrix.hstack(*cols) if symbolic else np.column_stack(cols)
+
+
+def geometric_jacobian(M, Slist, thetas):
+    """The problem set's geometric Jacobian J(θ) (6×n): [ω_s; ṗ] = J θ̇.
+
+    J = blockdiag(R, R) J_b = [[I, 0], [−[p], I]] J_s with T(θ) = e^{[S1]θ1}⋯e^{[Sn]θn} M = [[R, p], [0, 1]]:
+    top rows the angular velocity in {s}, bottom rows the velocity of the end-effector origin p in {s}.
+    """
+    from .chains import fk_space  # chains imports this module
+    T = fk_space(M, Slist, thetas)
+    Js = jacobian_space(Slist, thetas)
+    return space_to_geometric(Js, T)
+
+
+def _transform(T, name="T"):
+    return check_se3(T, name)
+
+
+def space_to_body(Js, T):
+    """J_b = Ad_{T⁻¹} J_s (T = T(θ), the end-effector pose)."""
+    symbolic = is_symbolic(Js, T)
+    Js, T = as_matrix(Js, "Js", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
+    R, p = T[:3, :3], T[:3, 3]
+    if symbolic:
+        Rt = R.T
+        top = Rt * Js[:3, :]
+        return sp.Matrix.vstack(top, Rt * (Js[3:, :] - skew(p) * Js[:3, :]))
+    Rt = R.T
+    return np.vstack([Rt @ Js[:3], Rt @ (Js[3:] - skew(p) @ Js[:3])])
+
+
+def body_to_space(Jb, T):
+    """J_s = Ad_T J_b."""
+    symbolic = is_symbolic(Jb, T)
+    Jb, T = as_matrix(Jb, "Jb", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
+    R, p = T[:3, :3], T[:3, 3]
+    if symbolic:
+        w = R * Jb[:3, :]
+        return sp.Matrix.vstack(w, skew(p) * w + R * Jb[3:, :])
+    w = R @ Jb[:3]
+    return np.vstack([w, skew(p) @ w + R @ Jb[3:]])
+
+
+def _rotation_of(T, symbolic, name="T"):
+    """R from a 4×4 transform T or a 3×3 rotation R."""
+    X = as_matrix(T, name, None, symbolic)
+    if X.shape == (3, 3):
+        return check_so3(X, name)
+    if X.shape == (4, 4):
+        return check_se3(X, name)[:3, :3]
+    raise ValueError(f"{name} must be a 4×4 transform T(θ) or its 3×3 rotation R, got {describe(T)}")
+
+
+def body_to_geometric(Jb, T):
+    """Geometric J = blockdiag(R, R) J_b, with R the rotation of T(θ) (T or R may be given)."""
+    symbolic = is_symbolic(Jb, T)
+    Jb = as_matrix(Jb, "Jb", (6, None), symbolic)
+    R = _rotation_of(T, symbolic)
+    if symbolic:
+        return sp.Matrix.vstack(R * Jb[:3, :], R * Jb[3:, :])
+    return np.vstack([R @ Jb[:3], R @ Jb[3:]])
+
+
+def geometric_to_body(J, T):
+    """J_b = blockdiag(Rᵀ, Rᵀ) J (the inverse of :func:`body_to_geometric`)."""
+    symbolic = is_symbolic(J, T)
+    J = as_matrix(J, "J", (6, None), symbolic)
+    R = _rotation_of(T, symbolic)
+    if symbolic:
+        return sp.Matrix.vstack(R.T * J[:3, :], R.T * J[3:, :])
+    return np.vstack([R.T @ J[:3], R.T @ J[3:]])
+
+
+def space_to_geometric(Js, T):
+    """Geometric J = [[I, 0], [−[p], I]] J_s: ṗ = v_s + ω_s × p."""
+    symbolic = is_symbolic(Js, T)
+    Js, T = as_matrix(Js, "Js", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
+    p = T[:3, 3]
+    if symbolic:
+        return sp.Matrix.vstack(Js[:3, :], Js[3:, :] - skew(p) * Js[:3, :])
+    return np.vstack([Js[:3], Js[3:] - skew(p) @ Js[:3]])
+
+
+def geometric_to_space(J, T):
+    """J_s = [[I, 0], [[p], I]] J (the inverse of :func:`space_to_geometric`)."""
+    symbolic = is_symbolic(J, T)
+    J, T = as_matrix(J, "J", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
+    p = T[:3, 3]
+    if symbolic:
+        return sp.Matrix.vstack(J[:3, :], J[3:, :] + skew(p) * J[:3, :])
+    return np.vstack([J[:3], J[3:] + skew(p) @ J[:3]])
+
+
+def linear_first(J):
+    """Rows [ω; v] → [v; ω] (the order of Pinocchio and the Robotics Toolbox); a twist or a 6×n Jacobian."""
+    symbolic = is_symbolic(J)
+    if isinstance(J, sp.MatrixBase) or (np.ndim(J) == 2):
+        X = as_matrix(J, "J", (6, None), symbolic)
+    else:
+        from ._backend import as_vector
+        X = as_vector(J, "J", 6, symbolic)
+        if symbolic:
+            X = sp.Matrix(X)
+    if symbolic:
+        return sp.Matrix.vstack(X[3:, :], X[:3, :])
+    return np.concatenate([X[3:], X[:3]])
+
+
+def angular_first(J):
+    """Rows [v; ω] → [ω; v] (from Pinocchio/Robotics Toolbox order back to the textbook's)."""
+    return linear_first(J)  # swapping the two 3-row blocks is its own inverse
+
+
+def position_jacobian(p, thetas):
+    """∂p/∂θ for a position map p(θ) written by hand (SymPy expressions): ṗ = (∂p/∂θ) θ̇.
+
+    Problem 1.1's cart-pole: p = [θ1 + L cos θ2, h + L sin θ2] gives [[1, −L sin θ2], [0, L cos θ2]].
+    """
+    if isinstance(p, sp.MatrixBase):
+        exprs = list(p)
+    elif isinstance(p, (list, tuple)):
+        exprs = list(p)
+    else:
+        raise TypeError(f"p must be a sequence or column of SymPy expressions (the position map), got {describe(p)}")
+    for i, e in enumerate(exprs):
+        if isinstance(e, (str, bytes)) or not isinstance(e, (sp.Expr, int, float)):
+            raise TypeError(f"p[{i}] must be a SymPy expression in the joint symbols, got {describe(e)}")
+    if isinstance(thetas, sp.Symbol):
+        thetas = [thetas]
+    if not isinstance(thetas, (list, tuple, sp.MatrixBase)):
+        raise TypeError(f"thetas must be a sequence of SymPy symbols (the joint variables), got {describe(thetas)}")
+    ths = list(thetas)
+    for i, t in enumerate(ths):
+        if not isinstance(t, sp.Symbol):
+            raise TypeError(f"thetas[{i}] must be a SymPy Symbol (a joint variable), got {describe(t)}")
+    return sp.Matrix([sp.sympify(e) for e in exprs]).jacobian(ths)
