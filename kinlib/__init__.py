@@ -15,6 +15,10 @@ from .jacobians import (
     space_to_body, space_to_geometric,
 )
 from .chains import SerialChain, fk_body, fk_space
+from .singularities import column_space, left_null_space, rank_at, singular_configurations, task_rows
+from .manipulability import (
+    condition_number, isotropy, manipulability, twist_speed_form, velocity_ellipsoid,
+)
 from . import robots
 
 __version__ = "0.1.0"
@@ -26,4 +30,6 @@ __all__ = [
     "jacobian_space", "jacobian_body", "geometric_jacobian", "space_to_body", "body_to_space",
     "body_to_geometric", "geometric_to_body", "space_to_geometric", "geometric_to_space",
     "linear_first", "angular_first", "position_jacobian", "robots",
+    "task_rows", "singular_configurations", "rank_at", "column_space", "left_null_space",
+    "manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
 ]

@@ -182,8 +182,10 @@ def is_zero(e: Any) -> bool:
     if e == 0:
         return True
     if not isinstance(e, sp.Basic) or not e.free_symbols:
+        # exact numbers: zero to 25 digits; numbers carrying Floats (from float input): zero to float precision
+        tol = 1e-9 if isinstance(e, sp.Basic) and e.has(sp.Float) else 1e-25
         try:
-            return abs(complex(sp.N(e, 30))) < 1e-25
+            return abs(complex(sp.N(e, 30))) < tol
         except (TypeError, ValueError):
             pass
     return sp.simplify(e) == 0

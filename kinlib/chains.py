@@ -10,11 +10,10 @@ from typing import Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_screw_list, describe, is_symbolic
+from ._backend import as_matrix, as_screw_list, as_thetas, describe, is_symbolic
 from .codegen import CompiledMatrix
 from .jacobians import _prepare, jacobian_body as _jacobian_body, jacobian_space as _jacobian_space
-from .jacobians import space_to_geometric
-from .rigid import adjoint, check_se3, cross, trans_inv
+from .rigid import adjoint, check_se3, cross, skew, trans_inv
 from .screws import _exp6
 
 __all__ = ["fk_space", "fk_body", "SerialChain"]
@@ -130,8 +129,9 @@ class SerialChain:
                 e = _jacobian_space(self.screws, th)
             elif what == "jb":
                 e = _jacobian_body(self.body_screws, th)
-            elif what == "jg":
-                e = space_to_geometric(self._expr("js"), self._expr("fk"))
+            elif what == "jg":  # = space_to_geometric(J_s, T) without re-checking T (its SE(3) check costs seconds on big T)
+                js, p = self._expr("js"), self._expr("fk")[:3, 3]
+                e = sp.Matrix.vstack(js[:3, :], js[3:, :] - skew(p) * js[:3, :])
             elif what == "skeleton":
                 e = self._skeleton_expr()
             else:  # pragma: no cover
@@ -152,6 +152,8 @@ class SerialChain:
         return sp.Matrix.hstack(*cols)
 
     def _eval(self, what: str, q):
+        if type(q) is np.ndarray and q.dtype.kind == "f" and what in self._num:  # fast path: float array
+            return self._num[what](q)
         expr = self._expr(what)
         if q is None:
             return expr
@@ -161,7 +163,7 @@ class SerialChain:
                 qs = [qs]
             if not isinstance(qs, (list, tuple)) or len(qs) != self.n:
                 raise ValueError(f"q must hold {self.n} joint values for {self.name}, got {describe(q)}")
-            vals = [sp.sympify(v) for v in qs]
+            vals = list(as_thetas(qs, self.n, "q", True))  # rejects strings (sympify would make symbols)
             return expr.xreplace(dict(zip(self.thetas, vals))) if all(v.is_Atom for v in vals) \
                 else expr.subs(dict(zip(self.thetas, vals)), simultaneous=True)
         return self._compiled(what)(q)

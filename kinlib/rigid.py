@@ -9,6 +9,7 @@ import random
 
 import numpy as np
 import sympy as sp
+from sympy.core.function import AppliedUndef
 
 from ._backend import as_matrix, as_vector, describe, is_symbolic, is_zero
 
@@ -117,6 +118,8 @@ def _numeric_sample(M):
     syms = sorted(M.free_symbols, key=str)
     rng = random.Random(12345)
     vals = {s: sp.Float(rng.uniform(0.3, 1.7)) for s in syms}
+    # joint angles written as functions of time, θ_i(t) (problem 1.2), are sampled like symbols
+    vals.update({f: sp.Float(rng.uniform(0.3, 1.7)) for f in sorted(M.atoms(AppliedUndef), key=str)})
     try:
         return np.array(M.xreplace(vals).evalf(), dtype=float)
     except (TypeError, ValueError):

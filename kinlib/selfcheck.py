@@ -1,0 +1,448 @@
+"""Self-checks for student workbooks: is an answer right, without revealing it.
+
+At build time (``python -m kinlib.handouts``) each reference answer is turned into a *fingerprint*:
+the answer evaluated at fixed sample values of its symbols (the same values for a symbol of the same
+name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA-256). The workbook
+holds only the fingerprint; the student's answer is fingerprinted the same way when the self-check
+cell runs, so a right answer in any equivalent form (simplified or not, floats or exact) passes::
+
+    from kinlib.selfcheck import check
+    check("2.2", Js="matrix|6x3|3f0c1b9e5a7d2c44")
+
+Kinds of answer (``kinds`` in the solution cell's ``kinlib`` metadata):
+
+- default / ``"expr"``: a SymPy Matrix, expression or number, compared as a function of its symbols;
+- ``"choice"``: an int, string or tuple of them (joint numbers 1-based; order ignored);
+- ``"set"``: a SymPy Set (or Python set/list of values, or a dict {symbol: Set}), compared through its
+  points in [-2π, 2π] taken modulo 2π (angles), intervals by their end points;
+- ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector.
+
+In a workbook, ``%load_ext kinlib.selfcheck`` adds the cell magic ``%%needs NAME...``: the cell runs
+only once the names it uses from the student's answers are filled in, and says so otherwise.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import sys
+from typing import Any
+
+import numpy as np
+import sympy as sp
+
+__all__ = ["check", "fingerprint", "describe_answer", "Unanswered", "CannotCheck", "KINDS",
+           "sample_value", "load_ipython_extension"]
+
+KINDS = ("default", "expr", "choice", "set", "subspace")
+SAMPLE_POINTS = 3          # configurations at which an answer's symbols are sampled
+_DIGITS = 8                # significant digits kept of every sampled value
+_ZERO = 1e-10              # |x| below this counts as 0
+_PROJ_DECIMALS = 6         # decimals kept of a subspace's projector
+
+
+class Unanswered(Exception):
+    """The answer variable is missing or still ``...``."""
+
+
+class CannotCheck(Exception):
+    """The answer is of a form the self-check cannot fingerprint (message says why)."""
+
+
+class WrongForm(Exception):
+    """The answer has the wrong type or shape (message says what was expected)."""
+
+
+# ---------------------------------------------------------------------------------------------------
+# Sample values: a fixed exact rational in [0.2, 1.3] per (symbol name, sample index).
+
+def sample_value(name: str, k: int) -> sp.Rational:
+    """The value given to every symbol called ``name`` at sample configuration ``k``."""
+    h = hashlib.sha256(f"kinlib-selfcheck:{name}:{k}".encode()).digest()
+    u = int.from_bytes(h[:4], "big") % 1_100_000
+    return sp.Rational(200_000 + u, 1_000_000)
+
+
+def _point(expr, k: int) -> dict:
+    syms = getattr(expr, "free_symbols", set())
+    return {s: sample_value(s.name, k) for s in syms if isinstance(s, sp.Symbol)}
+
+
+def _fmt(z) -> str:
+    """A number as a stable string of 8 significant digits ('0' for |x| < 1e-10)."""
+    try:
+        z = complex(z)
+    except (TypeError, ValueError) as e:
+        raise CannotCheck(f"it does not evaluate to a number ({e})") from None
+    if not (math.isfinite(z.real) and math.isfinite(z.imag)):
+        return "nan"
+    re = 0.0 if abs(z.real) < _ZERO else z.real
+    im = 0.0 if abs(z.imag) < _ZERO else z.imag
+    s = "0" if re == 0.0 else f"{re:.{_DIGITS - 1}e}"
+    if im != 0.0:
+        s += f"{im:+.{_DIGITS - 1}e}j"
+    return s
+
+
+def _evaluate(x, k: int):
+    """``x`` (SymPy object) with its symbols at sample point ``k``, evaluated to 30 digits."""
+    pt = _point(x, k)
+    y = x.subs(pt) if pt else x
+    return y.evalf(30) if hasattr(y, "evalf") else y
+
+
+# ---------------------------------------------------------------------------------------------------
+# Canonical forms, one per kind.
+
+def _is_unanswered(value) -> bool:
+    return value is Ellipsis or value is None
+
+
+def _as_sympy_value(value):
+    """Matrices, arrays, lists of numbers -> SymPy Matrix; numbers/expressions -> SymPy."""
+    if isinstance(value, sp.MatrixBase):
+        return sp.Matrix(value)
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            return sp.sympify(value.item())
+        if value.ndim > 2:
+            raise WrongForm(f"it should be a matrix or a number, yours is an array of shape {value.shape}")
+        return sp.Matrix(value.tolist())
+    if isinstance(value, (list, tuple)):
+        try:
+            return sp.Matrix(value)
+        except Exception:
+            raise WrongForm(f"it should be a SymPy Matrix, expression or number; yours is a "
+                            f"{type(value).__name__} that is not a matrix") from None
+    if isinstance(value, (str, bytes, dict, set)):
+        raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is a {type(value).__name__}")
+    try:
+        v = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError):
+        raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is a "
+                        f"{type(value).__name__}") from None
+    if isinstance(v, sp.MatrixBase):
+        return sp.Matrix(v)
+    return v
+
+
+def _shape_of(v) -> str:
+    return f"{v.shape[0]}x{v.shape[1]}" if isinstance(v, sp.MatrixBase) else ""
+
+
+def _canon_default(value, shape: str | None = None):
+    if isinstance(value, (bool, np.bool_, sp.logic.boolalg.BooleanAtom)):     # a yes/no answer
+        return "bool", "", [str(bool(value))]
+    if isinstance(value, dict) or shape == "dict":        # e.g. {configuration name: row of J}
+        if not isinstance(value, dict):
+            raise WrongForm(f"it should be a dict, yours is a {type(value).__name__}")
+        items = sorted(value.items(), key=lambda kv: str(kv[0]))
+        return "matrix", "dict", [[str(k), list(_canon_default(v)[1:])] for k, v in items]
+    v = _as_sympy_value(value)
+    if isinstance(v, sp.MatrixBase):
+        mine = _shape_of(v)
+        if shape == "" and v.shape == (1, 1):      # a 1x1 Matrix for a scalar answer
+            v, mine = v[0, 0], ""
+        elif shape not in (None, mine):
+            raise WrongForm(f"it should be {_shape_words(shape)}, yours is {_shape_words(mine)}")
+    elif shape:
+        raise WrongForm(f"it should be {_shape_words(shape)}, yours is {_shape_words('')}")
+    if isinstance(v, sp.MatrixBase):
+        pts = [[_fmt(e) for e in _evaluate(v, k)] for k in range(SAMPLE_POINTS)]
+        return "matrix", _shape_of(v), pts
+    if not isinstance(v, sp.Expr):
+        raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is {type(v).__name__}")
+    pts = [_fmt(_evaluate(v, k)) for k in range(SAMPLE_POINTS)]
+    return "scalar", "", pts
+
+
+def _choice_item(x):
+    if isinstance(x, (bool, np.bool_)):
+        return f"b:{bool(x)}"
+    if isinstance(x, str):
+        return "s:" + " ".join(x.strip().lower().split())
+    try:
+        xi = sp.sympify(x, strict=True)
+    except (sp.SympifyError, TypeError):
+        raise WrongForm(f"choices are numbers or strings, yours holds a {type(x).__name__}") from None
+    if isinstance(xi, sp.Integer) or (xi.is_number and xi == int(xi)):
+        return f"i:{int(xi)}"
+    if xi.is_number:
+        return "n:" + _fmt(xi)
+    raise WrongForm(f"choices are numbers or strings, yours holds {xi}")
+
+
+def _canon_choice(value, shape=None):
+    if isinstance(value, (list, tuple, set, frozenset, sp.FiniteSet, sp.Tuple)):
+        items = sorted(_choice_item(x) for x in value)
+    elif isinstance(value, np.ndarray):
+        items = sorted(_choice_item(x) for x in value.ravel().tolist())
+    else:
+        items = [_choice_item(value)]
+    return "choice", "", items
+
+
+def _to_set(value):
+    if isinstance(value, sp.Set):
+        return value
+    if isinstance(value, (set, frozenset, list, tuple)):
+        return sp.FiniteSet(*[sp.sympify(v) for v in value])
+    if isinstance(value, (int, float, sp.Expr)):
+        return sp.FiniteSet(value)
+    raise WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
+
+
+def _angle_point(p, k):
+    """A point of a set, modulo 2π, as a stable string (tuples component-wise)."""
+    if isinstance(p, (sp.Tuple, tuple)):
+        return "(" + ",".join(_angle_point(q, k) for q in p) + ")"
+    p = sp.sympify(p)
+    pt = _point(p, k)
+    if pt:
+        p = p.subs(pt)
+    if p.is_number and p.is_real is not False:
+        p = sp.Mod(p, 2 * sp.pi)
+        s = _fmt(p.evalf(30))
+        return "0" if s == _fmt(2 * math.pi) else s
+    return _fmt(p.evalf(30))
+
+
+def _canon_one_set(s, k):
+    s = _to_set(s)
+    pt = _point(s, k)
+    if pt:
+        s = s.subs(pt)
+    if not isinstance(s, sp.FiniteSet):
+        window = sp.Interval(-2 * sp.pi, 2 * sp.pi)
+        s = sp.Intersection(s, window)
+        if isinstance(s, sp.Intersection) or isinstance(s, sp.ConditionSet):
+            raise CannotCheck("SymPy cannot list this set's points in [-2π, 2π]")
+    parts = s.args if isinstance(s, sp.Union) else (s,)
+    out = set()
+    for part in parts:
+        if isinstance(part, sp.FiniteSet):
+            out.update(_angle_point(p, k) for p in part)
+        elif isinstance(part, sp.Interval):
+            out.add(f"I{'(' if part.left_open else '['}{_fmt(part.start.evalf(30))},"
+                    f"{_fmt(part.end.evalf(30))}{')' if part.right_open else ']'}")
+        elif part is sp.S.EmptySet:
+            pass
+        else:
+            raise CannotCheck(f"SymPy cannot list the points of {type(part).__name__} in [-2π, 2π]")
+    return sorted(out)
+
+
+def _canon_set(value, shape=None):
+    if isinstance(value, dict):
+        out = []
+        for key in sorted(value, key=str):
+            out.append([str(key)] + [_canon_one_set(value[key], k) for k in range(SAMPLE_POINTS)])
+        return "set", "dict", out
+    return "set", "", [_canon_one_set(value, k) for k in range(SAMPLE_POINTS)]
+
+
+def _canon_subspace(value, shape=None):
+    if isinstance(value, (list, tuple)) and value and all(
+            isinstance(c, (sp.MatrixBase, np.ndarray, list, tuple)) for c in value):
+        value = sp.Matrix.hstack(*[sp.Matrix(c) for c in value])   # a list of spanning vectors
+    v = _as_sympy_value(value)
+    if not isinstance(v, sp.MatrixBase):
+        raise WrongForm("it should be a Matrix whose columns span the subspace")
+    m = str(v.shape[0])
+    if shape not in (None, m):
+        raise WrongForm(f"its columns should be {shape}-vectors, yours are {m}-vectors")
+    pts = []
+    for k in range(SAMPLE_POINTS):
+        try:
+            A = np.array(_evaluate(v, k).tolist(), dtype=complex)
+        except TypeError as e:
+            raise CannotCheck(f"it does not evaluate to numbers ({e})") from None
+        if np.abs(A.imag).max(initial=0.0) > _ZERO:
+            raise CannotCheck("it has complex entries")
+        A = A.real
+        if A.size == 0 or np.abs(A).max() < _ZERO:
+            P = np.zeros((v.shape[0], v.shape[0]))
+        else:
+            U, s, _ = np.linalg.svd(A)
+            r = int((s > 1e-9 * max(1.0, s[0])).sum())
+            Q = U[:, :r]
+            P = Q @ Q.T
+        P = np.round(P, _PROJ_DECIMALS) + 0.0
+        pts.append([f"{x:.{_PROJ_DECIMALS}f}" for x in P.ravel()])
+    return "subspace", m, pts
+
+
+_CANON = {"default": _canon_default, "expr": _canon_default, "choice": _canon_choice,
+          "set": _canon_set, "subspace": _canon_subspace}
+
+
+def _shape_words(shape: str) -> str:
+    if shape == "dict":
+        return "a dict"
+    if not shape:
+        return "a single expression or number (not a matrix)"
+    r, c = shape.split("x")
+    return f"a {r}×{c} matrix"
+
+
+def _hash(kind, canon, salt: str = "") -> str:
+    text = json.dumps([kind, canon], separators=(",", ":"))
+    return hashlib.sha256(f"kinlib-selfcheck-v1:{salt}:{text}".encode()).hexdigest()[:16]
+
+
+def fingerprint(value, kind: str = "default", salt: str = "") -> str:
+    """The spec string of ``value``: ``"<form>|<shape>|<hash>"`` (no information about the value itself).
+
+    ``form`` is matrix/scalar/choice/set/subspace; ``shape`` is ``"6x3"`` for a matrix, the ambient
+    dimension for a subspace, ``"dict"`` for a dict of sets. ``salt`` (the workbooks use
+    ``"part:name"``) makes equal answers to different questions hash differently.
+    """
+    if kind not in _CANON:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    if _is_unanswered(value):
+        raise Unanswered("the value is missing or ...")
+    form, shape, canon = _CANON[kind](value)
+    return f"{form}|{shape}|{_hash(form, canon, salt)}"
+
+
+def describe_answer(value, kind: str = "default") -> str:
+    """A short description of the form of an answer (for the workbook's stub), e.g. 'a 6×3 Matrix'."""
+    if kind == "choice":
+        return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"
+    if kind == "set":
+        return "a dict {symbol: SymPy Set}" if isinstance(value, dict) else "a SymPy Set"
+    if isinstance(value, (bool, np.bool_, sp.logic.boolalg.BooleanAtom)):
+        return "True or False"
+    if kind == "subspace":
+        try:
+            return f"a Matrix whose columns span the subspace ({sp.Matrix(value).shape[0]}-vectors)"
+        except Exception:
+            return "a Matrix whose columns span the subspace"
+    try:
+        v = None if isinstance(value, dict) else _as_sympy_value(value)
+    except WrongForm:
+        return "a value"
+    if isinstance(value, dict):
+        return "a dict {" + ", ".join(map(str, value)) + ": ...}"
+    if isinstance(v, sp.MatrixBase):
+        return f"a {v.shape[0]}×{v.shape[1]} Matrix"
+    if isinstance(v, sp.Expr) and v.free_symbols:
+        return "a SymPy expression"
+    return "a number"
+
+
+# ---------------------------------------------------------------------------------------------------
+# The student's side.
+
+def _parse_spec(spec: str):
+    try:
+        form, shape, digest = spec.split("|")
+    except ValueError:
+        raise ValueError(f"a self-check spec looks like 'matrix|6x3|<16 hex digits>', got {spec!r}") from None
+    return form, shape, digest
+
+
+_FORM_KIND = {"matrix": "default", "scalar": "default", "bool": "default", "choice": "choice", "set": "set",
+              "subspace": "subspace"}
+
+last_results: dict = {}
+
+
+def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
+    """``(status, message)`` for an answer against a spec; status is correct/incorrect/unanswered/error."""
+    form, shape, digest = _parse_spec(spec)
+    if _is_unanswered(value):
+        return "unanswered", "not answered yet"
+    if form == "none":
+        return "error", "this answer has no automatic self-check: compare it with the worked solution"
+    kind = _FORM_KIND.get(form)
+    if kind is None:
+        raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
+    try:
+        if kind == "default":
+            mine_form, mine_shape, canon = _canon_default(value, shape)
+        elif kind == "subspace":
+            mine_form, mine_shape, canon = _canon_subspace(value, shape)
+        else:
+            mine_form, mine_shape, canon = _CANON[kind](value)
+            if kind == "set" and mine_shape != shape:
+                want = "a dict {symbol: Set}" if shape == "dict" else "a single Set"
+                raise WrongForm(f"it should be {want}")
+    except WrongForm as e:
+        return "incorrect", f"wrong form: {e}"
+    except CannotCheck as e:
+        return "error", f"cannot check it automatically: {e}"
+    except Exception as e:  # anything the student's object throws while being evaluated
+        return "error", f"could not evaluate your answer ({type(e).__name__}: {e})"
+    if _hash(mine_form, canon, salt) == digest:
+        return "correct", "correct"
+    if kind == "default":
+        how = "its values differ from the answer's at sample values of its symbols"
+    elif kind == "subspace":
+        how = "it spans a different subspace"
+    elif kind == "set":
+        how = "it holds different points"
+    else:
+        how = "that is not the right choice"
+    return "incorrect", f"not right yet: {how}"
+
+
+def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
+    """Print for each answer variable of ``part`` whether it is right; never shows the answer.
+
+    ``specs`` maps variable names to fingerprints made at build time; the variables are looked up
+    in the caller's globals (the notebook), so a missing variable reads as "not answered yet".
+    """
+    ns = _namespace if _namespace is not None else sys._getframe(1).f_globals
+    results = {}
+    for name, spec in specs.items():
+        value = ns.get(name, Ellipsis)
+        status, message = verdict(value, spec, salt=f"{part}:{name}")
+        results[name] = status
+        mark = {"correct": "✓", "incorrect": "✗", "unanswered": "…", "error": "?"}[status]
+        if status == "unanswered":
+            form, shape, _ = _parse_spec(spec)
+            what = _shape_words(shape) if form in ("matrix", "scalar") else (
+                "see the question" if form == "none" else "True or False" if form == "bool" else f"a {form}")
+            message = f"not answered yet: replace the ... in `{name} = ...` above with your answer ({what})"
+        print(f"part {part} · {name}: {mark} {message}")
+    last_results[part] = results
+
+
+# ---------------------------------------------------------------------------------------------------
+# Build side: used by kinlib.handouts inside the kernel, right after a part's solution cells ran.
+
+def _emit(answers: dict, ns: dict) -> None:
+    """Print one JSON line {name: {"spec", "describe"} | {"error"}} for answers {name: (kind, part)}."""
+    out = {}
+    for name, (kind, part) in answers.items():
+        if name not in ns:
+            out[name] = {"error": f"the solution cells did not define {name}"}
+            continue
+        try:
+            out[name] = {"spec": fingerprint(ns[name], kind, salt=f"{part}:{name}"),
+                         "describe": describe_answer(ns[name], kind)}
+        except Exception as e:
+            out[name] = {"error": f"{type(e).__name__}: {e}"}
+    print("KINLIB-SELFCHECK " + json.dumps(out))
+
+
+# ---------------------------------------------------------------------------------------------------
+# The %%needs cell magic.
+
+def _needs(line: str, cell: str):
+    from IPython import get_ipython
+    ip = get_ipython()
+    names = line.split("#", 1)[0].split()
+    missing = [n for n in names if _is_unanswered(ip.user_ns.get(n))]
+    if missing:
+        print(f"(skipped: this cell uses {', '.join(missing)} from your answers above; "
+              f"fill {'them' if len(missing) > 1 else 'it'} in, then run this cell again)")
+        return None
+    ip.run_cell(cell)
+    return None
+
+
+def load_ipython_extension(ip) -> None:
+    """``%load_ext kinlib.selfcheck``: registers the ``%%needs NAME...`` cell magic."""
+    ip.register_magic_function(_needs, magic_kind="cell", magic_name="needs")

@@ -1,0 +1,403 @@
+"""Interactive explorers (ipywidgets; imported on demand: ``from kinlib import widgets``).
+
+How the picture updates: each widget owns one matplotlib ``Figure`` that is *not* registered with
+pyplot (so the inline backend never prints a second, static copy). A slider move moves the existing
+artists (``ChainArtist.update`` etc., no figure rebuilt), renders the figure once with Agg and puts the
+PNG into an ``ipywidgets.Image``. This works with the plain inline backend in JupyterLab, Notebook and
+VS Code (no ipympl needed), and the last picture is kept in the saved widget state.
+
+Velocities come from the **geometric Jacobian** J(θ) = blockdiag(R, R) J_b, rows [ω_s; ṗ].
+Singularity test: the task rows J_r of J (default (ω_z, ṗ_x, ṗ_y) for a planar chain, all six rows
+otherwise) at θ; with σ_max ≥ … ≥ σ_min its singular values and w = √det(J_r J_rᵀ) (√det(J_rᵀ J_r)
+when fewer joints than rows) the manipulability, the configuration is called
+
+* ``"singular"`` when σ_min/σ_max < ``tol`` (default 10⁻⁶: J_r loses rank),
+* ``"near"`` when w < ``near`` · w_max (default 0.1; w_max = the largest w over a fixed sample of the
+  slider ranges: a relative, unit-free threshold),
+* ``"regular"`` otherwise.
+
+Speed: the static part of the figure (axes, grid, ticks, legend, {s}) is rendered once and cached;
+a slider move restores it, draws only the moving artists (blitting with Agg) and encodes a PNG.
+"""
+from __future__ import annotations
+
+import html
+import io
+import math
+from typing import Mapping, Sequence
+
+import numpy as np
+import ipywidgets as W
+from matplotlib.figure import Figure
+from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+from . import plotting as P
+from ._backend import describe
+
+__all__ = ["explorer", "Explorer", "config_picker", "ConfigPicker", "classify"]
+
+
+def classify(J_rows: np.ndarray, tol: float = 1e-6, near: float = 0.1, w_max: float | None = None) -> dict:
+    """Numbers for the readout of task rows J_r (m×n): rank, det (square only), manipulability w
+    (√det(J Jᵀ), or √det(Jᵀ J) when n < m), ratio σ_min/σ_max, ``relative`` = w / w_max and ``state``:
+    'singular' when σ_min/σ_max < tol, 'near' when w / w_max < near (w_max: the largest w over the
+    joint ranges; without it, the ratio σ_min/σ_max is compared with ``near``), else 'regular'."""
+    J = np.asarray(J_rows, float)
+    s = np.linalg.svd(J, compute_uv=False)
+    smax = float(s[0]) if s.size else 0.0
+    ratio = float(s[-1] / smax) if smax > 0 else 0.0
+    full = min(J.shape)
+    rank = int(np.sum(s > tol * max(smax, 1e-300))) if smax > 0 else 0
+    w = float(P.manipulability_values(J[None], "yoshikawa")[0])
+    rel = w / w_max if w_max else ratio
+    state = "singular" if ratio < tol else ("near" if rel < near else "regular")
+    return {"rank": rank, "full_rank": full, "det": float(np.linalg.det(J)) if J.shape[0] == J.shape[1] else None,
+            "manipulability": w, "ratio": ratio, "relative": rel, "state": state}
+
+
+def _png(canvas, fmt: str = "png") -> bytes:
+    """The canvas as PNG (RGB, fast zlib level 1: about 2/3 of the time of RGBA) or JPEG (quality 90,
+    several times faster to encode, slightly soft lines)."""
+    from PIL import Image
+    w, h = canvas.get_width_height(physical=True)
+    im = Image.frombuffer("RGBA", (w, h), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
+    buf = io.BytesIO()
+    if fmt == "jpeg":
+        im.save(buf, format="jpeg", quality=90)
+    else:
+        im.save(buf, format="png", compress_level=1)
+    return buf.getvalue()
+
+
+def _render_png(fig: Figure, dpi: float = None) -> bytes:
+    """Draw the whole figure with Agg and encode it as PNG."""
+    fig.canvas.draw()
+    return _png(fig.canvas)
+
+
+class _Blitter:
+    """Render a figure whose static part (axes, grid, ticks, legend, {s}) is drawn once and cached;
+    each render restores that background and draws only the moving artists, then encodes a PNG."""
+
+    def __init__(self, fig: Figure, artists: Sequence, fmt: str = "png"):
+        self.fig, self.artists, self.fmt = fig, [a for a in artists if a is not None], fmt
+        for a in self.artists:
+            a.set_animated(True)
+        self.background = None
+
+    def invalidate(self):
+        self.background = None
+
+    def render(self) -> bytes:
+        canvas = self.fig.canvas
+        if self.background is None:
+            canvas.draw()  # animated artists are skipped
+            self.background = canvas.copy_from_bbox(self.fig.bbox)
+        else:
+            canvas.restore_region(self.background)
+        renderer = canvas.get_renderer()
+        for a in self.artists:
+            if hasattr(a, "do_3d_projection") and hasattr(a, "set_segments"):
+                a.do_3d_projection()
+            a.draw(renderer)
+        return _png(canvas, self.fmt)
+
+
+def _new_figure(figsize, dpi, three_d: bool, ncols: int = 1):
+    fig = Figure(figsize=figsize, dpi=dpi)
+    FigureCanvasAgg(fig)
+    if ncols == 1:
+        ax = fig.add_subplot(projection="3d" if three_d else None)
+        return fig, ax
+    ax = fig.add_subplot(1, ncols, 1, projection="3d" if three_d else None)
+    return fig, ax
+
+
+def _slider_label(chain, i: int, rate: bool = False) -> str:
+    k = chain.joint_types[i]
+    base = f"θ{i + 1}"
+    if rate:
+        return f"θ̇{i + 1} ({'rad/s' if k == 'R' else 'len/s'})"
+    return f"{base} ({'rad' if k == 'R' else 'len'})"
+
+
+class Explorer(W.VBox):
+    """A slider per joint (θ_i in rad for revolute, length units for prismatic joints), optional sliders
+    for the joint rates θ̇_i, and one figure: the arm at θ, the end-effector velocity ṗ = J_ṗ θ̇ as an
+    arrow, the velocity ellipse, with a readout of det J_r (square task rows) or √det(J_r J_rᵀ), the
+    ratio σ_min/σ_max and a plain-words status.
+
+    State for tests and scripts: ``sliders``, ``rate_sliders``, ``status`` (HTML widget: contains
+    "singular" exactly when at or near a singular configuration), ``readout`` (HTML), ``image``
+    (the rendered PNG), ``fig``/``ax``, ``arm``/``velocity``/``ellipse`` artists, ``q``, ``qdot``,
+    ``info`` (the last :func:`classify` result), ``update(q=None, qdot=None)``.
+    """
+
+    def __init__(self, chain, *, q=None, qdot=None, rows=None, ranges=None, show_ellipse=True,
+                 show_velocity=True, rate_sliders=True, ellipse_rows=None, velocity_scale=0.5,
+                 tol=1e-6, near=0.1, params=None, figsize=(5.2, 5.0), dpi=80, step=None,
+                 continuous_update=True, title=None, image_format="png"):
+        if image_format not in ("png", "jpeg"):
+            raise ValueError(f"image_format must be 'png' or 'jpeg', got {image_format!r}")
+        chain = P.numeric_chain(chain, params)
+        self.chain = chain
+        n = chain.n
+        self.rows = P.task_row_indices(rows) if rows is not None else P._default_task_rows(chain)
+        self.tol, self.near = float(tol), float(near)
+        self.dpi = dpi
+        self.ranges = P.default_ranges(chain, ranges)
+        q0 = P._as_q(chain, q)
+        qd0 = P._as_q(chain, qdot, "qdot") if qdot is not None else np.ones(n)
+        for i, (lo, hi) in enumerate(self.ranges):
+            q0[i] = min(max(q0[i], lo), hi)
+        self.q, self.qdot = q0, qd0
+        self.planar = P.is_planar(chain)
+        self.fig, self.ax = _new_figure(figsize, dpi, not self.planar)
+        self.arm = P.draw_chain(chain, q0, self.ax, ranges=self.ranges, title=title or chain.name)
+        self.ellipse = (P.draw_velocity_ellipse(self.ax, chain, q0, rows=ellipse_rows, scale=velocity_scale,
+                                                label=f"velocity ellipse (×{velocity_scale:g})")
+                        if show_ellipse else None)
+        self.velocity = (P.draw_velocity(self.ax, chain, q0, qd0, scale=velocity_scale,
+                                         label=rf"$\dot p = J\,\dot\theta$ (×{velocity_scale:g})")
+                         if show_velocity else None)
+        if show_ellipse or show_velocity:
+            self.ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
+        self.fig.tight_layout()
+
+        self.sliders = []
+        for i, (lo, hi) in enumerate(self.ranges):
+            st = step if step is not None else (math.pi / 180 if chain.joint_types[i] == "R" else (hi - lo) / 200)
+            self.sliders.append(W.FloatSlider(value=q0[i], min=lo, max=hi, step=st, description=_slider_label(chain, i),
+                                              readout_format=".3f", continuous_update=continuous_update,
+                                              style={"description_width": "70px"},
+                                              layout=W.Layout(width="330px")))
+        self.rate_sliders = []
+        if rate_sliders and show_velocity:
+            for i in range(n):
+                self.rate_sliders.append(W.FloatSlider(value=qd0[i], min=-2.0, max=2.0, step=0.05,
+                                                       description=_slider_label(chain, i, rate=True),
+                                                       readout_format=".2f", continuous_update=continuous_update,
+                                                       style={"description_width": "70px"},
+                                                       layout=W.Layout(width="330px")))
+        moving = self.arm.artists + (self.ellipse.artists if self.ellipse is not None else []) + \
+            (self.velocity.artists if self.velocity is not None else [])
+        self._blit = _Blitter(self.fig, moving, image_format)
+        self.w_max = self._max_manipulability()
+        self.status = W.HTML(value="")
+        self.readout = W.HTML(value="")
+        self.image = W.Image(format=image_format, layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
+        self._hold = False
+        for s in self.sliders + self.rate_sliders:
+            s.observe(self._on_change, names="value")
+        controls = [W.HTML("<b>joint positions</b>"), *self.sliders]
+        if self.rate_sliders:
+            controls += [W.HTML("<b>joint rates</b> (for the ṗ arrow)"), *self.rate_sliders]
+        controls += [self.readout, self.status]
+        super().__init__([W.HBox([W.VBox(controls, layout=W.Layout(width="350px")), self.image])])
+        self.refresh()
+
+    # -- reactions ----------------------------------------------------------------------------------
+    def _on_change(self, change):
+        if not self._hold:
+            self.refresh()
+
+    def update(self, q=None, qdot=None):
+        """Set the sliders (joint values ``q``, rates ``qdot``) and redraw once."""
+        self._hold = True
+        try:
+            if q is not None:
+                for s, v in zip(self.sliders, P._as_q(self.chain, q)):
+                    s.value = float(v)
+            if qdot is not None:
+                qd = P._as_q(self.chain, qdot, "qdot")
+                if self.rate_sliders:
+                    for s, v in zip(self.rate_sliders, qd):
+                        s.value = float(v)
+                else:
+                    self.qdot = qd
+        finally:
+            self._hold = False
+        self.refresh()
+        return self
+
+    def refresh(self):
+        """Read the sliders, move the artists, update the readout and re-render the picture."""
+        q = np.array([s.value for s in self.sliders], float)
+        if self.rate_sliders:
+            self.qdot = np.array([s.value for s in self.rate_sliders], float)
+        self.q = q
+        self.arm.update(q)
+        if self.ellipse is not None:
+            self.ellipse.update(q)
+        if self.velocity is not None:
+            self.velocity.update(q, self.qdot)
+        J = self.chain.jacobian_geometric(q)[list(self.rows)]
+        self.info = info = classify(J, self.tol, self.near, self.w_max)
+        self.readout.value = self._readout_html(info)
+        self.status.value = self._status_html(info)
+        self.image.value = self._blit.render()
+
+    def _max_manipulability(self) -> float:
+        """The largest √det(J_r J_rᵀ) over a fixed sample of the slider ranges (the reference for "near")."""
+        rng = np.random.default_rng(0)
+        lo = np.array([r[0] for r in self.ranges])
+        hi = np.array([r[1] for r in self.ranges])
+        Q = np.vstack([lo + (hi - lo) * rng.random((4000, self.chain.n)), self.q])
+        J = self.chain.jacobian_geometric(Q)[:, list(self.rows), :]
+        return float(np.max(P.manipulability_values(J, "yoshikawa")))
+
+    def _readout_html(self, info) -> str:
+        rows = P._rows_label(self.rows)
+        lines = [f"task rows of J: ({rows})"]
+        if info["det"] is not None:
+            lines.append(f"det J = {info['det']:+.4f}")
+        m, n = len(self.rows), self.chain.n
+        lines.append(f"manipulability {'√det(JᵀJ)' if n < m else '√det(JJᵀ)'} = {info['manipulability']:.4f}")
+        lines.append(f"  = {100 * info['relative']:.1f}% of its maximum {self.w_max:.4f}")
+        lines.append(f"σ_min/σ_max = {info['ratio']:.4f}, rank {info['rank']} of {info['full_rank']}")
+        if self.velocity is not None:
+            v = self.velocity.velocity
+            lines.append("ṗ = (" + ", ".join(f"{x:+.3f}" for x in v) + ")")
+        return "<div style='font-family:monospace;font-size:12px'>" + "<br>".join(map(html.escape, lines)) + "</div>"
+
+    def _status_html(self, info) -> str:
+        if info["state"] == "singular":
+            msg, color = (f"SINGULAR configuration: J loses rank (rank {info['rank']} of {info['full_rank']}); "
+                          f"some end-effector velocities are impossible here (singular)"), "#b00020"
+        elif info["state"] == "near":
+            msg, color = (f"near a singular configuration (manipulability {100 * info['relative']:.1f}% of its "
+                          f"maximum): some directions need large joint rates"), "#b36b00"
+        else:
+            msg, color = f"regular configuration: full rank {info['rank']}", "#1b5e20"
+        return f"<b style='color:{color}'>{html.escape(msg)}</b>"
+
+    @property
+    def state(self) -> str:
+        """'singular', 'near' or 'regular' at the current sliders."""
+        return self.info["state"]
+
+
+def explorer(chain, **kwargs) -> Explorer:
+    """An :class:`Explorer` for ``chain``: display it as the last expression of a cell.
+
+    Keywords: ``q``/``qdot`` (initial joint values/rates; rates default to 1), ``rows`` (task rows for
+    det J, manipulability and the status; default (ω_z, ṗ_x, ṗ_y) planar, all six otherwise), ``ranges``
+    (slider ranges, list or {joint number: (lo, hi)}; default ±π and ±half the reach for prismatic
+    joints), ``show_ellipse``, ``show_velocity``, ``rate_sliders``, ``ellipse_rows``, ``velocity_scale``
+    (display factor of the ṗ arrow and the ellipse, 0.5), ``tol``/``near`` (status thresholds),
+    ``params`` ({"L": 1} for a symbolic chain), ``figsize``, ``dpi``, ``step`` (slider step; π/180 for
+    angles so that multiples of 1° such as −π/4 are reachable), ``continuous_update``, ``title``,
+    ``image_format`` ('png' or the faster 'jpeg')."""
+    return Explorer(chain, **kwargs)
+
+
+class ConfigPicker(W.VBox):
+    """Named configurations (problem 4.1): buttons choose one; the figure shows the arm with each joint's
+    velocity arrow at the tool (column i of J_ṗ, i.e. ṗ for θ̇_i = 1) and a bar chart of the chosen
+    row's joint contributions J[row, i]; the table below names the joint with the largest |J[row, i]|
+    (ties within 10⁻⁹ relative are reported as ties).
+
+    ``rows``: one row for all configurations ('vx', 'vy', …) or a dict {name: row}.
+    State: ``buttons``, ``table`` (HTML), ``image``, ``contributions`` (n values of the current row),
+    ``best`` (1-based joints with the largest |contribution|), ``select(name)``.
+    """
+
+    def __init__(self, chain, configs: Mapping, *, rows="vx", params=None, scale=1.0, figsize=(9.5, 4.3),
+                 dpi=80, title=None):
+        chain = P.numeric_chain(chain, params)
+        self.chain = chain
+        if not isinstance(configs, Mapping) or not configs:
+            raise TypeError(f"configs must be a non-empty dict {{name: q}}, got {describe(configs)}")
+        self.configs = {str(k): P._as_q(chain, v, f"configs[{k!r}]") for k, v in configs.items()}
+        if isinstance(rows, Mapping):
+            missing = set(self.configs) - set(map(str, rows))
+            if missing:
+                raise ValueError(f"rows must give a row for every configuration; missing {sorted(missing)}")
+            self.rows = {str(k): self._one_row(v) for k, v in rows.items()}
+        else:
+            r = self._one_row(rows)
+            self.rows = {k: r for k in self.configs}
+        self.dpi = dpi
+        planar = P.is_planar(chain)
+        self.fig = Figure(figsize=figsize, dpi=dpi)
+        FigureCanvasAgg(self.fig)
+        self.ax = self.fig.add_subplot(1, 2, 1, projection=None if planar else "3d")
+        self.ax_bar = self.fig.add_subplot(1, 2, 2)
+        name0 = next(iter(self.configs))
+        q0 = self.configs[name0]
+        # the view: every configuration's skeleton and its joint-velocity arrow tips, padded
+        pts = []
+        for qq in self.configs.values():
+            sk = chain.skeleton(qq)
+            J = chain.jacobian_geometric(qq)
+            pts += [sk, sk[:, -1:] + scale * J[3:, :]]
+        pts = np.hstack(pts)
+        d = 2 if planar else 3
+        c = 0.5 * (pts.min(1) + pts.max(1))[:d]
+        h = 0.5 * float(np.max(pts.max(1) - pts.min(1))) * 1.15 + 1e-9
+        self.arm = P.draw_chain(chain, q0, self.ax, limits=np.stack([c - h, c + h], axis=1),
+                                title=title or chain.name)
+        self.arrows = P.draw_joint_velocities(self.ax, chain, q0, scale=scale)
+        n = chain.n
+        self.bars = self.ax_bar.bar(np.arange(1, n + 1), np.zeros(n),
+                                    color=[P.JOINT_COLORS[i % 10] for i in range(n)])
+        self.bar_texts = [self.ax_bar.text(i + 1, 0, "", ha="center", va="bottom", fontsize=9) for i in range(n)]
+        self.ax_bar.axhline(0, color="k", lw=0.8)
+        self.ax_bar.set_xticks(np.arange(1, n + 1), [P._theta_tex(i + 1, dot=True) for i in range(n)])
+        self.ax_bar.grid(True, axis="y", lw=0.4, alpha=0.5)
+        # a common y-range over all configurations, so bars compare across them
+        vals = [chain.jacobian_geometric(qq)[self.rows[k]] for k, qq in self.configs.items()]
+        top = max(float(np.max(np.abs(v))) for v in vals) or 1.0
+        self.ax_bar.set_ylim(-1.2 * top, 1.2 * top)
+        self.fig.tight_layout()
+        self.buttons = W.ToggleButtons(options=list(self.configs), value=name0, description="configuration")
+        self.table = W.HTML()
+        self.image = W.Image(format="png", layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
+        self.buttons.observe(lambda ch: self.select(ch["new"]), names="value")
+        super().__init__([self.buttons, self.image, self.table])
+        self.select(name0)
+
+    @staticmethod
+    def _one_row(r) -> int:
+        idx = P.task_row_indices(r)
+        if len(idx) != 1:
+            raise ValueError(f"rows must name one row per configuration (e.g. 'vx'), got {describe(r)}")
+        return idx[0]
+
+    def select(self, name: str):
+        """Show configuration ``name``."""
+        if name not in self.configs:
+            raise ValueError(f"unknown configuration {name!r}; choose from {list(self.configs)}")
+        if self.buttons.value != name:
+            self.buttons.value = name  # the observer calls select again
+            return self
+        q, row = self.configs[name], self.rows[name]
+        self.name = name
+        self.arm.update(q)
+        self.arrows.update(q)
+        c = self.chain.jacobian_geometric(q)[row]
+        self.contributions = c
+        for b, t, v in zip(self.bars, self.bar_texts, c):
+            b.set_height(v)
+            t.set_position((t.get_position()[0], v))
+            t.set_va("bottom" if v >= 0 else "top")
+            t.set_text(f"{v:+.3f}")
+        lab = P.ROW_LABELS[row]
+        self.ax_bar.set_title(f"{name}: {P.ROW_TEX[row]} for each " + r"$\dot\theta_i = 1$", fontsize=10)
+        a = np.abs(c)
+        self.best = tuple(int(i) + 1 for i in np.flatnonzero(a >= a.max() - 1e-9 * max(a.max(), 1e-300)))
+        cells = "".join(f"<td style='padding:0 8px'>{'<b>' if i + 1 in self.best else ''}{v:+.4f}"
+                        f"{'</b>' if i + 1 in self.best else ''}</td>" for i, v in enumerate(c))
+        heads = "".join(f"<th style='padding:0 8px'>θ̇{i + 1}</th>" for i in range(len(c)))
+        who = (f"joint {self.best[0]}" if len(self.best) == 1 else
+               "a tie between joints " + " and ".join(map(str, self.best)))
+        self.table.value = (f"<table><tr><th>{html.escape(lab)} per unit rate</th>{heads}</tr>"
+                            f"<tr><td>θ = ({', '.join(f'{x:.4f}' for x in q)})</td>{cells}</tr></table>"
+                            f"<div>largest |{html.escape(lab)}|: {who}</div>")
+        self.image.value = _render_png(self.fig, self.dpi)
+        return self
+
+
+def config_picker(chain, configs: Mapping, **kwargs) -> ConfigPicker:
+    """A :class:`ConfigPicker` (keywords: rows, params, scale, figsize, dpi, title)."""
+    return ConfigPicker(chain, configs, **kwargs)

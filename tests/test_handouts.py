@@ -1,0 +1,346 @@
+"""``make handouts`` (kinlib.handouts) and the workbook self-checks (kinlib.selfcheck).
+
+The end-to-end tests build the fixture notebook ``tests/fixtures/handouts/01_fixture_jacobians.ipynb``
+(every answer kind, a solution markdown cell, check cells, a figure, a widget, an animation, a cell that
+reads an answer) once per session. The npm packages are cached in build/vendor (fetched once).
+"""
+from __future__ import annotations
+
+import ast
+import copy
+import re
+import shutil
+from pathlib import Path
+
+import nbformat
+import numpy as np
+import pytest
+import sympy as sp
+from IPython.core.inputtransformer2 import TransformerManager
+
+from kinlib import handouts, robots, selfcheck
+from kinlib.selfcheck import fingerprint, verdict
+
+ROOT = Path(__file__).resolve().parents[1]
+FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
+VENDOR = ROOT / "build" / "vendor"
+STEM = "01_fixture_jacobians"
+
+
+# ---------------------------------------------------------------------------------------------------
+# selfcheck: fingerprints identify answers up to equivalence, and nothing else
+
+def _v(value, ref, kind="default", salt="1.1:x"):
+    return verdict(value, fingerprint(ref, kind, salt=salt), salt=salt)[0]
+
+
+def test_equivalent_forms_pass():
+    r = robots.planar_offset_3r()
+    Js = r.jacobian_space()
+    assert _v(sp.simplify(Js), Js) == "correct"
+    assert _v(Js.expand(trig=True), Js) == "correct"
+    # symbols of the same names but other assumptions, as a student may make them
+    t1, t2, t3, L = sp.symbols("theta1 theta2 theta3 L")
+    plain = Js.subs(dict(zip(r.thetas + r.params, (t1, t2, t3, L))))
+    assert _v(plain, Js) == "correct"
+    # numbers: floats vs exact, NumPy vs SymPy, 1x1 matrix for a scalar
+    assert _v(0.7071067811865476, sp.sqrt(2) / 2) == "correct"
+    assert _v(np.float64(np.sqrt(2) / 2), sp.sqrt(2) / 2) == "correct"
+    assert _v(sp.Matrix([[sp.sqrt(2) / 2]]), sp.sqrt(2) / 2) == "correct"
+    r1 = r.subs(L=1)
+    q = [0.1, -0.7, 0.4]
+    assert _v(r1.jacobian_space(q), Js.subs(dict(zip(r.thetas + r.params, q + [1])))) == "correct"
+
+
+def test_wrong_answers_fail_with_a_reason():
+    r = robots.planar_offset_3r()
+    Js, Jb = r.jacobian_space(), r.jacobian_body()
+    status, msg = verdict(Jb, fingerprint(Js))
+    assert status == "incorrect" and "differ" in msg
+    status, msg = verdict(Js.T, fingerprint(Js))
+    assert status == "incorrect" and "6×3" in msg and "3×6" in msg
+    status, msg = verdict(sp.Symbol("x"), fingerprint(Js))
+    assert status == "incorrect" and "6×3" in msg
+    assert verdict("J", fingerprint(Js))[0] == "incorrect"
+    assert verdict(..., fingerprint(Js))[0] == "unanswered"
+    assert verdict(None, fingerprint(Js))[0] == "unanswered"
+    # an extra symbol that does not cancel is wrong; one that cancels is fine
+    x = sp.Symbol("x")
+    assert _v(Js + x * sp.ones(6, 3), Js) == "incorrect"
+    assert _v(Js + x * sp.ones(6, 3) - x * sp.ones(6, 3), Js) == "correct"
+
+
+def test_kinds_sets_subspaces_choices():
+    th = sp.Symbol("theta2", real=True)
+    n = sp.Dummy("n")
+    every_pi = sp.ImageSet(sp.Lambda(n, n * sp.pi), sp.Integers)
+    assert _v(sp.FiniteSet(0, sp.pi), every_pi, "set") == "correct"
+    assert _v(sp.solveset(sp.sin(th), th, sp.S.Reals), every_pi, "set") == "correct"
+    assert _v(sp.FiniteSet(0), every_pi, "set") == "incorrect"
+    assert _v({th: sp.FiniteSet(-sp.pi, 0)}, {th: every_pi}, "set") == "correct"
+    assert _v(sp.FiniteSet(0, sp.pi), {th: every_pi}, "set") == "incorrect"      # a dict was asked for
+    A = sp.Matrix([[1, 0], [0, 1], [0, 0]])
+    assert _v(sp.Matrix([[1, 1], [1, -1], [0, 0]]), A, "subspace") == "correct"
+    assert _v([sp.Matrix([2, 0, 0]), sp.Matrix([0, 3, 0]), sp.Matrix([1, 1, 0])], A, "subspace") == "correct"
+    assert _v(sp.Matrix([1, 0, 0]), A, "subspace") == "incorrect"
+    assert verdict(sp.Matrix([1, 0]), fingerprint(A, "subspace"))[0] == "incorrect"     # wrong ambient dim
+    assert _v((3, 1), (1, 3), "choice") == "correct"
+    assert _v(3, (3,), "choice") == "correct"
+    assert _v(2, 3, "choice") == "incorrect"
+
+
+def test_fingerprints_reveal_nothing_and_are_salted():
+    spec = fingerprint(sp.Integer(6), salt="1.3:n")
+    form, shape, digest = spec.split("|")
+    assert (form, shape) == ("scalar", "") and re.fullmatch(r"[0-9a-f]{16}", digest)
+    assert fingerprint(sp.Integer(6), salt="1.3:n") != fingerprint(sp.Integer(6), salt="1.3:rank")
+    assert verdict(6, spec, salt="1.3:n")[0] == "correct"
+    assert verdict(6, spec, salt="1.3:rank")[0] == "incorrect"
+
+
+def test_check_prints_a_line_per_answer(capsys):
+    Js = robots.planar_offset_3r().jacobian_space()
+    spec = fingerprint(Js, salt="2.2:Js")
+    spec2 = fingerprint(sp.Integer(3), "choice", salt="2.2:k")
+    selfcheck.check("2.2", _namespace={"Js": Js, "k": ...}, Js=spec, k=spec2)
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("part 2.2 · Js: ✓")
+    assert out[1].startswith("part 2.2 · k: …") and "not answered yet" in out[1]
+    selfcheck.check("2.2", _namespace={}, Js=spec)
+    assert "not answered yet" in capsys.readouterr().out
+    selfcheck.check("2.2", _namespace={"Js": Js.T}, Js=spec)
+    assert "✗ wrong form" in capsys.readouterr().out
+    assert selfcheck.last_results["2.2"] == {"Js": "incorrect"}
+
+
+# ---------------------------------------------------------------------------------------------------
+# the job, end to end on the fixture notebook
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    out = tmp_path_factory.mktemp("handouts") / "handouts"
+    log = []
+    entries = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, log=log.append)
+    return out, entries[0], log
+
+
+def _solution_cells(nb):
+    return [c for c in nb.cells if "solution" in c.metadata.get("tags", [])]
+
+
+def test_writes_every_handout_and_the_index(built):
+    out, entry, log = built
+    for rel in (f"solutions/{STEM}.html", f"problems/{STEM}.html", f"workbooks/{STEM}.ipynb", "index.html",
+                "assets/require.js", "assets/widgets/embed-amd.js", "assets/mathjax/MathJax.js",
+                "assets/mathjax/config/kinlib.js", "assets/font-awesome/css/font-awesome.min.css"):
+        assert (out / rel).is_file(), rel
+    index = (out / "index.html").read_text()
+    for kind in ("problems", "solutions"):
+        assert f'href="{kind}/{STEM}.html"' in index
+    assert f'href="workbooks/{STEM}.ipynb"' in index
+    assert "Fixture: Jacobians of a planar robot" in index
+    assert any(STEM in line and "done in" in line for line in log)      # progress: notebook and time
+
+
+def test_pages_load_nothing_from_the_network(built):
+    out, _, _ = built
+    for page in [out / "index.html", *sorted(out.glob("*/*.html"))]:
+        text = page.read_text()
+        remote = re.findall(r"""(?:src|href)\s*=\s*["'](?:https?:)?//[^"']+""", text)
+        assert not remote, f"{page.name} loads {remote[:3]}"
+        for url in re.findall(r"""src=["'](\.\./assets/[^"'?]+)""", text):
+            assert (page.parent / url).resolve().is_file(), url
+
+
+def test_solutions_page_has_everything(built):
+    out, entry, _ = built
+    text = (out / "solutions" / f"{STEM}.html").read_text()
+    assert "LEAK-MARKDOWN-1.1" in text and "LEAK-CHECK-OUTPUT" in text
+    assert "Js = r.jacobian_space()" in _visible(text)
+    assert "application/vnd.jupyter.widget-state+json" in text
+    assert "../assets/mathjax/MathJax.js?config=" in text and "../assets/widgets/embed-amd.js" in text
+    assert "anim" in text and "../assets/font-awesome/css/font-awesome.min.css" in text
+
+
+def test_problems_leak_no_solution(built):
+    out, entry, _ = built
+    text = (out / "problems" / f"{STEM}.html").read_text()
+    visible = _visible(text)
+    executed = entry["executed"]
+    assert "LEAK-" not in text
+    assert "NBVAL_CHECK_OUTPUT" not in text
+    for c in executed.cells:
+        tags = set(c.metadata.get("tags", []))
+        if tags & {"solution", "check"}:
+            for line in c.source.splitlines():          # no line of a solution or check cell's source
+                if len(line.strip()) >= 12:
+                    assert line.strip() not in visible, line
+            for o in c.get("outputs", []):              # no output of theirs (answer values, check lines)
+                for mime in ("text/latex", "text/plain"):
+                    v = o.get("data", {}).get(mime)
+                    if v and len(v) >= 12:
+                        assert html_escape(v) not in text and v not in visible, v[:80]
+    # the answer values computed independently
+    r = robots.planar_offset_3r()
+    for value in (sp.simplify(r.jacobian_space()),):
+        assert sp.latex(value) not in text
+    # no prompt numbers that betray removed cells
+    assert not re.search(r"In&nbsp;\[\s*\d+\]|Out\[\s*\d+\]|In\s*\[\d+\]:", text)
+    # questions, narrative, the figure, the widget and the animation stay
+    assert "1.4 (3 points)" in text and "planar offset 3R at home" in text
+    assert text.count("data:image/png;base64") >= 2
+    assert "widget-view+json" in text and "anim" in text
+    # an output computed from an answer (J_home.shape) is not shown
+    assert "(6, 3)" not in text and "\\left( 6, \\  3\\right)" not in text
+
+
+def html_escape(s):
+    import html
+    return html.escape(s, quote=False)
+
+
+def _visible(page: str) -> str:
+    """The page's text with the tags (syntax highlighting) removed."""
+    import html
+    return html.unescape(re.sub(r"<[^>]+>", "", page))
+
+
+def test_problem_widget_state_is_pruned(built):
+    _, entry, _ = built
+    key = "application/vnd.jupyter.widget-state+json"
+    state = entry["problems"].metadata["widgets"][key]["state"]
+    full = entry["executed"].metadata["widgets"][key]["state"]
+    assert set(state) <= set(full) and state
+    shown = {o["data"]["application/vnd.jupyter.widget-view+json"]["model_id"]
+             for c in entry["problems"].cells for o in c.get("outputs", [])
+             if "application/vnd.jupyter.widget-view+json" in o.get("data", {})}
+    assert shown <= set(state)
+
+
+def test_workbook_is_a_valid_student_notebook(built):
+    out, entry, _ = built
+    wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
+    nbformat.validate(wb)
+    text = (out / "workbooks" / f"{STEM}.ipynb").read_text()
+    assert "LEAK-" not in text and "NBVAL_CHECK_OUTPUT" not in text and "r.jacobian_space()" not in text
+    assert "widgets" not in wb.metadata
+    for c in wb.cells:
+        if c.cell_type == "code":
+            assert c.outputs == [] and c.execution_count is None
+            ast.parse(TransformerManager().transform_cell(c.source))      # every cell parses
+    source = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
+    src_sol, wb_sol = _solution_cells(source), _solution_cells(wb)
+    assert len(src_sol) == len(wb_sol)
+    for a, b in zip(src_sol, wb_sol):
+        assert b.metadata.get("kinlib") == a.metadata.get("kinlib")      # metadata kept for the grader
+        if a.cell_type == "code":
+            for name in a.metadata["kinlib"]["answers"]:
+                assert re.search(rf"^{name} = \.\.\.  # TODO: .*\(part {a.metadata['kinlib']['part']}\)$",
+                                 b.source, re.M), b.source
+    assert "the space Jacobian J_s(θ), a 6×3 Matrix" in text              # 'describe' metadata + auto
+    checks = [c for c in wb.cells if "selfcheck" in c.metadata.get("tags", [])]
+    assert len(checks) == 4                                           # 3 check cells + 1.2 without one
+    assert all("check(" in c.source for c in checks)
+    assert not [c for c in wb.cells if "check" in c.metadata.get("tags", [])]
+    assert any(c.source.startswith("%%needs Js") for c in wb.cells)
+
+
+def _run(wb, tmp_path):
+    p = tmp_path / f"{STEM}.ipynb"
+    nbformat.write(wb, p)
+    return handouts.run_workbook(p)
+
+
+def _selfcheck_lines(nb):
+    lines = []
+    for c in nb.cells:
+        if "selfcheck" in c.metadata.get("tags", []):
+            for o in c.outputs:
+                lines += [ln for ln in o.get("text", "").splitlines() if ln.startswith("part ")]
+    return lines
+
+
+def _stream(nb):
+    return "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.outputs)
+
+
+def test_workbook_runs_top_to_bottom_unanswered(built, tmp_path):
+    out, _, _ = built
+    wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
+    ran = _run(wb, tmp_path)
+    lines = _selfcheck_lines(ran)
+    assert len(lines) == 5 and all("not answered yet" in ln for ln in lines), lines
+    assert "skipped: this cell uses Js" in _stream(ran)
+
+
+def _paste_solutions(wb, source, edit=None):
+    wb = copy.deepcopy(wb)
+    src = [c for c in _solution_cells(source) if c.cell_type == "code"]
+    dst = [c for c in _solution_cells(wb) if c.cell_type == "code"]
+    for a, b in zip(src, dst):
+        b.source = edit(a.source) if edit else a.source
+    return wb
+
+
+def test_workbook_with_the_solutions_passes(built, tmp_path):
+    out, _, _ = built
+    wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
+    source = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
+    ran = _run(_paste_solutions(wb, source), tmp_path)
+    lines = _selfcheck_lines(ran)
+    assert len(lines) == 5 and all("✓ correct" in ln for ln in lines), lines
+    assert "skipped" not in _stream(ran)
+
+
+def test_workbook_with_wrong_answers_fails(built, tmp_path):
+    out, _, _ = built
+    wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
+    source = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
+    wrong = _paste_solutions(wb, source, edit=lambda s: s.replace("r.jacobian_space()", "r.jacobian_body()")
+                             .replace("fastest = 3", "fastest = 2"))
+    lines = _selfcheck_lines(_run(wrong, tmp_path))
+    assert any(ln.startswith("part 1.1 · Js: ✗") for ln in lines), lines
+    assert any(ln.startswith("part 1.2 · fastest: ✗") for ln in lines), lines
+    assert any(ln.startswith("part 1.4 · span: ") for ln in lines)
+
+
+def test_a_failing_notebook_is_named_with_its_cell(tmp_path, capsys):
+    nbs = tmp_path / "nbs"
+    nbs.mkdir()
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x = 1"),
+                                         nbformat.v4.new_markdown_cell("text"),
+                                         nbformat.v4.new_code_cell("y = x +\n")])
+    nb.cells[2].metadata["tags"] = ["solution"]
+    nb.cells[2].metadata["kinlib"] = {"part": "9.9", "answers": ["y"]}
+    nbformat.write(nb, nbs / "07_broken.ipynb")
+    code = handouts.main([str(nbs), "--out", str(tmp_path / "out"), "--vendor", str(VENDOR), "--jobs", "1"])
+    err = capsys.readouterr().err
+    assert code == 1
+    assert "07_broken.ipynb" in err and "cell 2" in err and "part 9.9" in err and "SyntaxError" in err
+
+
+def test_answer_groups_of_the_fixture():
+    nb = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
+    groups = handouts.answer_groups(nb)
+    assert [[(p, n, k) for p, n, k, _ in g.answers] for g in groups] == [
+        [("1.1", "Js", "default")], [("1.2", "fastest", "choice")],
+        [("1.3", "detJ", "default"), ("1.3", "singular", "set")], [("1.4", "span", "subspace")]]
+    assert [g.check_cell is not None for g in groups] == [True, False, True, True]
+
+
+def test_names_read_before_bound():
+    free, bound = handouts._names("for name, pose in poses.items():\n    print(name)\nJ = J.subs(a)\n"
+                                  "f = lambda t: t + w\n%matplotlib inline\n")
+    assert {"poses", "J", "a", "w"} <= free and not {"name", "pose", "t"} & free
+    assert {"name", "pose", "J", "f"} <= bound
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")), ids=lambda p: p.stem)
+def test_real_notebooks_have_the_structure(path):
+    """Every real notebook parses into answer groups, and every answer kind is one selfcheck knows."""
+    nb = nbformat.read(path, as_version=4)
+    meta = nb.metadata.get("kinlib", {})
+    assert meta.get("notebook") == path.stem and meta.get("title")
+    for g in handouts.answer_groups(nb):
+        for part, name, kind, _ in g.answers:
+            assert part and name.isidentifier() and kind in selfcheck.KINDS, (part, name, kind)

@@ -1,0 +1,144 @@
+"""kinlib.manipulability against NumPy (det, SVD, cond) and modern_robotics Jacobians."""
+from __future__ import annotations
+
+import modern_robotics as mr
+import numpy as np
+import pytest
+import sympy as sp
+
+from kinlib import robots
+from kinlib.manipulability import (
+    condition_number, isotropy, manipulability, singular_values, twist_speed, twist_speed_form,
+    velocity_ellipsoid,
+)
+from kinlib.singularities import evaluate_at, task_rows
+
+from conftest import assert_sym_equal
+
+pi = sp.pi
+
+
+@pytest.mark.parametrize("m, n", [(2, 3), (3, 3), (6, 4), (3, 2), (6, 6), (1, 4)])
+def test_numeric_manipulability_is_yoshikawa(rng, m, n):
+    for _ in range(5):
+        J = rng.normal(size=(m, n))
+        G = J @ J.T if n >= m else J.T @ J
+        assert np.isclose(manipulability(J), np.sqrt(np.linalg.det(G)), rtol=1e-10)
+    batch = rng.normal(size=(7, m, n))
+    w = manipulability(batch)
+    assert w.shape == (7,)
+    assert np.allclose(w, [manipulability(Jk) for Jk in batch])
+
+
+def test_numeric_condition_and_isotropy(rng):
+    for shape in [(3, 3), (2, 3), (6, 4)]:
+        J = rng.normal(size=shape)
+        assert np.isclose(condition_number(J), np.linalg.cond(J))
+        assert np.isclose(isotropy(J), 1 / np.linalg.cond(J))
+    batch = rng.normal(size=(5, 3, 3))
+    assert np.allclose(condition_number(batch), np.linalg.cond(batch))
+    assert np.allclose(isotropy(batch), 1 / np.linalg.cond(batch))
+    sing = np.array([[1.0, 1.0], [1.0, 1.0]])
+    assert condition_number(sing) == np.inf and isotropy(sing) == 0.0
+    assert isotropy(np.eye(3)) == 1.0 and condition_number(np.eye(3)) == 1.0
+    assert isotropy(np.zeros((2, 2))) == 0.0
+
+
+def test_problem_5_4_symbolic_form(rng):
+    """√det(J Jᵀ) of the planar task rows is L²√(sin 2θ2 + 1) (the printed eq. 50), checked numerically."""
+    r = robots.planar_offset_3r()
+    L = r.params[0]
+    th2 = r.thetas[1]
+    J = task_rows(r.jacobian_space(), "planar")
+    w = manipulability(J, simplify=True)
+    assert w == L**2 * sp.sqrt(sp.sin(2 * th2) + 1)
+    exact = manipulability(J)
+    f = sp.lambdify((L,) + r.thetas, exact, "numpy")
+    S = np.array(r.subs(L=1.3).screws, dtype=float)
+    for _ in range(5):
+        q = rng.uniform(-np.pi, np.pi, 3)
+        Jn = mr.JacobianSpace(S, q)[[2, 3, 4]]
+        assert np.isclose(f(1.3, *q), np.sqrt(np.linalg.det(Jn @ Jn.T)))
+        assert np.isclose(manipulability(Jn), 1.3**2 * np.sqrt(np.sin(2 * q[1]) + 1))
+    assert manipulability(evaluate_at(J, [0, -pi / 4, 0], r.thetas)) == 0
+
+
+def test_rpp_is_isotropic_everywhere():
+    """Problem 5.5: det(J Jᵀ) = 1, every singular value 1 (J_s rows ωz, vx, vy)."""
+    p = robots.planar_rpp()
+    J = task_rows(p.jacobian_space(), "planar")
+    assert manipulability(J, simplify=True) == 1
+    assert_sym_equal(J * J.T, sp.eye(3), "J Jᵀ")
+    assert condition_number(J) == 1 and isotropy(J) == 1
+    lengths, U = velocity_ellipsoid(J)
+    assert lengths == [1, 1, 1]
+    assert_sym_equal(U.T * U, sp.eye(3), "orthonormal axes")
+
+
+def test_velocity_ellipsoid_numeric(rng):
+    r = robots.planar_offset_3r(1)
+    for _ in range(4):
+        q = rng.uniform(-np.pi, np.pi, 3)
+        Jg = r.jacobian_geometric(q)
+        lengths, U = velocity_ellipsoid(Jg)  # a 6-row J: the linear rows ṗ
+        Jp = Jg[3:]
+        assert lengths.shape == (3,) and U.shape == (3, 3)
+        assert np.allclose(U.T @ U, np.eye(3))
+        for k in range(3):
+            assert np.allclose(Jp @ Jp.T @ U[:, k], lengths[k] ** 2 * U[:, k], atol=1e-10)
+        assert np.isclose(lengths[2], 0.0, atol=1e-12)  # planar: no ṗ_z
+        l2, U2 = velocity_ellipsoid(Jg, rows=["vx", "vy"])
+        assert np.allclose(l2, np.linalg.svd(Jp[:2], compute_uv=False))
+    batch = r.jacobian_geometric(rng.uniform(-3, 3, (5, 3)))
+    lb, Ub = velocity_ellipsoid(batch)
+    assert lb.shape == (5, 3) and Ub.shape == (5, 3, 3)
+    assert np.allclose(singular_values(batch[:, 3:, :]), lb)
+
+
+def test_twist_speed_form_problem_6_2(rng):
+    """Jᵀ J of the RPPR geometric Jacobian is diag(1 + (L2 + θ3)², 1, 1, 1): the printed eq. 60 lacks the 1."""
+    r = robots.spatial_rppr()
+    L2 = [p for p in r.params if str(p) == "L2"][0]
+    th3 = r.thetas[2]
+    J = r.jacobian_geometric()
+    G = twist_speed_form(J, simplify=True)
+    assert_sym_equal(G, sp.diag(1 + (L2 + th3) ** 2, 1, 1, 1), "JᵀJ")
+    qd = sp.symbols("thetadot1:5", real=True)
+    VV = twist_speed(J, qd)
+    r1 = r.subs(L1=1, L2=sp.Rational(1, 2))
+    for _ in range(4):
+        q = rng.uniform(-2, 2, 4)
+        v = rng.normal(size=4)
+        Jn = r1.jacobian_geometric(q)
+        assert np.isclose(twist_speed(Jn, v), np.dot(Jn @ v, Jn @ v))
+        val = VV.subs({**dict(zip(r.thetas, q)), **dict(zip(qd, v)), L2: 0.5, r.params[0]: 1})
+        assert np.isclose(float(val), np.dot(Jn @ v, Jn @ v))
+        assert np.allclose(twist_speed_form(Jn), Jn.T @ Jn)
+    assert twist_speed(np.ones((5, 6, 4)), np.ones(4)).shape == (5,)
+
+
+def test_symbolic_condition_number_of_a_constant_matrix():
+    J = sp.Matrix([[2, 0], [0, 1]])
+    assert condition_number(J) == 2 and isotropy(J) == sp.Rational(1, 2)
+    assert condition_number(sp.Matrix([[1, 1], [1, 1]])) == sp.oo
+    assert isotropy(sp.Matrix([[1, 1], [1, 1]])) == 0
+
+
+@pytest.mark.parametrize("bad, exc", [
+    ("J", TypeError), (None, TypeError), (3.0, TypeError), (np.zeros(3), ValueError),
+    (np.zeros((2, 0)), ValueError), (np.array([[np.nan, 1.0]]), ValueError), ([["a", "b"]], TypeError),
+    (np.zeros((2, 2, 2, 2)), ValueError),
+])
+def test_bad_input(bad, exc):
+    for f in (manipulability, condition_number, isotropy):
+        with pytest.raises(exc, match="J must"):
+            f(bad)
+
+
+def test_bad_qdot_and_rows():
+    with pytest.raises(ValueError, match="qdot must hold 4"):
+        twist_speed(np.ones((6, 4)), np.ones(3))
+    with pytest.raises(ValueError, match="qdot must be a vector of length 4"):
+        twist_speed(sp.ones(6, 4), sp.symbols("a b c"))
+    with pytest.raises(ValueError, match="unknown row name"):
+        velocity_ellipsoid(np.ones((6, 3)), rows=["vw"])

@@ -1,0 +1,195 @@
+"""kinlib.widgets: the explorer and the configuration picker react to their controls and say the right
+thing about singular configurations (known independently: problem 5.1's θ2 = −π/4, the UR5 at home)."""
+import math
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import modern_robotics as mr  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+from kinlib import robots, widgets  # noqa: E402
+
+PNG = b"\x89PNG"
+
+
+@pytest.fixture(autouse=True)
+def _close():
+    yield
+    plt.close("all")
+
+
+@pytest.fixture(scope="module")
+def r3():
+    return robots.planar_offset_3r(1)
+
+
+def tool_position(chain, q):
+    return mr.FKinSpace(np.array(chain.M, float), np.array(chain.screws, float), np.asarray(q, float))[:3, 3]
+
+
+@pytest.mark.parametrize("make", [lambda: robots.cart_pole(1, 1), lambda: robots.planar_offset_3r(1),
+                                  lambda: robots.spatial_rppr(1, 1), lambda: robots.planar_3r(1, 1, 1),
+                                  lambda: robots.planar_rpp(1), lambda: robots.ur5()])
+def test_explorer_builds_for_every_robot(make):
+    chain = make()
+    ex = widgets.explorer(chain)
+    assert len(ex.sliders) == chain.n and len(ex.rate_sliders) == chain.n
+    assert bytes(ex.image.value).startswith(PNG)
+    for i, s in enumerate(ex.sliders):
+        assert s.description.startswith(f"θ{i + 1} (")
+        assert ("rad" in s.description) == (chain.joint_types[i] == "R")
+    q = np.linspace(0.1, 0.4, chain.n)
+    ex.update(q)
+    d = 2 if ex.planar else 3
+    np.testing.assert_allclose(ex.arm.tool_position, tool_position(chain, q), atol=1e-9)
+    assert ex.velocity.velocity.shape == (d,)
+
+
+def test_status_at_a_singular_and_a_regular_configuration(r3):
+    ex = widgets.explorer(r3, q=[0.3, math.pi / 4, 0.2])
+    assert ex.state == "regular"
+    assert "singular" not in ex.status.value.lower()
+    img = bytes(ex.image.value)
+    # a slider move (as in the browser) to θ2 = −π/4: problem 5.1's singular configuration
+    ex.sliders[1].value = -math.pi / 4
+    assert ex.state == "singular"
+    assert "SINGULAR configuration" in ex.status.value
+    assert ex.info["rank"] == 2 and abs(ex.info["det"]) < 1e-9
+    assert bytes(ex.image.value) != img
+    # close to it, but not at it
+    ex.sliders[1].value = -math.pi / 4 + 0.05
+    assert ex.state == "near" and "near a singular configuration" in ex.status.value
+    # the other family θ2 = 3π/4, reached through update()
+    ex.update([1.0, 3 * math.pi / 4, -2.0])
+    assert ex.state == "singular"
+    ex.update([1.0, 0.0, -2.0])
+    assert ex.state == "regular" and "singular" not in ex.status.value.lower()
+
+
+def test_slider_step_reaches_the_singular_value(r3):
+    ex = widgets.explorer(r3)
+    s = ex.sliders[1]
+    k = round((-math.pi / 4 - s.min) / s.step)
+    s.value = s.min + k * s.step  # what a slider at an integer number of steps reports
+    assert ex.state == "singular"
+
+
+def test_explorer_readout_matches_the_kinematics(r3):
+    q, qdot = [0.2, -0.7, 0.5], [0.5, -1.0, 0.25]
+    ex = widgets.explorer(r3, q=q, qdot=qdot)
+    h = 1e-6
+    pdot = (tool_position(r3, np.add(q, h * np.array(qdot))) - tool_position(r3, np.subtract(q, h * np.array(qdot)))) / (2 * h)
+    np.testing.assert_allclose(ex.velocity.velocity, pdot[:2], atol=1e-6)
+    J = mr.JacobianSpace(np.array(r3.screws, float), np.array(q))[[2, 3, 4]]
+    assert ex.info["det"] == pytest.approx(np.linalg.det(J), abs=1e-9)
+    assert ex.info["manipulability"] == pytest.approx(abs(np.linalg.det(J)), abs=1e-9)
+    assert f"{ex.info['det']:+.4f}" in ex.readout.value
+    # the rate sliders drive the arrow
+    arrow = ex.velocity.artist
+    ex.rate_sliders[0].value = 2.0
+    assert ex.velocity.artist is arrow
+    qd = [2.0, -1.0, 0.25]
+    pdot = (tool_position(r3, np.add(q, h * np.array(qd))) - tool_position(r3, np.subtract(q, h * np.array(qd)))) / (2 * h)
+    np.testing.assert_allclose(ex.velocity.velocity, pdot[:2], atol=1e-6)
+
+
+def test_explorer_updates_artists_in_place(r3):
+    ex = widgets.explorer(r3)
+    ids = [id(a) for a in ex.arm.artists + ex.ellipse.artists + ex.velocity.artists]
+    children = len(ex.ax.get_children())
+    for v in (0.3, 0.6, -1.0):
+        ex.sliders[2].value = v
+    assert [id(a) for a in ex.arm.artists + ex.ellipse.artists + ex.velocity.artists] == ids
+    assert len(ex.ax.get_children()) == children
+    np.testing.assert_allclose(ex.q, [0, 0, -1.0])
+    # the cached-background picture equals a full redraw of the same state
+    from PIL import Image
+    import io
+    fast = np.asarray(Image.open(io.BytesIO(ex.image.value)))
+    for a in ex._blit.artists:
+        a.set_animated(False)
+    full = np.asarray(Image.open(io.BytesIO(widgets._render_png(ex.fig))))
+    assert fast.shape == full.shape
+    assert np.mean(np.any(fast != full, axis=-1)) < 0.01
+
+
+def test_ur5_home_is_singular():
+    ex = widgets.explorer(robots.ur5(), rate_sliders=False)
+    assert ex.rate_sliders == []
+    assert ex.state == "singular"  # θ5 = 0: the wrist singularity of the UR5
+    ex.update([0.1, -0.6, 1.2, 0.3, 0.8, 0.2])
+    assert ex.state != "singular"
+
+
+def test_explorer_bad_input(r3):
+    with pytest.raises(ValueError, match="subs"):
+        widgets.explorer(robots.planar_offset_3r())
+    with pytest.raises(ValueError, match="q must hold 3"):
+        widgets.explorer(r3, q=[0, 0])
+    ex = widgets.explorer(r3)
+    with pytest.raises(ValueError, match="q must hold 3"):
+        ex.update([0, 0, 0, 0])
+    with pytest.raises(ValueError, match="qdot"):
+        ex.update(qdot=[1])
+    with pytest.raises(ValueError, match="lo < hi"):
+        widgets.explorer(r3, ranges={2: (1, -1)})
+    ex = widgets.explorer(robots.planar_offset_3r(), params={"L": 1}, ranges={2: (-1, 1)})
+    assert (ex.sliders[1].min, ex.sliders[1].max) == (-1, 1)
+
+
+CONFIGS = {"θ = (−π/8, π/4, π/8)": [-math.pi / 8, math.pi / 4, math.pi / 8],
+           "θ = (3π/4, −π/4, 0)": [3 * math.pi / 4, -math.pi / 4, 0],
+           "θ = (π/2, −π/8, −π/2)": [math.pi / 2, -math.pi / 8, -math.pi / 2]}
+
+
+def test_config_picker_problem_4_1():
+    chain = robots.planar_3r(1, 1, 1)
+    names = list(CONFIGS)
+    cp = widgets.config_picker(chain, CONFIGS, rows={names[0]: "vx", names[1]: "vx", names[2]: "vy"})
+    expected_best = {names[0]: (2,), names[1]: (1,), names[2]: (1, 2)}  # problem 4.1 (a tie in the third)
+    h = 1e-6
+    for name in names:
+        cp.buttons.value = name  # as a click does
+        q = np.array(CONFIGS[name])
+        row = 0 if cp.rows[name] == 3 else 1
+        fd = [(tool_position(chain, q + h * e) - tool_position(chain, q - h * e))[row] / (2 * h) for e in np.eye(3)]
+        np.testing.assert_allclose(cp.contributions, fd, atol=1e-6)
+        np.testing.assert_allclose([b.get_height() for b in cp.bars], fd, atol=1e-6)
+        assert cp.best == expected_best[name]
+        assert cp.name == name and bytes(cp.image.value).startswith(PNG)
+    assert "tie between joints 1 and 2" in cp.table.value
+    cp.select(names[0])
+    assert cp.buttons.value == names[0] and "joint 2" in cp.table.value
+
+
+def test_config_picker_bad_input():
+    chain = robots.planar_3r(1, 1, 1)
+    with pytest.raises(TypeError, match="configs"):
+        widgets.config_picker(chain, {})
+    with pytest.raises(ValueError, match="configs"):
+        widgets.config_picker(chain, {"a": [0, 0]})
+    with pytest.raises(ValueError, match="missing"):
+        widgets.config_picker(chain, {"a": [0, 0, 0], "b": [1, 1, 1]}, rows={"a": "vx"})
+    with pytest.raises(ValueError, match="one row"):
+        widgets.config_picker(chain, {"a": [0, 0, 0]}, rows=("vx", "vy"))
+    cp = widgets.config_picker(chain, {"a": [0, 0, 0]})
+    with pytest.raises(ValueError, match="unknown configuration"):
+        cp.select("b")
+
+
+def test_jpeg_pictures_and_bad_format(r3):
+    ex = widgets.explorer(r3, image_format="jpeg")
+    assert bytes(ex.image.value).startswith(b"\xff\xd8") and ex.image.format == "jpeg"
+    with pytest.raises(ValueError, match="image_format"):
+        widgets.explorer(r3, image_format="gif")
+
+
+def test_importing_widgets_leaves_pyplot_figures_alone(r3):
+    n = len(plt.get_fignums())
+    widgets.explorer(r3)
+    widgets.config_picker(robots.planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]})
+    assert len(plt.get_fignums()) == n  # no extra static copy under the inline backend
