@@ -8,7 +8,6 @@ extra variable) without printing the reference answer.
 """
 from __future__ import annotations
 
-import itertools
 import math
 from fractions import Fraction
 
@@ -20,7 +19,7 @@ NOT_ANSWERED = {
     "missing": "is not defined after your notebook ran (never assigned, deleted, or its cell failed)",
     "ellipsis": "is still `...`: not answered yet",
     "none": "is None",
-    "bool": "is True/False; expected a SymPy expression or matrix",
+    "bool": "is True/False (an equation sp.Eq(...) or a comparison?); expected a SymPy expression or matrix",
     "empty": "is an empty list",
     "ragged": "is a list of vectors of different lengths",
     "array": "is an array with more than 2 dimensions",
@@ -74,7 +73,9 @@ def _symbol_notes(stu, ref):
     rs, ss = set(ref.get("symbols", [])), set(stu.get("symbols", []))
     notes = []
     missing, extra = sorted(rs - ss), sorted(ss - rs)
-    if missing:
+    if missing and not ss:
+        notes.append(f"is a constant, but the answer depends on {', '.join(sorted(rs))}")
+    elif missing:
         notes.append(f"does not depend on {', '.join(missing)} (a missing variable: did you substitute a number?)")
     if extra:
         known = ", ".join(sorted(rs)) or "no symbols"
@@ -92,7 +93,16 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
+    if ref.get("tag") == "dict":
+        if stu.get("tag") != "dict":
+            return False, f"{name} is a {stu.get('type')}; expected a dict with keys {', '.join(ref['items'])}"
+        if set(stu["items"]) != set(ref["items"]):
+            return False, f"{name} has keys {sorted(stu['items'])}; expected {sorted(ref['items'])}"
+        msgs = [compare_expr(stu["items"][k], ref["items"][k], f"{name}[{k!r}]") for k in ref["items"]]
+        return all(ok for ok, _ in msgs), "; ".join(m for _, m in msgs if m)
     if stu.get("tag") not in ("matrix", "scalar"):
+        if str(stu.get("type", "")).endswith("Equality"):
+            return False, f"{name} is an equation (sp.Eq): assign the expression or matrix itself"
         return False, f"{name} is a {stu.get('type')}; expected a SymPy expression or Matrix"
     rshape, sshape = list(ref["shape"]), list(stu["shape"])
     if rshape in ([1, 1], []) and sshape in ([1, 1], []):
@@ -143,10 +153,15 @@ def _diagnose(S, R, shape, stu) -> str:
     bad = [k for k in range(S.shape[1]) if not _close(S[:, k], R[:, k])]
     if neg and len(neg) == len(bad):
         return f"has the wrong sign in entries {_entries(neg, shape)}"
+    if np.all(np.abs(S) < 1e-12):
+        return "is zero everywhere"
     ratio = _const_ratio(S, R)
     if ratio is not None:
         if abs(abs(ratio) - 180 / math.pi) < 1e-6 * 180 / math.pi or abs(abs(ratio) - math.pi / 180) < 1e-9:
             return "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)"
+        if abs(ratio - 1) < 1e-2:
+            return (f"is {ratio:.6g} times the answer: rounded decimals? Use exact values "
+                    "(sp.sqrt(2), sp.pi, sp.Rational(1, 3))")
         return f"is off by a constant factor ({ratio:.6g} times the answer)"
     if stu.get("degrees"):
         return ("looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, "
@@ -252,44 +267,86 @@ def _canon_intervals(ivs):
                   for a, b in ivs)
 
 
-def _comp_key(comps, ref_vars):
-    """{var: comp}; a bare set (var None) is taken as the set of the only reference variable."""
-    out = {}
-    for c in comps:
-        v = c.get("var")
-        if v is None and len(ref_vars) == 1:
-            v = ref_vars[0]
-        if c.get("intervals") == [[-math.inf, math.inf]] and not c.get("points"):
-            continue  # "any value": no constraint
-        out[v] = c
+def _empty(c):
+    return not c.get("error") and not c.get("points") and not c.get("intervals") and not c.get("tuples")
+
+
+def _free(c):
+    return c.get("intervals") == [[-math.inf, math.inf]] and not c.get("points")
+
+
+def _conds(desc_point, ref_vars):
+    """Conditions as {var: component}; unsatisfiable ones (an empty component) dropped, "any value" ones
+    ignored, and a bare set (var None) taken as the set of the only reference variable."""
+    out = []
+    for cond in desc_point:
+        d = {}
+        dead = False
+        for c in cond:
+            v = c.get("var")
+            if v is None and len(ref_vars) == 1:
+                v = next(iter(ref_vars))
+            if _empty(c):
+                dead = True
+            if _free(c):
+                continue
+            d[v] = c
+        if not dead:
+            out.append(d)
     return out
 
 
+def _cond_match(s, r, periodic):
+    if set(s) != set(r):
+        return False, None
+    for v in r:
+        ok, msg = _compare_component(s[v], r[v], periodic and str(v).startswith("theta"))
+        if not ok:
+            return False, f"({v}): {msg}"
+    return True, ""
+
+
 def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple[bool, str]:
-    """Sets of configurations as sets: the same members (angles modulo 2π) for each constrained joint."""
+    """Sets of configurations as sets: the same conditions, each with the same members (angles modulo 2π)."""
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
     if stu.get("tag") != "set":
-        return False, f"{name} is a {stu.get('type')}; expected a SymPy Set or a dict {{symbol: Set}}"
-    for sp_, rp in zip(stu["points"], ref["points"]):
-        rvars = [c.get("var") for c in rp]
-        rk, sk = _comp_key(rp, rvars), _comp_key(sp_, rvars)
-        errs = [f"{v or 'your set'}: {c['error']}" for v, c in sk.items() if c.get("error")]
+        return False, (f"{name} is a {stu.get('type')}; expected a SymPy Set, a dict {{symbol: Set}} or a list "
+                       "of those")
+    for sp_, rp in zip(stu["conditions"], ref["conditions"]):
+        ref_vars = {c.get("var") for cond in rp for c in cond if c.get("var") is not None}
+        rc, sc = _conds(rp, ref_vars), _conds(sp_, ref_vars)
+        errs = [f"{v or 'your set'}: {c['error']}" for d in sc for v, c in d.items() if c.get("error")]
         if errs:
             return False, f"{name} could not be compared: " + "; ".join(errs)
-        if set(sk) != set(rk):
-            missing, extra = sorted(set(rk) - set(sk), key=str), sorted(set(sk) - set(rk), key=str)
-            parts = []
-            if missing:
-                parts.append(f"says nothing about {', '.join(map(str, missing))}")
-            if extra:
-                parts.append(f"constrains {', '.join(map(str, extra))}, which the answer leaves free")
-            return False, f"{name} " + " and ".join(parts)
-        for v in rk:
-            ok, msg = _compare_component(sk[v], rk[v], periodic and str(v).startswith("theta"))
+        if not rc and sc:
+            return False, f"{name} is not empty, but there are no such configurations"
+        if rc and not sc:
+            return False, f"{name} is empty, but such configurations exist"
+        if len(rc) == 1 and len(sc) == 1:
+            r, s = rc[0], sc[0]
+            if set(s) != set(r):
+                missing, extra = sorted(set(r) - set(s), key=str), sorted(set(s) - set(r), key=str)
+                parts = []
+                if missing:
+                    parts.append(f"says nothing about {', '.join(map(str, missing))}")
+                if extra:
+                    parts.append(f"constrains {', '.join(map(str, extra))}, which the answer leaves free")
+                return False, f"{name} " + " and ".join(parts)
+            ok, msg = _cond_match(s, r, periodic)
             if not ok:
-                return False, f"{name} ({v}): {msg}"
+                return False, f"{name} {msg}"
+            continue
+        unmatched = list(sc)
+        for r in rc:
+            hit = next((s for s in unmatched if _cond_match(s, r, periodic)[0]), None)
+            if hit is None:
+                return False, (f"{name}: {len(sc)} condition(s) given, {len(rc)} expected, and not all of them "
+                               f"match (conditions on {', '.join(sorted(map(str, r)))})")
+            unmatched.remove(hit)
+        if unmatched:
+            return False, f"{name} has {len(unmatched)} condition(s) more than the answer"
     return True, ""
 
 

@@ -16,7 +16,7 @@ import signal
 import subprocess
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from jupyter_client import BlockingKernelClient
 from jupyter_client.connect import write_connection_file
@@ -68,7 +68,6 @@ class Kernel:
     proc: subprocess.Popen | None = None
     kc: BlockingKernelClient | None = None
     dead_reason: str = ""
-    _n: int = field(default=0)
 
     def start(self) -> None:
         Kernel._counter = getattr(Kernel, "_counter", 0) + 1
@@ -130,8 +129,11 @@ class Kernel:
         deadline = t0 + timeout
         interrupted_at = None
         idle = replied = False
+        replied_at = None
         while not (idle and replied):
             now = time.monotonic()
+            if replied_at is not None and now > replied_at + 2.0:
+                break  # the reply is in; an idle status lost in an output flood must not hang us
             if interrupted_at is None and now > deadline:
                 self._interrupt()
                 interrupted_at = now
@@ -146,10 +148,12 @@ class Kernel:
                 self.dead_reason = "the kernel died (the code exited Python or crashed)"
                 res.status, res.note = "died", self.dead_reason
                 break
-            try:
-                msg = self.kc.get_iopub_msg(timeout=0.2)
-            except queue.Empty:
-                msg = None
+            msg = None
+            if not idle:
+                try:
+                    msg = self.kc.get_iopub_msg(timeout=0.1 if replied else 0.05)
+                except queue.Empty:
+                    msg = None
             if msg is not None and msg.get("parent_header", {}).get("msg_id") == msg_id:
                 mt, c = msg["msg_type"], msg["content"]
                 if mt == "status" and c.get("execution_state") == "idle":
@@ -163,11 +167,11 @@ class Kernel:
                         str(c.get("evalue", ""))[:500]
             if not replied:
                 try:
-                    reply = self.kc.get_shell_msg(timeout=0 if msg is not None else 0.01)
+                    reply = self.kc.get_shell_msg(timeout=0.1 if idle else 0)
                 except queue.Empty:
                     reply = None
                 if reply is not None and reply.get("parent_header", {}).get("msg_id") == msg_id:
-                    replied = True
+                    replied, replied_at = True, time.monotonic()
                     c = reply["content"]
                     if c.get("status") == "error" and res.status == "ok":
                         res.status, res.ename, res.evalue = "error", str(c.get("ename", ""))[:200], \

@@ -14,7 +14,6 @@ This module runs in two places with the same code:
 
 It imports only the standard library, SymPy and NumPy, and never imports kinlib.
 """
-import cmath
 import json
 import math
 import random
@@ -50,37 +49,52 @@ def snapshot():
     return {"mods": mods, "classes": classes, "sysmods": sysmods}
 
 
+_NOT_RESTORED = {"input", "raw_input", "get_ipython", "display", "help", "exit", "quit"}
+
+
+def _fn(v):
+    """Functions, classes and descriptors are restored; data (counters, caches, flags) is left alone."""
+    return callable(v) or isinstance(v, (staticmethod, classmethod, property))
+
+
+def _display_only(k):
+    """Rich-display hooks (``init_printing`` sets them): they do not change any value."""
+    return str(k).startswith("_repr_")
+
+
 def restore(snap):
-    """Undo changes to the snapshotted namespaces; returns how many attributes were put back."""
+    """Undo replaced functions/classes in the snapshotted namespaces; returns the names put back."""
     import types
-    fixed = 0
+    fixed = []
     for name, m in snap["sysmods"].items():
         if sys.modules.get(name) is not m:
             sys.modules[name] = m
-            fixed += 1
-    for m, saved in snap["mods"].values():
+            fixed.append(f"sys.modules[{name!r}]")
+    for name, (m, saved) in snap["mods"].items():
         cur = m.__dict__
         for k in list(cur):
-            if k not in saved and not isinstance(cur[k], types.ModuleType):
+            if k not in saved and _fn(cur[k]) and not isinstance(cur[k], types.ModuleType) \
+                    and not k.startswith("__") and k not in _NOT_RESTORED:
                 del cur[k]
-                fixed += 1
+                fixed.append(f"{name}.{k} (added)")
         for k, v in saved.items():
-            if cur.get(k, _MISSING) is not v:
+            if cur.get(k, _MISSING) is not v and _fn(v) and not k.startswith("__") and k not in _NOT_RESTORED:
                 cur[k] = v
-                fixed += 1
+                fixed.append(f"{name}.{k}")
     for cls, saved in snap["classes"].values():
+        where = f"{cls.__module__}.{cls.__qualname__}"
         for k in list(cls.__dict__):
-            if k not in saved:
+            if k not in saved and _fn(cls.__dict__[k]) and not _display_only(k):
                 try:
                     delattr(cls, k)
-                    fixed += 1
+                    fixed.append(f"{where}.{k} (added)")
                 except (AttributeError, TypeError):
                     pass
         for k, v in saved.items():
-            if cls.__dict__.get(k, _MISSING) is not v:
+            if cls.__dict__.get(k, _MISSING) is not v and _fn(v) and not _display_only(k):
                 try:
                     setattr(cls, k, v)
-                    fixed += 1
+                    fixed.append(f"{where}.{k}")
                 except (AttributeError, TypeError):
                     pass
     try:
@@ -125,7 +139,7 @@ def to_sympy(value):
         return "ellipsis", None
     if value is None:
         return "none", None
-    if isinstance(value, (bool, np.bool_)):
+    if isinstance(value, (bool, np.bool_)) or value is sp.true or value is sp.false:
         return "bool", None
     if isinstance(value, sp.MatrixBase):
         return "matrix", sp.Matrix(value)
@@ -215,9 +229,36 @@ def _degrees_hint(obj):
     return False
 
 
+def _lambdified_values(obj, entries, points, seed):
+    """Values at ``points`` through a NumPy lambdify (complex128), or None to fall back to evalf."""
+    import numpy as np
+    import sympy as sp
+    if not points:
+        return []
+    syms = sorted((s for s in obj.free_symbols if isinstance(s, sp.Symbol)), key=lambda s: s.name)
+    if any(not isinstance(s, sp.Symbol) for s in obj.free_symbols) or obj.atoms(sp.core.function.AppliedUndef):
+        return None
+    try:
+        f = sp.lambdify(syms, entries, modules="numpy", cse=True)
+        out = []
+        for p in points:
+            args = [np.complex128(p[s.name] if s.name in p else _extra_value(seed, s.name)) for s in syms]
+            with np.errstate(all="ignore"):
+                vals = [complex(v) for v in f(*args)]
+            if not all(math.isfinite(v.real) and math.isfinite(v.imag) for v in vals):
+                return None
+            out.append([[v.real, v.imag] for v in vals])
+        return out
+    except Exception:  # noqa: BLE001
+        return None
+
+
 def describe_expr(value, points, seed=0):
     """Matrix/expression answer: type, shape, symbols and values at ``points`` (dicts name -> float)."""
     import sympy as sp
+    if isinstance(value, dict) and value and all(isinstance(k, (str, int)) for k in value):
+        return {"tag": "dict", "type": "dict",
+                "items": {str(k): describe_expr(v, points, seed) for k, v in value.items()}}
     tag, obj = to_sympy(value)
     out = {"tag": tag, "type": _type_name(value)}
     if obj is None:
@@ -227,6 +268,10 @@ def describe_expr(value, points, seed=0):
                degrees=_degrees_hint(obj),
                undefined=sorted({str(f.func) for f in obj.atoms(sp.core.function.AppliedUndef)}))
     entries = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
+    fast = _lambdified_values(obj, entries, points, seed)
+    if fast is not None:
+        out["values"] = fast
+        return out
     values = []
     for p in points:
         subs = _subs_for(obj, p, seed)
@@ -322,56 +367,81 @@ def _enum1d(S, subs, window):
     raise ValueError(f"a {type(S).__name__} cannot be enumerated (use FiniteSet, ImageSet or Union)")
 
 
-def describe_set(value, points, seed=0, window=4 * math.pi):
-    """Set-of-configurations answer: {var name or None: {points, intervals}} at the first point(s)."""
+def _conditions(value):
+    """A set-of-configurations answer as a list of conditions, each a list of (key, 1-D set or tuples).
+
+    A SymPy Set or a Python set/list of values is one condition on one (unnamed) joint; a dict
+    {symbol: Set} is one condition on each named joint; a list of such dicts (as
+    ``kinlib.singularities.singular_configurations`` returns) is a union of conditions; an empty list or
+    ``EmptySet`` is the empty set.
+    """
     import numpy as np
     import sympy as sp
-    out = {"tag": "set", "type": _type_name(value)}
+    if isinstance(value, (dict, sp.Dict)):
+        return [list(dict(value).items())]
+    if isinstance(value, (list, tuple)) and all(isinstance(v, (dict, sp.Dict)) for v in value):
+        return [list(dict(v).items()) for v in value]
+    if isinstance(value, np.ndarray):
+        value = value.tolist()
+    if isinstance(value, (sp.Set, set, frozenset, list, tuple)):
+        return [[(None, value)]]
+    return None
+
+
+def _component(key, S, p, seed, window):
+    import sympy as sp
+    name = key.name if isinstance(key, sp.Symbol) else (str(key) if key is not None else None)
+    subs = _subs_for(S, p, seed) if isinstance(S, sp.Basic) else {}
+    comp = {"var": name}
+    try:
+        if isinstance(S, sp.FiniteSet) and any(isinstance(a, (sp.Tuple, sp.MatrixBase)) for a in S.args) \
+                or isinstance(S, (list, tuple, set, frozenset)) and S and \
+                all(isinstance(a, (tuple, list, sp.Tuple)) for a in S):
+            tuples = []
+            for a in (S.args if isinstance(S, sp.FiniteSet) else S):
+                t = []
+                for e in a:
+                    x = _real(sp.sympify(e), subs)
+                    if x is None:
+                        raise ValueError(f"member {a} is not real")
+                    t.append(x)
+                tuples.append(t)
+            comp["tuples"] = tuples
+        else:
+            pts, ivs = _enum1d(S, subs, window)
+            comp["points"] = pts
+            comp["intervals"] = ivs
+    except Exception as exc:  # noqa: BLE001  (any failure is reported, not raised)
+        comp["error"] = f"{type(exc).__name__}: {exc}"[:300]
+    return comp
+
+
+def describe_set(value, points, seed=0, window=4 * math.pi):
+    """Set-of-configurations answer: per point, a list of conditions, each a list of components
+    {"var": name or None, "points"/"intervals" (members in [-window, window]) or "tuples"}."""
     if value is Ellipsis:
         return {"tag": "ellipsis", "type": "ellipsis"}
     if value is None:
         return {"tag": "none", "type": "NoneType"}
-    if isinstance(value, (dict, sp.Dict)):
-        items = list(dict(value).items())
-    elif isinstance(value, (sp.Set, set, frozenset, list, tuple, np.ndarray)):
-        items = [(None, value)]
-    else:
-        out["tag"] = "other"
-        return out
+    conds = _conditions(value)
+    if conds is None:
+        return {"tag": "other", "type": _type_name(value)}
     per_point = []
     for p in points:
-        comps = []
-        for k, S in items:
-            name = k.name if isinstance(k, sp.Symbol) else (str(k) if k is not None else None)
-            S_ = S
-            if isinstance(S_, np.ndarray):
-                S_ = S_.tolist()
-            subs = _subs_for(S_, p, seed) if isinstance(S_, sp.Basic) else {}
-            comp = {"var": name}
-            try:
-                if isinstance(S_, sp.FiniteSet) and any(isinstance(a, (sp.Tuple, sp.MatrixBase)) for a in S_.args) \
-                        or isinstance(S_, (list, tuple, set, frozenset)) and S_ and \
-                        all(isinstance(a, (tuple, list, sp.Tuple)) for a in S_):
-                    tuples = []
-                    for a in (S_.args if isinstance(S_, sp.FiniteSet) else S_):
-                        t = []
-                        for e in a:
-                            x = _real(sp.sympify(e), subs)
-                            if x is None:
-                                raise ValueError(f"member {a} is not real")
-                            t.append(x)
-                        tuples.append(t)
-                    comp["tuples"] = tuples
-                else:
-                    pts, ivs = _enum1d(S_, subs, window)
-                    comp["points"] = pts
-                    comp["intervals"] = ivs
-            except Exception as exc:  # noqa: BLE001  (any failure is reported, not raised)
-                comp["error"] = f"{type(exc).__name__}: {exc}"[:300]
-            comps.append(comp)
-        per_point.append(comps)
-    out["points"] = per_point
-    return out
+        per_point.append([[_component(k, S, p, seed, window) for k, S in cond] for cond in conds])
+    return {"tag": "set", "type": _type_name(value), "conditions": per_point}
+
+
+def looks_like_set(value):
+    """Answers of the default kind that are really sets of configurations (Sets, {symbol: Set}, lists of those)."""
+    import sympy as sp
+    if isinstance(value, sp.Set):
+        return True
+    if isinstance(value, (dict, sp.Dict)):
+        return bool(value) and all(isinstance(k, sp.Symbol) for k in dict(value))
+    if isinstance(value, (list, tuple)):
+        return len(value) == 0 or all(isinstance(v, (dict, sp.Dict)) and looks_like_set(v) for v in value)
+    return False
 
 
 # ----------------------------------------------------------------------------- choices
@@ -418,12 +488,16 @@ def normalize_reference(kind, value):
     """The reference value as something ``srepr`` round-trips (instructor side only)."""
     import numpy as np
     import sympy as sp
+    if kind == "expr" and isinstance(value, dict) and value and all(isinstance(k, (str, int)) for k in value):
+        return {str(k): normalize_reference(kind, v) for k, v in value.items()}
     if kind in ("expr", "subspace"):
         tag, obj = to_sympy(value)
         if obj is None:
             raise TypeError(f"reference answer of kind {kind!r} is {tag} ({_type_name(value)})")
         return obj
     if kind == "set":
+        if isinstance(value, (list, tuple)) and all(isinstance(v, dict) for v in value):
+            return [normalize_reference(kind, v) for v in value]
         if isinstance(value, dict):
             return {k: (sp.FiniteSet(*v) if isinstance(v, (set, frozenset, list, tuple)) else v)
                     for k, v in value.items()}
@@ -442,18 +516,27 @@ def dump_reference(ns, answers):
             out[name] = {"error": f"{name} is not defined after the solution notebook ran"}
             continue
         try:
+            if kind == "expr" and looks_like_set(ns[name]):
+                kind = "set"
+            if kind == "expr" and (isinstance(ns[name], (bool, str)) or ns[name] is sp.true or ns[name] is sp.false
+                                   or type(ns[name]).__name__ == "bool_"):
+                kind = "choice"
             if kind == "choice":
-                out[name] = {"choice": describe_choice(ns[name])}
+                out[name] = {"choice": describe_choice(ns[name]), "kind": kind}
                 continue
             obj = normalize_reference(kind, ns[name])
             text = sp.srepr(obj)
             syms = set()
-            for s in getattr(obj, "free_symbols", set()) or set():
-                syms.add(s)
-            if isinstance(obj, dict):
-                for k, v in obj.items():
-                    syms |= getattr(v, "free_symbols", set())
-            out[name] = {"srepr": text, "symbols": {s.name: {"positive": bool(s.is_positive)}
+            stack = [obj]
+            while stack:
+                o = stack.pop()
+                if isinstance(o, dict):
+                    stack += list(o.values())
+                elif isinstance(o, (list, tuple)):
+                    stack += list(o)
+                else:
+                    syms |= set(getattr(o, "free_symbols", set()) or set())
+            out[name] = {"kind": kind, "srepr": text, "symbols": {s.name: {"positive": bool(s.is_positive)}
                                                      for s in syms if isinstance(s, sp.Symbol)}}
         except Exception as exc:  # noqa: BLE001
             out[name] = {"error": f"{type(exc).__name__}: {exc}"[:500]}
@@ -558,9 +641,9 @@ SNAP = None
 
 def restore_saved(path):
     """Restore the snapshot taken before the first student cell; write how many attributes changed."""
-    n = restore(SNAP) if SNAP is not None else 0
+    names = restore(SNAP) if SNAP is not None else []
     with open(path, "w") as f:
-        json.dump({"restored": n}, f)
+        json.dump({"restored": names[:50]}, f)
 
 
 def probe_reference(ns, answers, path):
@@ -572,5 +655,3 @@ def probe_reference(ns, answers, path):
     with open(path, "w") as f:
         json.dump(dump_reference(values, answers), f)
 
-
-_ = cmath  # kept importable for evaluations that return complex numbers

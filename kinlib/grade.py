@@ -21,7 +21,11 @@ How it works
 * **Each submission** runs in its own fresh kernel (:mod:`kinlib._grade_kernel`) in a scratch copy
   (a temp dir as cwd), every code cell in order with a per-cell and a total time limit. A cell that
   raises is recorded and the next one runs; a cell that kills the kernel (``os._exit``) or ignores the
-  time limit is skipped after a restart (at most two), so the other parts are still graded.
+  time limit is skipped after a restart (at most two), so the other parts are still graded. An answer
+  is the value its variable has when its part ends (before the next ``question`` cell; the last part
+  at the end of the notebook), so cells a student adds below a stub count and later reuse of the name
+  does not. Workbook self-check cells that only call ``kinlib.selfcheck.check`` are not run (they
+  cannot change an answer and cost seconds).
 * **Values cross the boundary as JSON numbers only.** Before the first student cell the checker
   starts :mod:`kinlib._grade_probe` in the kernel from its source text (a private module under a
   random name) and snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
@@ -34,7 +38,10 @@ How it works
   (expand_trig/expand, then simplify), reported as advice: it cannot turn a numeric failure into a pass.
 * **Kinds** (``kinds`` beside ``answers``): ``expr`` (default: matrices/expressions as functions of
   the symbols), ``subspace`` (by span: rank [A B] = rank A = rank B), ``set`` (sets of configurations:
-  members compared, angles modulo 2π), ``choice`` (ints/tuples compared as sets).
+  members compared, angles modulo 2π; a list of {symbol: Set} conditions is their union, [] the empty
+  set), ``choice`` (ints/tuples compared as sets). A default-kind answer that is a Set, a
+  {symbol: Set} dict or a list of those is compared as a set; a bool or string as a choice; a dict with
+  string keys entry by entry.
 
 Threat model
 ------------
@@ -304,12 +311,12 @@ class _Run:
                 src = _source(cell)
                 if not src.strip() or is_plain_selfcheck(cell):
                     self.results[i] = CellResult(i, "ok", note="self-check not run by the checker" if src.strip() else "")
-                    continue
-                r = self.kernel.run(src, timeout=min(self.cell_timeout, left), index=i)
-                self.results[i] = r
-                if r.status in ("died", "timeout") and not self.kernel.alive():
-                    died_at = i
-                    break
+                else:
+                    r = self.kernel.run(src, timeout=min(self.cell_timeout, left), index=i)
+                    self.results[i] = r
+                    if r.status in ("died", "timeout") and not self.kernel.alive():
+                        died_at = i
+                        break
                 if i in self.stash_after and self.kernel.alive():
                     self.kernel.run(f"{self._m()}.stash(globals(), {self.stash_after[i]!r})", timeout=10,
                                     silent=True)
@@ -413,9 +420,9 @@ def build_reference(path: Path, cache: Path | None = None, timeout: float = 300.
     return ref
 
 
-def load_references(notebooks: Path, cache: Path | None, ids: set | None = None, log=None) -> dict:
+def load_references(notebooks: Path, cache: Path | None, ids: set | None = None, log=None, jobs: int = 1) -> dict:
     """{notebook id: Reference} for the solution notebooks in ``notebooks`` (only ``ids`` if given)."""
-    refs = {}
+    todo = {}
     for p in sorted(Path(notebooks).glob("*.ipynb")):
         try:
             nid = _nb_id(json.loads(p.read_bytes()))
@@ -423,8 +430,13 @@ def load_references(notebooks: Path, cache: Path | None, ids: set | None = None,
             continue
         if nid is None or (ids is not None and nid not in ids):
             continue
-        refs[nid] = build_reference(p, cache, log=log)
-    return refs
+        todo[nid] = p
+    if jobs <= 1 or len(todo) <= 1:
+        return {nid: build_reference(p, cache, log=log) for nid, p in todo.items()}
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {nid: pool.submit(build_reference, p, cache, log=log) for nid, p in todo.items()}
+        return {nid: f.result() for nid, f in futures.items()}
 
 
 # ----------------------------------------------------------------------------------------- one submission
@@ -595,7 +607,7 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         out["restored"] = (got or {}).get("restored", 0) if got else f"restore failed: {e}"
         for p in parts:
             for name in p["answers"]:
-                kind = p["kinds"].get(name, "expr")
+                kind = ref.answers.get(name, {}).get("kind") or p["kinds"].get(name, "expr")
                 n = N_SET_POINTS if kind == "set" else (0 if kind == "choice" else N_POINTS)
                 got, e = run.call(f"probe_answer(globals(), {name!r}, {kind!r}, {points[:n]!r}, {seed}, PATH)",
                                   PROBE_TIMEOUT)
@@ -612,7 +624,7 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
             continue
         msgs, ok_all, err = [], True, False
         for name in p["answers"]:
-            kind = p["kinds"].get(name, "expr")
+            kind = ref.answers.get(name, {}).get("kind") or p["kinds"].get(name, "expr")
             ra = ref.answers.get(name, {})
             stu = results.get(name) or {"tag": "probe-error", "error": "no result"}
             if not isinstance(stu, dict):
@@ -672,11 +684,13 @@ def _done(out, t0):
 # ----------------------------------------------------------------------------------------- batch
 
 def find_submissions(paths) -> list[Path]:
-    """Files given, plus every .ipynb under folders given (checkpoints skipped), in order."""
+    """Files given, plus every .ipynb under folders given (hidden folders such as .ipynb_checkpoints
+    skipped), in order."""
     found = []
     for p in map(Path, paths):
         if p.is_dir():
-            found += sorted(q for q in p.rglob("*.ipynb") if ".ipynb_checkpoints" not in q.parts)
+            found += sorted(q for q in p.rglob("*.ipynb")
+                            if not any(part.startswith(".") for part in q.relative_to(p).parts[:-1]))
         elif p.exists():
             found.append(p)
         else:
@@ -721,7 +735,7 @@ def grade_batch(paths, out, jobs: int = 2, timeout: float = 300.0, cell_timeout:
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
     ids = {i for i in (_peek_id(p) for p in subs) if i}
-    refs = load_references(notebooks, Path(cache) if cache else None, ids, log=log)
+    refs = load_references(notebooks, Path(cache) if cache else None, ids, log=log, jobs=max(1, int(jobs)))
     t_ref = time.monotonic() - t0
     names = _display_names(subs)
     jobs = max(1, int(jobs))
@@ -795,6 +809,10 @@ def feedback_markdown(res: dict) -> str:
         if res.get("restarts"):
             lines.append(f"- the kernel was restarted {res['restarts']} time(s); the cells that stopped it were "
                          "skipped")
+    if res.get("restored") and isinstance(res["restored"], list):
+        names = ", ".join(f"`{n}`" for n in res["restored"][:8]) + (" …" if len(res["restored"]) > 8 else "")
+        lines += ["", f"Your notebook replaced {names}; the checker put the originals back before reading "
+                      "your answers."]
     if res.get("output_bytes", 0) > 1_000_000:
         lines.append(f"- your notebook printed {res['output_bytes'] / 1e6:.1f} MB of output (not kept)")
     lines += ["", "How this was checked: your notebook ran top to bottom in a fresh Python kernel; each answer "
@@ -817,7 +835,7 @@ def write_outputs(out: Path, results: list, refs: dict) -> None:
     fb = out / "feedback"
     fb.mkdir(exist_ok=True)
     with open(out / "grades.csv", "w", newline="") as f:
-        w = csv.writer(f)
+        w = csv.writer(f, lineterminator="\n")
         w.writerow(["submission", "notebook", "part", "status", "points", "message"])
         for res in results:
             for r in res["rows"]:

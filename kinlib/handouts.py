@@ -5,14 +5,18 @@
 For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with nbconvert) it writes
 
 - ``solutions/NN_*.html``: the whole notebook with its outputs;
-- ``problems/NN_*.html``: questions, narrative, set-up and figures; no ``solution`` or ``check``
-  cells, no output that repeats a solution's, no prompt numbers, only the widgets still shown;
+- ``problems/NN_*.html``: questions, narrative, set-up and figures; left out: ``solution`` and
+  ``check`` cells, the untagged markdown inside a worked solution (between a ``question`` and the last
+  ``solution``/``check`` cell answering it), cells that read answer variables (and their markdown
+  caption just above), any output that repeats an answer cell's output; no prompt numbers; the saved
+  widget state pruned to the widgets still shown;
 - ``workbooks/NN_*.ipynb``: the student notebook: each ``solution`` code cell becomes a stub
   (``Js = ...  # TODO: ...``, keeping its ``kinlib`` metadata), each solution markdown cell a prompt,
   each ``check`` cell a self-check (:mod:`kinlib.selfcheck`) that compares a fingerprint of the
-  student's answer with the reference's made here; cells that use answer variables run only once
-  those are filled in (``%%needs``); outputs cleared. Unless ``--no-verify``, each workbook is then
-  run top to bottom (the stubs must not crash it);
+  student's answer with the reference's made here (a part without a check cell gets one after its
+  last solution cell); worked-solution markdown left out as above; cells that use answer variables
+  run only once those are filled in (``%%needs``); outputs cleared. Unless ``--no-verify``, each
+  workbook is then run top to bottom (the stubs must not crash it);
 - ``index.html`` linking everything, and ``assets/``: MathJax 2 (copied from the installed
   ``jupyter-server-mathjax``), require.js and the ``@jupyter-widgets/html-manager`` embed bundle
   (``npm pack`` from the npm registry into ``build/vendor`` once, then reused), so every page
@@ -312,16 +316,6 @@ def _leaks(output, texts, images) -> bool:
     return False
 
 
-def _is_picture(output) -> bool:
-    """A figure, an animation or a widget (not a value printed as text or LaTeX)."""
-    data = output.get("data", {})
-    if any(m in data for m in ("image/png", "image/jpeg", "application/vnd.jupyter.widget-view+json")):
-        return True
-    h = data.get("text/html", "")
-    h = h if isinstance(h, str) else "".join(h)
-    return "<img" in h or "<canvas" in h or "<video" in h
-
-
 def _widget_ids(obj, found: set):
     if isinstance(obj, str):
         if obj.startswith("IPY_MODEL_"):
@@ -367,21 +361,25 @@ def make_problems(executed) -> tuple:
     answer_cells = [c for c in nb.cells if ANSWER_TAGS & set(_tags(c))]
     texts, images = _leak_signatures(answer_cells)
     dependents = answer_dependents(nb)
+    narrative = worked_narrative(nb)
     notes, cells = [], []
+    if narrative:
+        notes.append(f"problems and workbook: left out {len(narrative)} untagged markdown cell(s) inside worked "
+                     f"solutions (cells {', '.join(map(str, sorted(narrative)))})")
+    dropped = [i for i in dependents if not ANSWER_TAGS & set(_tags(nb.cells[i]))]
+    if dropped:
+        notes.append(f"problems: left out {len(dropped)} cell(s) computed from answers "
+                     f"(cells {', '.join(map(str, sorted(dropped)))})")
+    captions = {i - 1 for i in dependents if i > 0 and nb.cells[i - 1].cell_type == "markdown"
+                and not _tags(nb.cells[i - 1]) and not nb.cells[i - 1].source.lstrip().startswith("#")}
     for i, c in enumerate(nb.cells):
-        if ANSWER_TAGS & set(_tags(c)):
-            continue
+        if ANSWER_TAGS & set(_tags(c)) or i in narrative or i in dependents or i in captions:
+            continue       # answers, worked-solution steps, what is computed from answers and its caption
         if c.cell_type == "code":
             kept = [o for o in c.outputs if not _leaks(o, texts, images)]
             if len(kept) != len(c.outputs):
-                notes.append(f"cell {i}: dropped {len(c.outputs) - len(kept)} output(s) that repeat an answer")
-            if i in dependents:             # computed from the answers: keep figures and widgets, not values
-                n = len(kept)
-                kept = [o for o in kept if o.get("output_type") in ("display_data", "execute_result")
-                        and _is_picture(o)]
-                if len(kept) != n:
-                    notes.append(f"cell {i}: dropped {n - len(kept)} text output(s) computed from "
-                                 f"{', '.join(dependents[i])}")
+                notes.append(f"problems: cell {i}: dropped {len(c.outputs) - len(kept)} output(s) that repeat "
+                             "an answer")
             for o in kept:
                 if "execution_count" in o:
                     o["execution_count"] = None
@@ -510,6 +508,21 @@ def _names(src: str) -> tuple[set, set]:
     return v.free, v.bound
 
 
+def worked_narrative(nb) -> set:
+    """Untagged markdown cells inside a worked solution: after a ``question`` cell and before the last
+    ``solution``/``check`` cell answering it (its steps and explanations). Problems and workbooks drop them."""
+    out: set = set()
+    cells = nb.cells
+    questions = [i for i, c in enumerate(cells) if "question" in _tags(c)]
+    for k, q in enumerate(questions):
+        stop = questions[k + 1] if k + 1 < len(questions) else len(cells)
+        answers = [i for i in range(q + 1, stop) if ANSWER_TAGS & set(_tags(cells[i]))]
+        if answers:
+            out |= {i for i in range(q + 1, answers[-1])
+                    if cells[i].cell_type == "markdown" and not _tags(cells[i])}
+    return out
+
+
 def answer_dependents(nb) -> dict:
     """{cell index: names it reads that come from solution cells} for the other code cells.
 
@@ -570,6 +583,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
     after = {g.last_solution: g for g in groups if g.check_cell is None and g.answers}
 
     needs = answer_dependents(nb)
+    narrative = worked_narrative(nb)
 
     cells = []
     part = ""
@@ -591,6 +605,8 @@ def make_workbook(source_nb, groups: list, fps: dict):
             g = check_group.get(i)
             if g is not None and g.answers:
                 cells.append(_selfcheck_cell(g, fps, cell))
+        elif i in narrative:
+            pass
         else:
             if i in needs:
                 cell.source = f"%%needs {' '.join(needs[i])}\n" + cell.source

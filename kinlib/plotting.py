@@ -461,18 +461,105 @@ def _set_segs(c, segs, three_d):
 # ---------------------------------------------------------------------------------------------------
 def _workspace_limits(chain, ranges, q=None, pad=0.12):
     """Bounding box (3, 2) of the skeleton over a deterministic sample of the joint ranges."""
-    rng = np.random.default_rng(0)
-    lo = np.array([r[0] for r in ranges])
-    hi = np.array([r[1] for r in ranges])
-    Q = lo + (hi - lo) * rng.random((400, chain.n))
-    extra = [np.zeros(chain.n)] + ([q] if q is not None else [])
-    Q = np.vstack([Q, np.array(extra)])
-    P = chain.skeleton(Q)  # (N, 3, n+2)
-    box = np.stack([P.min(axis=(0, 2)), P.max(axis=(0, 2))], axis=1)
+    P = _workspace_points(chain, ranges, q)
+    box = np.stack([P.min(axis=1), P.max(axis=1)], axis=1)
     size = float(np.max(box[:, 1] - box[:, 0]))
     box[:, 0] -= pad * size
     box[:, 1] += pad * size
     return box, size
+
+
+def _workspace_points(chain, ranges, q=None, samples=400):
+    """The skeleton points (3, N·(n+2)) of a deterministic sample of the joint ranges (and home, q)."""
+    rng = np.random.default_rng(0)
+    lo = np.array([r[0] for r in ranges])
+    hi = np.array([r[1] for r in ranges])
+    Q = lo + (hi - lo) * rng.random((samples, chain.n))
+    extra = [np.zeros(chain.n)] + ([q] if q is not None else [])
+    Q = np.vstack([Q, np.array(extra)])
+    return np.moveaxis(chain.skeleton(Q), 1, 0).reshape(3, -1)
+
+
+# --- the view: equal aspect, tight around what is drawn ---------------------------------------------
+def _fit_view(ax, pts, margin=0.08, min_frac=0.4):
+    """Limits around the points pts (3, k) with equal scaling on every axis: a box of the points' own
+    proportions (each side at least ``min_frac`` of the longest, so a flat arm still gets some depth),
+    padded by ``margin`` × the longest side. 3-D: ``set_box_aspect`` to the box's sides."""
+    pts = np.asarray(pts, float)
+    d = 3 if _is3d(ax) else 2
+    P = pts[:d]
+    lo, hi = P.min(axis=1), P.max(axis=1)
+    ext = hi - lo
+    m = max(float(ext.max()), 1e-6)
+    ext = np.maximum(ext, min_frac * m)
+    c = 0.5 * (lo + hi)
+    half = 0.5 * ext + margin * m
+    ax.set_xlim(c[0] - half[0], c[0] + half[0])
+    ax.set_ylim(c[1] - half[1], c[1] + half[1])
+    if d == 3:
+        ax.set_zlim(c[2] - half[2], c[2] + half[2])
+        ax.set_box_aspect(tuple(2 * half), zoom=0.95)
+    else:
+        ax.set_aspect("equal", adjustable="box")
+
+
+def _include(ax, pts):
+    """Grow an automatic kinlib view (one set by draw_chain without ``limits``) so that the points
+    (3, k) or (2, k), e.g. a velocity arrow's tip, are inside it; labels are placed again around them."""
+    view = getattr(ax, "_kinlib_view", None)
+    if view is None:
+        return
+    pts = np.asarray(pts, float)
+    if pts.shape[0] == 2:
+        pts = np.vstack([pts, np.zeros(pts.shape[1])])
+    pts = pts[:, np.all(np.isfinite(pts), axis=0)]
+    view["obstacles"] = np.hstack([view["obstacles"], pts])
+    if view["fit"]:
+        view["points"] = np.hstack([view["points"], pts])
+        _fit_view(ax, view["points"], view["margin"])
+    art = view.get("chain")
+    if art is not None:
+        art.place_labels()
+
+
+_DIRS3 = np.array([[0, -1, 1], [0, 1, 1], [1, 0, 1], [-1, 0, 1], [0, -1, -1], [0, 1, -1], [1, 0, -1],
+                   [-1, 0, -1], [1, 1, 0], [-1, -1, 0], [1, -1, 0], [-1, 1, 0], [0, 0, 1], [0, 0, -1]], float)
+_DIRS3 /= np.linalg.norm(_DIRS3, axis=1)[:, None]
+_DIRS2 = np.array([[-1, 1, 0], [1, 1, 0], [-1, -1, 0], [1, -1, 0], [0, 1, 0], [0, -1, 0], [-1, 0, 0],
+                   [1, 0, 0]], float)
+_DIRS2 /= np.linalg.norm(_DIRS2, axis=1)[:, None]
+
+
+def _to_pixels(ax, P):
+    """Display coordinates (k, 2) of the points P (3, k) in ax (through the 3-D projection if any)."""
+    if _is3d(ax):
+        from mpl_toolkits.mplot3d import proj3d
+        x, y, _ = proj3d.proj_transform(P[0], P[1], P[2], ax.get_proj())
+        return ax.transData.transform(np.column_stack([x, y]))
+    return ax.transData.transform(P[:2].T)
+
+
+def _data_per_pixel(ax) -> float:
+    """Data length per pixel on screen (3-D: along the least foreshortened of the box's edges)."""
+    if not _is3d(ax):
+        return float(np.diff(ax.get_xlim())[0]) / max(ax.bbox.width, 1.0)
+    lims = np.array([ax.get_xlim(), ax.get_ylim(), ax.get_zlim()])
+    c = lims[:, :1]
+    ends = np.repeat(c, 6, axis=1)
+    for k in range(3):
+        ends[k, 2 * k], ends[k, 2 * k + 1] = lims[k]
+    px = _to_pixels(ax, ends)
+    pix = np.linalg.norm(px[0::2] - px[1::2], axis=1)
+    return float(np.min((lims[:, 1] - lims[:, 0]) / np.maximum(pix, 1e-9)))
+
+
+def _segment_samples(pts, k=16):
+    """Points along the polyline through the columns of pts (3, m), k per segment."""
+    if pts.shape[1] < 2:
+        return pts
+    t = np.linspace(0.0, 1.0, k)[None, :, None]
+    a, b = pts[:, :-1].T[:, None, :], pts[:, 1:].T[:, None, :]
+    return (a + t * (b - a)).reshape(-1, 3).T
 
 
 class ChainArtist:
@@ -480,26 +567,33 @@ class ChainArtist:
 
     Attributes: ``ax``, ``chain`` (numeric), ``q``, ``planar``, ``scale`` (a length for frame arrows),
     ``links`` (Line through the skeleton), ``revolute``/``prismatic`` (joint markers), ``axes_lines``,
-    ``frame_s``/``frame_b`` (arrow sets), ``labels`` (Text per joint), ``tool`` (tool-origin marker).
+    ``frame_s``/``frame_b`` (arrow sets), ``labels`` (Text θi per joint, placed where they overlap
+    neither each other nor the links: at the end of the joint's axis in 3-D, beside the joint in 2-D),
+    ``annotations`` (extra Text, e.g. the screw axes of :func:`draw_home`), ``tool`` (tool-origin marker).
     """
 
+    AXIS_HALF = 0.35    # half-length of a drawn joint axis, × scale
+    FRAME = 0.22        # length of a frame arrow, × scale
+
     def __init__(self, ax, chain, q, *, planar, frames=True, axes=True, labels=True, color="0.25",
-                 scale=None, lw=4.0):
+                 scale=None, lw=4.0, fontsize=9):
         self.ax, self.chain, self.planar = ax, chain, planar
         self.three_d = _is3d(ax)
         self.q = q
         self.scale = scale
+        self.fontsize = fontsize
         self.kinds = chain.joint_types
         self.rev = [i for i, k in enumerate(self.kinds) if k == "R"]
         self.pri = [i for i, k in enumerate(self.kinds) if k == "P"]
         sk, T, Js = self._kin(q)
+        self._geom = (sk, T, Js)
         self.links = _line(ax, sk, color=color, lw=lw, solid_capstyle="round", zorder=2,
                            marker="", label="links")
         self.base = _line(ax, sk[:, :1], color="k", marker="s", ms=9, ls="", zorder=3)
         self.tool = _line(ax, sk[:, -1:], color="k", marker="o", ms=4, ls="", zorder=5)
         rp = sk[:, [i + 1 for i in self.rev]]
-        self.revolute = _line(ax, rp, ls="", marker="o", ms=12, mfc="white", mec="k", mew=1.8, zorder=4,
-                              label="revolute joint")
+        self.revolute = _line(ax, rp, ls="", marker="o", ms=12 if not self.three_d else 10, mfc="white", mec="k",
+                              mew=1.8, zorder=4, label="revolute joint")
         self.revolute_dot = (_line(ax, rp, ls="", marker=".", ms=5, color="k", zorder=5)
                              if not self.three_d else None)
         self.prismatic = _segs_collection(ax, self._rails(sk, Js), colors="tab:gray", linewidths=9,
@@ -513,31 +607,34 @@ class ChainArtist:
         self.frame_texts = []
         if frames:
             d = 3 if self.three_d else 2
-            L = 0.22 * scale
+            L = self.FRAME * scale
             E = np.eye(3)[:d, :d] * L
             cols = FRAME_COLORS[:d]
-            self.frame_s = _Arrows(ax, np.zeros((d, d)), E, cols, head=0.3, zorder=3)
-            self.frame_b = _Arrows(ax, np.tile(T[:d, 3], (d, 1)), (T[:d, :d] * L).T, cols, head=0.3, zorder=6)
-            off = -0.09 * scale * np.array([1.0, 1.0, 0.0])
-            self.frame_texts = [_text(ax, off, r"$\{s\}$", fontsize=9, ha="center", va="center"),
-                                _text(ax, T[:3, 3] + self._label_offset(), r"$\{b\}$", fontsize=9, ha="center",
-                                      va="center")]
+            # thinner and lighter than the velocity arrows drawn on top, so the two are not confused
+            thin = dict(head=0.3, width=0.006, lw=1.6, alpha=0.75)
+            self.frame_s = _Arrows(ax, np.zeros((d, d)), E, cols, zorder=3, **thin)
+            self.frame_b = _Arrows(ax, np.tile(T[:d, 3], (d, 1)), (T[:d, :d] * L).T, cols, zorder=3, **thin)
+            self.frame_texts = [_text(ax, np.zeros(3), r"$\{s\}$", fontsize=fontsize - 1, ha="center", va="center",
+                                      zorder=7),
+                                _text(ax, T[:3, 3], r"$\{b\}$", fontsize=fontsize - 1, ha="center", va="center",
+                                      zorder=7)]
         self.labels = []
         if labels:
             for i in range(chain.n):
-                p = sk[:, i + 1] + self._label_offset(i)
-                self.labels.append(_text(ax, p, _theta_tex(i + 1),
-                                         fontsize=10, color=JOINT_COLORS[i % 10], ha="center", va="center",
-                                         zorder=7))
+                self.labels.append(_text(ax, sk[:, i + 1], _theta_tex(i + 1), fontsize=fontsize,
+                                         color=JOINT_COLORS[i % 10], ha="center", va="center", zorder=7))
+        self.annotations = []
+        self.place_labels()
 
     # -- geometry -----------------------------------------------------------------------------------
     def _kin(self, q):
         c = self.chain
         return c.skeleton(q), c.fk(q), c.jacobian_space(q)
 
-    def _label_offset(self, i=None):
-        s = 0.09 * self.scale
-        return np.array([-s, s, 0.0]) if self.three_d is False else np.array([0.0, -s, s])
+    def _axis_dirs(self, Js):
+        """Unit joint axes (3, n): ω_i for revolute, v_i for prismatic joints (columns of J_s)."""
+        A = np.where(np.array([k == "R" for k in self.kinds])[None, :], Js[:3], Js[3:])
+        return A / np.maximum(np.linalg.norm(A, axis=0), 1e-12)
 
     def _rails(self, sk, Js):
         h = 0.12 * self.scale
@@ -550,7 +647,7 @@ class ChainArtist:
         return segs
 
     def _axis_segments(self, sk, Js):
-        h = 0.35 * self.scale
+        h = self.AXIS_HALF * self.scale
         segs = []
         for i, k in enumerate(self.kinds):
             if k == "R" and not self.three_d:
@@ -561,12 +658,88 @@ class ChainArtist:
             segs.append([p - h * a, p + h * a])
         return segs
 
+    def extent_points(self) -> np.ndarray:
+        """Every point the drawing reaches (3, k): skeleton, frame-arrow tips, ends of the joint axes."""
+        sk, T, Js = self._geom
+        pts = [sk]
+        L = self.FRAME * self.scale
+        if self.frame_s is not None:
+            pts += [np.eye(3) * L, T[:3, 3:4] + T[:3, :3] * L]
+        h = (self.AXIS_HALF + 0.12) * self.scale
+        A = self._axis_dirs(Js)
+        if self.three_d or self.pri:
+            for i, k in enumerate(self.kinds):
+                if k == "P" or self.three_d:
+                    pts.append(sk[:, [i + 1, i + 1]] + np.outer(A[:, i], [h, -h]))
+        if not self.three_d:  # room for the labels beside the joints
+            r = 0.2 * self.scale
+            pts.append(np.hstack([sk[:, 1:-1] + np.array([[r], [r], [0]]), sk[:, 1:-1] - np.array([[r], [r], [0]])]))
+        return np.hstack(pts)
+
+    # -- labels ---------------------------------------------------------------------------------------
+    def place_labels(self):
+        """Put θ1…θn, {s} and {b} where they overlap neither each other nor the links (in screen space).
+
+        Candidates per joint, in order of preference: the two ends of its drawn axis (3-D, prismatic), then
+        directions around the joint; the first candidate far enough from the labels already placed and
+        from the drawing wins (else the one with the most room). Moves the Text artists only."""
+        if not self.labels and not self.frame_texts:
+            return
+        sk, T, Js = self._geom
+        ax = self.ax
+        A = self._axis_dirs(Js)
+        h = (self.AXIS_HALF + 0.08) * self.scale
+        px = self.fontsize * ax.figure.dpi / 72.0               # the font size in pixels
+        per_px = _data_per_pixel(ax)
+        r = min(2.2 * px * per_px, 0.3 * self.scale)             # beside a joint: about two font sizes
+        dirs = _DIRS3 if self.three_d else _DIRS2
+        items = []  # (text, candidate points (3, m))
+        for i, t in enumerate(self.labels):
+            p = sk[:, i + 1:i + 2]
+            cands = []
+            if self.three_d or self.kinds[i] == "P":
+                a = A[:, i:i + 1]
+                cands += [p + h * a, p - h * a, p + 1.45 * h * a, p - 1.45 * h * a]
+            cands += [p + r * dirs.T, p + 1.6 * r * dirs.T]
+            items.append((t, np.hstack(cands)))
+        if self.frame_texts:
+            fd = np.vstack([-dirs[0], -dirs[1:]]) if not self.three_d else dirs[::-1]
+            ring = np.hstack([0.8 * r * fd.T, 1.3 * r * fd.T, 1.9 * r * fd.T])
+            items.append((self.frame_texts[0], ring))
+            items.append((self.frame_texts[1], T[:3, 3:4] + ring))
+        L = self.FRAME * self.scale
+        obstacles = [_segment_samples(sk)]
+        if self.frame_s is not None:
+            t = np.linspace(0.3, 1.0, 5)
+            for o, R in ((np.zeros((3, 1)), np.eye(3)), (T[:3, 3:4], T[:3, :3])):
+                for k in range(3 if self.three_d else 2):
+                    obstacles.append(o + L * np.outer(R[:, k], t))
+        for a, b in (self._rails(sk, Js) + (self._axis_segments(sk, Js) if self.axes_lines is not None else [])):
+            obstacles.append(_segment_samples(np.column_stack([a, b]), 9))
+        view = getattr(ax, "_kinlib_view", None)
+        if view is not None and view.get("chain") is self:
+            obstacles.append(view["obstacles"])
+        O = _to_pixels(ax, np.hstack(obstacles))
+        px = self.fontsize * ax.figure.dpi / 72.0
+        need_lab, need_obs = 2.0 * px, 1.4 * px
+        placed = np.zeros((0, 2))
+        for t, C in items:
+            Cp = _to_pixels(ax, C)
+            d_obs = np.min(np.linalg.norm(Cp[:, None, :] - O[None, :, :], axis=2), axis=1)
+            d_lab = (np.min(np.linalg.norm(Cp[:, None, :] - placed[None, :, :], axis=2), axis=1)
+                     if len(placed) else np.full(len(Cp), np.inf))
+            ok = np.flatnonzero((d_lab >= need_lab) & (d_obs >= need_obs))
+            k = int(ok[0]) if ok.size else int(np.argmax(np.minimum(d_lab, 2.0 * d_obs)))
+            _move_text(t, C[:, k])
+            placed = np.vstack([placed, Cp[k]])
+
     # -- update ---------------------------------------------------------------------------------------
     def update(self, q):
         """Move every artist to configuration q (no artist is re-created)."""
         q = _as_q(self.chain, q)
         self.q = q
         sk, T, Js = self._kin(q)
+        self._geom = (sk, T, Js)
         _set_line(self.links, sk)
         _set_line(self.tool, sk[:, -1:])
         rp = sk[:, [i + 1 for i in self.rev]]
@@ -579,11 +752,9 @@ class ChainArtist:
             _set_segs(self.axes_lines, self._axis_segments(sk, Js), self.three_d)
         if self.frame_b is not None:
             d = 3 if self.three_d else 2
-            L = 0.22 * self.scale
+            L = self.FRAME * self.scale
             self.frame_b.set(np.tile(T[:d, 3], (d, 1)), (T[:d, :d] * L).T)
-            _move_text(self.frame_texts[1], T[:3, 3] + self._label_offset())
-        for i, t in enumerate(self.labels):
-            _move_text(t, sk[:, i + 1] + self._label_offset(i))
+        self.place_labels()
         return self
 
     @property
@@ -592,7 +763,7 @@ class ChainArtist:
         out = [self.links, self.revolute, self.tool]
         out += [a for a in (self.revolute_dot, self.prismatic, self.axes_lines) if a is not None]
         if self.frame_b is not None:
-            out += [self.frame_b.artist, self.frame_texts[1]]
+            out += [self.frame_b.artist, *self.frame_texts]
         return out + list(self.labels)
 
     @property
@@ -602,18 +773,25 @@ class ChainArtist:
 
 
 def draw_chain(chain, q=None, ax=None, *, planar=None, frames=True, axes=True, labels=True, params=None,
-               ranges=None, limits=None, color="0.25", title=None, figsize=None) -> ChainArtist:
+               ranges=None, limits=None, view=None, color="0.25", title=None, figsize=None,
+               fontsize=9) -> ChainArtist:
     """Draw ``chain`` at the numeric configuration ``q`` (zeros by default) and return a :class:`ChainArtist`.
 
     Links join ``chain.skeleton(q)`` (base, joint points, tool origin); revolute joints are circles
     (⊙ in 2-D: the axis leaves the page), prismatic joints grey rails along their axis v_i; ``axes``
     adds the current joint axes (dashed, from the columns of J_s(θ)); ``frames`` the space frame {s}
-    and the tool frame {b} = T(θ) with x (red), y (green), z (blue) arrows; ``labels`` θ1…θn.
+    and the tool frame {b} = T(θ) with x (red), y (green), z (blue) arrows; ``labels`` θ1…θn (placed
+    clear of each other and of the links; ``fontsize``).
 
     ``planar``: 2-D drawing (the xy-plane) when True; default: 2-D exactly when :func:`is_planar`.
     ``params``: numbers for symbolic link lengths (``{"L": 1}``); without them a chain with symbolic
-    parameters raises ValueError. ``ranges``: joint ranges used to size the view (see
-    :func:`default_ranges`); ``limits``: explicit view box [[xmin, xmax], [ymin, ymax](, [zmin, zmax])].
+    parameters raises ValueError.
+
+    The view has equal scales on all axes (lengths and angles look right) and is fitted to
+    ``view="pose"``: what is drawn now (the default; arrows drawn later with :func:`draw_velocity` & co.
+    enlarge it), or ``view="workspace"``: every pose in the joint ranges (the default when ``ranges`` is
+    given, e.g. for sliders: the arm never leaves the picture). ``ranges``: joint ranges (see
+    :func:`default_ranges`); ``limits``: an explicit box [[xmin, xmax], [ymin, ymax](, [zmin, zmax])].
     """
     chain = numeric_chain(chain, params)
     q = _as_q(chain, q)
@@ -621,40 +799,54 @@ def draw_chain(chain, q=None, ax=None, *, planar=None, frames=True, axes=True, l
         planar = not _is3d(ax)
     if planar is None:
         planar = is_planar(chain)
+    if view is None:
+        view = "workspace" if ranges is not None else "pose"
+    if view not in ("pose", "workspace"):
+        raise ValueError(f"view must be 'pose' or 'workspace', got {view!r}")
     ax = new_axes(planar, ax, figsize)
     if planar == _is3d(ax):
         raise ValueError(f"ax is a {'3-D' if _is3d(ax) else '2-D'} axes but planar={planar}")
+    if not planar:
+        ax.computed_zorder = False  # keep the labels above the links and markers (zorder, not depth, decides)
     rngs = default_ranges(chain, ranges)
-    box, size = _workspace_limits(chain, rngs, q)
+    W = _workspace_points(chain, rngs, q)
+    size = float(np.max(W.max(axis=1) - W.min(axis=1)))
     scale = max(_reach(chain), 1e-6)
     scale = min(scale, size) if size > 0 else scale
     art = ChainArtist(ax, chain, q, planar=planar, frames=frames, axes=axes, labels=labels, color=color,
-                      scale=scale)
-    lim = np.asarray(limits, float) if limits is not None else box
-    if planar:
-        if limits is None:  # a square view, so that equal aspect needs no change of limits
-            c = box[:2].mean(axis=1)
-            h = 0.5 * float(np.max(box[:2, 1] - box[:2, 0]))
-            lim = np.stack([c - h, c + h], axis=1)
+                      scale=scale, fontsize=fontsize)
+    if limits is not None:
+        lim = np.asarray(limits, float)
+        if lim.shape != ((2, 2) if planar else (3, 2)):
+            raise ValueError(f"limits must be {'[[xmin, xmax], [ymin, ymax]]' if planar else '[[xmin, xmax], [ymin, ymax], [zmin, zmax]]'}, "
+                             f"got {describe(limits)}")
         ax.set_xlim(*lim[0])
         ax.set_ylim(*lim[1])
-        ax.set_aspect("equal", adjustable="box")
+        if planar:
+            ax.set_aspect("equal", adjustable="box")
+        else:
+            ax.set_zlim(*lim[2])
+            ax.set_box_aspect(tuple(lim[:, 1] - lim[:, 0]), zoom=0.95)
+        ax._kinlib_view = {"fit": False, "points": None, "margin": 0.0, "obstacles": np.zeros((3, 0)), "chain": art}
+    else:
+        pts = art.extent_points() if view == "pose" else np.hstack([W, art.extent_points()])
+        margin = 0.06 if view == "pose" else 0.03
+        _fit_view(ax, pts, margin)
+        ax._kinlib_view = {"fit": True, "points": pts, "margin": margin, "obstacles": np.zeros((3, 0)), "chain": art}
+    if planar:
         ax.set_xlabel("x_s")
         ax.set_ylabel("y_s")
         ax.grid(True, lw=0.4, alpha=0.5)
     else:
-        if limits is None:  # a cube around the workspace box, so that lengths look right
-            c = box.mean(axis=1)
-            h = 0.5 * float(np.max(box[:, 1] - box[:, 0]))
-            lim = np.stack([c - h, c + h], axis=1)
-        ax.set_xlim(*lim[0])
-        ax.set_ylim(*lim[1])
-        ax.set_zlim(*lim[2])
-        ax.set_box_aspect((1, 1, 1))
-        ax.set_xlabel("x_s")
-        ax.set_ylabel("y_s")
-        ax.set_zlabel("z_s")
+        from matplotlib.ticker import MaxNLocator
+        for axis in (ax.xaxis, ax.yaxis, ax.zaxis):
+            axis.set_major_locator(MaxNLocator(4))
+        ax.tick_params(labelsize=7, pad=0)
+        ax.set_xlabel("x_s", labelpad=-2)
+        ax.set_ylabel("y_s", labelpad=-2)
+        ax.set_zlabel("z_s", labelpad=-2)
     ax.set_title(title if title is not None else chain.name)
+    art.place_labels()
     return art
 
 
@@ -669,46 +861,43 @@ def _fmt_vec(v) -> str:
 
 def draw_home(chain, ax=None, *, params=None, annotate=True, frames=True, title=None, figsize=None,
               fontsize=8) -> ChainArtist:
-    """The chain at home (θ = 0) with each joint's axis drawn and labelled from its screw axis S_i:
-    revolute ``θi: ω=(…), q=(…)``, prismatic ``θi: v=(…)``, in the chain's own symbols when it has
-    symbolic link lengths (``params`` gives the numbers used for the drawing itself)."""
+    """The chain at home (θ = 0), its joint axes drawn and labelled θ1…θn, and beside the picture each
+    joint's screw axis S_i: revolute ``θi: ω=(…), q=(…)`` (axis direction and a point on it), prismatic
+    ``θi: v=(…)``, in the chain's own symbols when it has symbolic link lengths (``params`` gives the
+    numbers used for the drawing itself). The screw-axis texts are ``.annotations`` of the result."""
     sym_chain = _check_chain(chain)
     num = numeric_chain(sym_chain, params)
     n = num.n
-    # a view fitted to the home pose (and its joint-axis marks), not to the whole workspace
-    sk = num.skeleton(np.zeros(n))
-    reach = _reach(num)
-    lo, hi = sk.min(axis=1) - 0.45 * reach, sk.max(axis=1) + 0.45 * reach
-    planar = is_planar(num) if ax is None else not _is3d(ax)
-    c, h = 0.5 * (lo + hi), 0.5 * float(np.max((hi - lo)[:2] if planar else hi - lo))
-    limits = np.stack([c - h, c + h], axis=1)[: 2 if planar else 3]
-    art = draw_chain(num, np.zeros(n), ax, frames=frames, axes=True, labels=not annotate, limits=limits,
+    own_figure = ax is None
+    if own_figure and figsize is None:
+        figsize = (9, 5) if is_planar(num) else (9.5, 6)
+    art = draw_chain(num, np.zeros(n), ax, frames=frames, axes=True, labels=True,
                      title=title if title is not None else f"{sym_chain.name} at home (θ = 0)",
-                     figsize=figsize)
+                     figsize=figsize, fontsize=fontsize + 1)
     if annotate:
+        from matplotlib.lines import Line2D
         S = sym_chain.screws
-        placed = []
+        handles, texts = [], []
         for i, k in enumerate(sym_chain.joint_types):
             if k == "R":
-                s = f"θ{i + 1}: ω={_fmt_vec(S[:3, i])}\nq={_fmt_vec(sym_chain.joint_points[:, i])}"
+                s = f"θ{i + 1}: ω = {_fmt_vec(S[:3, i])}\n      q = {_fmt_vec(sym_chain.joint_points[:, i])}"
             else:
-                s = f"θ{i + 1}: v={_fmt_vec(S[3:, i])}"
-            sign = 1.0 if i % 2 == 0 else -1.0
-            off = np.array([0.0, sign * 0.22 * reach, 0.0]) if planar else \
-                np.array([0.0, 0.0, sign * 0.18 * reach]) + np.array([0.12 * reach, 0.0, 0.0]) * (i % 3 - 1)
-            p = sk[:, i + 1] + off
-            # keep clear of labels already placed (joints that share a point, e.g. the cart-pole's)
-            ax_k = 1 if planar else 2
-            for _ in range(len(placed)):
-                if not any(np.all(np.abs((p - o)[: 3 if not planar else 2] / np.array([0.5, 0.16, 0.16][: 3 if not planar else 2])) < reach)
-                           for o in placed):
-                    break
-                p = p.copy()
-                p[ax_k] += sign * 0.16 * reach
-            placed.append(p)
-            art.labels.append(_text(art.ax, p, s, fontsize=fontsize, color=JOINT_COLORS[i % 10], ha="center",
-                                    va="center", zorder=7,
-                                    bbox=dict(boxstyle="round,pad=0.2", fc="white", ec="none", alpha=0.75)))
+                s = f"θ{i + 1}: v = {_fmt_vec(S[3:, i])}"
+            c = JOINT_COLORS[i % 10]
+            handles.append(Line2D([], [], ls="", marker="o" if k == "R" else "s", mfc="white" if k == "R" else c,
+                                  mec=c, mew=1.8, ms=7))
+            texts.append(s)
+        leg = art.ax.legend(handles, texts, loc="center left", bbox_to_anchor=(1.02, 0.5), fontsize=fontsize,
+                            title="screw axes at θ = 0\n(revolute: axis ω through q;\n prismatic: direction v)",
+                            title_fontsize=fontsize, frameon=True, labelspacing=0.9, handletextpad=0.4,
+                            alignment="left")
+        for t, i in zip(leg.get_texts(), range(n)):
+            t.set_color(JOINT_COLORS[i % 10])
+        art.legend = leg
+        art.annotations = list(leg.get_texts())
+        if own_figure:
+            art.ax.figure.subplots_adjust(left=0.0 if not art.planar else 0.1, right=0.62)
+        art.place_labels()
     return art
 
 
@@ -736,6 +925,7 @@ class VelocityArtist:
         self.arrows = _Arrows(ax, p[None], v[None] * scale, [color], label=label, zorder=6, head=0.22,
                               width=0.014)
         self.velocity = v
+        _include(ax, p[:, None] + np.outer(scale * v, np.linspace(0.2, 1.05, 6)))
 
     def _compute(self, q, qdot):
         J = self.chain.jacobian_geometric(q)
@@ -787,11 +977,43 @@ class JointVelocitiesArtist:
         self.texts = []
         if labels:
             for k, i in enumerate(joints):
-                self.texts.append(_text(ax, self._label_pos(p, V[k] * scale), labels[k], color=colors[k],
-                                        fontsize=9, ha="center", va="center", zorder=8))
+                self.texts.append(_text(ax, p, labels[k], color=colors[k], fontsize=9, ha="center", va="center",
+                                        zorder=8))
+        _include(ax, np.hstack([p[:, None] + np.outer(scale * V[k], np.linspace(0.2, 1.25, 7))
+                                for k in range(len(joints))]))
+        self._place(p, V)
+        self._show_labels(V)
 
-    def _label_pos(self, p, v):
-        return p + 1.15 * v
+    def _place(self, p, V):
+        """Each label just beyond its arrow's tip; labels that would overlap are pushed sideways."""
+        if not self.texts:
+            return
+        ax = self.ax
+        d = len(p)
+        px = 9 * ax.figure.dpi / 72.0
+        step = 1.3 * px * _data_per_pixel(ax)
+        V = V * self.scale
+        P3 = lambda x: np.r_[x, np.zeros(3 - d)] if d == 2 else x  # noqa: E731
+        placed = []
+        for t, v in zip(self.texts, V):
+            nv = np.linalg.norm(v)
+            u = v / nv if nv > 0 else np.zeros(d)
+            w = _perp(P3(u))[:d] if nv > 0 else np.eye(d)[0]
+            base = p + v + step * u
+            best = base
+            for off in (0.0, 1.0, -1.0, 2.0, -2.0):
+                cand = base + off * step * w
+                if not placed or np.min(np.linalg.norm(_to_pixels(ax, P3(cand)[:, None])[0] - np.array(placed), axis=1)) > 1.6 * px:
+                    best = cand
+                    break
+            _move_text(t, P3(best))
+            placed.append(_to_pixels(ax, P3(best)[:, None])[0])
+
+    def _show_labels(self, V):
+        """Hide the label of an arrow too short to carry one (< 8 % of the longest): they would pile up."""
+        n = np.linalg.norm(V, axis=1)
+        for t, nk in zip(self.texts, n):
+            t.set_visible(bool(nk > 0.08 * max(n.max(), 1e-300)))
 
     def _compute(self, q):
         J = self.chain.jacobian_geometric(q)
@@ -805,8 +1027,8 @@ class JointVelocitiesArtist:
         p, V = self._compute(q)
         self.columns = V
         self.arrows.set(np.tile(p, (len(self.joints), 1)), V * self.scale)
-        for k, t in enumerate(self.texts):
-            _move_text(t, self._label_pos(p, V[k] * self.scale))
+        self._place(p, V)
+        self._show_labels(V)
         return self
 
     @property
@@ -853,6 +1075,7 @@ class EllipseArtist:
             self.fill = ax.fill(curves[0][0], curves[0][1], color=color, alpha=0.12, zorder=1)[0]
         self.axes = _segs_collection(ax, axes, colors=color, linewidths=1.0, linestyles=":", zorder=5) \
             if axes_lines else None
+        _include(ax, np.hstack(curves))
 
     def _compute(self, q):
         J = self.chain.jacobian_geometric(q)[list(self.rows)]
@@ -940,6 +1163,7 @@ def draw_ellipse(ax, center, lengths, axes, *, color="tab:green", label=None, sc
     if axes_lines:
         segs = [[np.r_[c - A[:, k], [0.0] * (3 - d)], np.r_[c + A[:, k], [0.0] * (3 - d)]] for k in range(d)]
         out.append(_segs_collection(ax, segs, colors=color, linewidths=1.0, linestyles=":", zorder=5))
+    _include(ax, np.column_stack([c[:, None] + A, c[:, None] - A]))
     return out
 
 
@@ -1038,6 +1262,8 @@ def draw_directions(ax, origin, vectors, labels=None, *, colors=None, components
                 out.append(_Arrows(ax, o[None], -v[None], [c], linestyle=ls, lw=lw, zorder=7).artist)
             if lab:
                 out.append(_text(ax, o + 1.12 * v, lab, color=c, fontsize=fontsize))
+    ends = [o + 1.2 * v for v in vecs] + ([o - v for v in vecs] if both_ways else []) + [o]
+    _include(ax, np.column_stack(ends))
     return out
 
 

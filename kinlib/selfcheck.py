@@ -26,7 +26,6 @@ import hashlib
 import json
 import math
 import sys
-from typing import Any
 
 import numpy as np
 import sympy as sp

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 import kinlib
 from kinlib import robots
 
-from conftest import FAST, assert_no_floats, assert_sym_equal
+from helpers import FAST, assert_no_floats, assert_sym_equal
 
 METHODS = ("fk", "jacobian_space", "jacobian_body", "jacobian_geometric", "skeleton")
 

@@ -17,7 +17,7 @@ from hypothesis import strategies as st
 import kinlib
 from kinlib import robots
 
-from conftest import FAST, assert_sym_equal, random_arm, random_thetas
+from helpers import FAST, assert_sym_equal, random_arm, random_thetas
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 njoints = st.integers(min_value=1, max_value=7)

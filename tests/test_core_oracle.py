@@ -15,7 +15,7 @@ import sympy as sp
 import kinlib
 from kinlib import robots
 
-from conftest import random_arm, random_thetas
+from helpers import random_arm, random_thetas
 
 TOL = 1e-9
 SEEDS = range(6)

@@ -20,7 +20,7 @@ import sympy as sp
 import kinlib
 from kinlib import robots
 
-from conftest import assert_no_floats, assert_sym_equal
+from helpers import assert_no_floats, assert_sym_equal
 
 sin, cos, sqrt, pi = sp.sin, sp.cos, sp.sqrt, sp.pi
 
@@ -276,7 +276,7 @@ def test_planar_rpp_eq54():
 # the equality helper itself: it must prove true identities and reject false ones
 # --------------------------------------------------------------------------------------------
 def test_assert_sym_equal_helper():
-    from conftest import _is_zero_exact
+    from helpers import _is_zero_exact
     a, b = sp.symbols("a b", real=True)
     assert _is_zero_exact(sin(a + b) - sin(a) * cos(b) - cos(a) * sin(b))
     assert _is_zero_exact(sin(a) ** 2 + cos(a) ** 2 - 1)

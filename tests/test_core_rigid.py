@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 import kinlib
 
-from conftest import FAST, assert_no_floats, assert_sym_equal, random_arm, random_transform
+from helpers import FAST, assert_no_floats, assert_sym_equal, random_arm, random_transform
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
 angles = st.floats(min_value=-10.0, max_value=10.0, allow_nan=False, allow_infinity=False)

@@ -6,7 +6,7 @@ import pytest
 import sympy as sp
 
 from kinlib import robots
-from kinlib.display import simplify_for_display
+from kinlib.display import is_identically_zero, simplify_for_display
 
 
 def _num(M, subs):
@@ -70,3 +70,106 @@ def test_expression_and_errors():
         simplify_for_display("sin(x)")
     with pytest.raises(TypeError, match="M must be"):
         simplify_for_display([1, 2])
+
+
+# ------------------------------------------------------------------------------------------------
+# phase_shifts=True: the printed solutions' √2 cos(x + π/4) form, still exactly equal
+# ------------------------------------------------------------------------------------------------
+def test_phase_shifts_printed_form():
+    chain = robots.planar_offset_3r()
+    L = chain.params[0]
+    t1, t2, t3 = chain.thetas
+    T = chain.fk()
+    D = simplify_for_display(T, phase_shifts=True)
+    # problem set eq. (17): p_x = L c123 + L c1 + √2 L cos(θ1 + θ2 + π/4)
+    assert sp.expand(D[0, 3] - L * (sp.cos(t1 + t2 + t3) + sp.cos(t1) + sp.sqrt(2) * sp.cos(t1 + t2 + sp.pi / 4))) == 0
+    assert is_identically_zero(D - T)
+    Jb = simplify_for_display(chain.jacobian_body(), phase_shifts=True)
+    assert Jb[3, 1] == -sp.sqrt(2) * L * sp.cos(t3 + sp.pi / 4)                 # eq. (20)
+    for seed in range(2):
+        s = _random_subs(chain, seed)
+        assert np.allclose(_num(Jb, s), _num(chain.jacobian_body(), s), atol=1e-12, rtol=0)
+    assert not simplify_for_display(T).has(sp.sqrt(2))                        # default: no phase shifts
+
+
+# ------------------------------------------------------------------------------------------------
+# is_identically_zero: exact identity test
+# ------------------------------------------------------------------------------------------------
+x, y, z = sp.symbols("x y z", real=True)
+
+
+@pytest.mark.parametrize("expr", [
+    sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1,
+    sp.sin(x + y) - sp.sin(x) * sp.cos(y) - sp.cos(x) * sp.sin(y),
+    sp.cos(2 * x) - sp.cos(x) ** 4 + sp.sin(x) ** 4,
+    sp.sin(x) ** 2 - sp.sin(x) ** 4 - sp.sin(x) ** 2 * sp.cos(x) ** 2,
+    sp.sqrt(2) * sp.cos(x + sp.pi / 4) - sp.cos(x) + sp.sin(x),
+    1 / (z * (z + 1)) - 1 / z + 1 / (z + 1),
+    sp.tan(x) - sp.sin(x) / sp.cos(x),
+    sp.Integer(0),
+])
+def test_identities_are_zero(expr):
+    assert is_identically_zero(expr) is True
+
+
+@pytest.mark.parametrize("expr", [
+    sp.sin(x),
+    sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1 + sp.Rational(1, 10**12),   # numerically ~0, exactly not
+    sp.sin(x + y) - sp.sin(x) * sp.cos(y) + sp.cos(x) * sp.sin(y),
+    sp.sqrt(2) * sp.cos(x + sp.pi / 4) - sp.cos(x) - sp.sin(x),
+    z * sp.sin(x) ** 2 + z * sp.cos(x) ** 2,
+    sp.Integer(3),
+])
+def test_nonzero_is_not_zero(expr):
+    assert is_identically_zero(expr) is False
+    # independent: the expression is nonzero at some point (exact rational evaluation, 50 digits)
+    vals = [sp.N(expr.subs({x: sp.Rational(a, 7), y: sp.Rational(b, 5), z: sp.Rational(3, 2)}), 50)
+            for a, b in [(1, 2), (3, -4), (-5, 1), (2, 9)]]
+    assert any(abs(v) > 1e-40 for v in vals)
+
+
+def test_body_jacobian_is_adjoint_of_space_jacobian():
+    """J_b = Ad_{T⁻¹} J_s exactly, for the symbolic robots (the difference is a large trig polynomial)."""
+    import kinlib
+    for chain in (robots.planar_offset_3r(), robots.spatial_rppr(), robots.ur5()):
+        Js, Jb, T = chain.jacobian_space(), chain.jacobian_body(), chain.fk()
+        gap = Jb - kinlib.adjoint(kinlib.trans_inv(T)) * Js
+        assert not all(e == 0 for e in gap)       # not trivially zero as written
+        assert is_identically_zero(gap)
+        assert not is_identically_zero(Jb - Js)   # J_b ≠ J_s: the test does not say yes to everything
+
+
+def test_time_functions_and_derivatives():
+    """The 1.2 derivation: θ_i(t) and θ̇_i are variables too (chain rule for e^{[S]θ(t)})."""
+    import kinlib
+    t = sp.Symbol("t", real=True)
+    q = sp.Function("theta1", real=True)(t)
+    S = kinlib.screw_revolute(sp.Matrix([0, 1, 0]), sp.Matrix([1, 0, 2]))
+    E = kinlib.exp6(S, q)
+    assert is_identically_zero(E.diff(t) - kinlib.bracket(S) * q.diff(t) * E)
+    assert not is_identically_zero(E.diff(t) - kinlib.bracket(S) * E)
+
+
+def test_agrees_with_simplify_on_random_trig_polynomials():
+    rng = random.Random(7)
+    atoms = [sp.sin(x), sp.cos(x), sp.sin(y), sp.cos(y), z]
+    for _ in range(25):
+        e = sum(rng.randint(-2, 2) * sp.Mul(*rng.choices(atoms, k=rng.randint(0, 3))) for _ in range(4))
+        ident = e * (sp.sin(x) ** 2 + sp.cos(x) ** 2) - e          # ≡ 0
+        assert is_identically_zero(ident)
+        assert is_identically_zero(e) == (sp.simplify(e) == 0)
+
+
+def test_accepts_scalars_matrices_and_lists():
+    assert is_identically_zero(0) and is_identically_zero(0.0) and not is_identically_zero(1)
+    assert is_identically_zero(sp.zeros(2, 3))
+    assert is_identically_zero(sp.Matrix([[sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1, 0]]))
+    assert not is_identically_zero(sp.Matrix([[0, 0], [0, sp.cos(x)]]))
+    assert is_identically_zero([[sp.cos(x) ** 2 - 1 + sp.sin(x) ** 2], [0]])
+    assert is_identically_zero(np.zeros((2, 2)))
+
+
+@pytest.mark.parametrize("bad", ["sin(x)**2 + cos(x)**2 - 1", None, {"a": 1}, ["x", 0], True, sp.Eq(x, x)])
+def test_bad_input(bad):
+    with pytest.raises(TypeError, match="M must"):
+        is_identically_zero(bad)

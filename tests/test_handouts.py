@@ -9,7 +9,6 @@ from __future__ import annotations
 import ast
 import copy
 import re
-import shutil
 from pathlib import Path
 
 import nbformat
@@ -242,6 +241,7 @@ def test_workbook_is_a_valid_student_notebook(built):
     assert len(checks) == 4                                           # 3 check cells + 1.2 without one
     assert all("check(" in c.source for c in checks)
     assert not [c for c in wb.cells if "check" in c.metadata.get("tags", [])]
+    assert "LEAK-NARRATIVE" not in text
     assert any(c.source.startswith("%%needs Js") for c in wb.cells)
 
 
@@ -344,3 +344,20 @@ def test_real_notebooks_have_the_structure(path):
     for g in handouts.answer_groups(nb):
         for part, name, kind, _ in g.answers:
             assert part and name.isidentifier() and kind in selfcheck.KINDS, (part, name, kind)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("stem", [p.stem for p in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))])
+def test_real_workbook_with_the_solutions_passes(stem, tmp_path):
+    """The real workbook, with the notebook's solution cells pasted back, passes every self-check."""
+    source = nbformat.read(ROOT / "notebooks" / f"{stem}.ipynb", as_version=4)
+    executed, groups, fps = handouts.execute_notebook(ROOT / "notebooks" / f"{stem}.ipynb")
+    wb = handouts.make_workbook(source, groups, fps)
+    nbformat.validate(wb)
+    p = tmp_path / f"{stem}.ipynb"
+    nbformat.write(_paste_solutions(wb, source), p)
+    lines = _selfcheck_lines(handouts.run_workbook(p))
+    n_answers = sum(len(g.answers) for g in groups)
+    assert len(lines) == n_answers
+    bad = [ln for ln in lines if "✓ correct" not in ln and "no automatic self-check" not in ln]
+    assert not bad, bad

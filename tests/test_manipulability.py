@@ -13,7 +13,7 @@ from kinlib.manipulability import (
 )
 from kinlib.singularities import evaluate_at, task_rows
 
-from conftest import assert_sym_equal
+from helpers import assert_sym_equal
 
 pi = sp.pi
 

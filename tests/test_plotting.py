@@ -172,12 +172,85 @@ def test_not_a_chain():
 
 def test_draw_home_annotates_screw_axes():
     art = P.draw_home(robots.planar_offset_3r(), params={"L": 1})
-    texts = [t.get_text() for t in art.labels]
-    assert any("q=(2·L, L, 0)" in t for t in texts), texts
+    texts = [t.get_text() for t in art.annotations]
+    assert any("q = (2·L, L, 0)" in t for t in texts), texts
+    assert [t.get_text() for t in art.labels] == [r"$\theta_{1}$", r"$\theta_{2}$", r"$\theta_{3}$"]
     art3 = P.draw_home(robots.spatial_rppr(), params={"L1": 1, "L2": 1})
-    texts = [t.get_text() for t in art3.labels]
-    assert any("v=(0, 0, 1)" in t for t in texts) and any("L1 + L2" in t for t in texts), texts
+    texts = [t.get_text() for t in art3.annotations]
+    assert any("v = (0, 0, 1)" in t for t in texts) and any("L1 + L2" in t for t in texts), texts
+    # the screw axes come from the chain itself: θ4 is the revolute joint about x through (L2, 0, L1 + L2)
+    assert texts[3].startswith("θ4: ω = (1, 0, 0)")
     art3.ax.figure.canvas.draw()
+
+
+def _label_pixels(art):
+    art.ax.figure.canvas.draw()
+    texts = [t for t in art.labels + art.frame_texts]
+    if hasattr(art.ax, "get_zlim"):  # a 3-D text's anchor, through matplotlib's own projection
+        from mpl_toolkits.mplot3d import proj3d
+        X = np.array([t.get_position_3d() for t in texts]).T
+        x, y, _ = proj3d.proj_transform(X[0], X[1], X[2], art.ax.get_proj())
+        return art.ax.transData.transform(np.column_stack([x, y])), texts
+    return np.array([t.get_window_extent().get_points().mean(axis=0) for t in texts]), texts
+
+
+@pytest.mark.parametrize("name", list(ROBOTS))
+@pytest.mark.parametrize("home", [True, False])
+def test_labels_do_not_overlap(chains, name, home):
+    """θ1…θn, {s} and {b} keep at least about a font size apart on screen (the UR5's joints 1, 2 and
+    joints 5, 6 nearly coincide; the RPPR's joints 1, 2 share the z axis)."""
+    chain = chains[name]
+    art = P.draw_home(chain) if home else P.draw_chain(chain, q_of(chain, 3))
+    xy, texts = _label_pixels(art)
+    px = art.fontsize * art.ax.figure.dpi / 72
+    d = np.linalg.norm(xy[:, None] - xy[None], axis=2) + np.eye(len(xy)) * 1e9
+    assert d.min() > 1.2 * px, [t.get_text() for t in texts]
+    # every label is inside the view
+    box = art.ax.get_window_extent()
+    assert all(box.x0 <= x <= box.x1 and box.y0 <= y <= box.y1 for x, y in xy)
+
+
+@pytest.mark.parametrize("name", ["spatial_rppr", "ur5"])
+def test_3d_view_is_tight_and_equal_aspect(chains, name):
+    chain = chains[name]
+    q = q_of(chain, 5)
+    art = P.draw_chain(chain, q)
+    ax = art.ax
+    lims = np.array([ax.get_xlim(), ax.get_ylim(), ax.get_zlim()])
+    sides = lims[:, 1] - lims[:, 0]
+    # equal scale on every axis: the drawn box has the proportions of the data box
+    np.testing.assert_allclose(np.array(ax.get_box_aspect()) / np.max(ax.get_box_aspect()), sides / sides.max(),
+                               rtol=1e-9)
+    # the whole skeleton is inside, and the box is not much larger than the drawing (frames, axes, margin)
+    sk = chain.skeleton(q)
+    assert np.all(sk >= lims[:, :1] - 1e-12) and np.all(sk <= lims[:, 1:] + 1e-12)
+    extent = sk.max(axis=1) - sk.min(axis=1)
+    assert sides.max() < extent.max() + 2.2 * art.scale
+    # the workspace view (used with sliders) holds every pose in the joint ranges
+    ws = P.draw_chain(chain, q, view="workspace").ax
+    wl = np.array([ws.get_xlim(), ws.get_ylim(), ws.get_zlim()])
+    Q = np.random.default_rng(11).uniform(-np.pi, np.pi, (200, chain.n))
+    Q[:, [i for i, k in enumerate(chain.joint_types) if k == "P"]] *= 0.1
+    pts = np.moveaxis(chain.skeleton(Q), 1, 0).reshape(3, -1)
+    assert np.all(pts >= wl[:, :1] - 0.05) and np.all(pts <= wl[:, 1:] + 0.05)
+
+
+def test_arrows_drawn_later_stay_in_view():
+    chain = robots.planar_offset_3r(1)
+    q = [np.pi / 6, -np.pi / 4, np.pi / 3]
+    art = P.draw_chain(chain, q)
+    v = P.draw_velocity(art.ax, chain, q, [3.0, 2.0, 1.0])
+    tip = art.tool_position[:2] + v.velocity
+    (x0, x1), (y0, y1) = art.ax.get_xlim(), art.ax.get_ylim()
+    assert x0 < tip[0] < x1 and y0 < tip[1] < y1
+    # explicit limits are respected
+    art = P.draw_chain(chain, q, limits=[[-1, 1], [-1, 1]])
+    P.draw_velocity(art.ax, chain, q, [3.0, 2.0, 1.0])
+    assert art.ax.get_xlim() == (-1, 1)
+    with pytest.raises(ValueError, match="view must be"):
+        P.draw_chain(chain, q, view="tight")
+    with pytest.raises(ValueError, match="limits must be"):
+        P.draw_chain(chain, q, limits=[[-1, 1]])
 
 
 # --- velocities ----------------------------------------------------------------------------------

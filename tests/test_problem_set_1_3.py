@@ -31,7 +31,7 @@ import sympy as sp  # noqa: E402
 
 import kinlib  # noqa: E402
 
-from conftest import assert_sym_equal  # noqa: E402
+from helpers import assert_sym_equal  # noqa: E402
 
 NB_DIR = pathlib.Path(__file__).resolve().parents[1] / "notebooks"
 NOTEBOOKS = {
