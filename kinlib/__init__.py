@@ -19,7 +19,7 @@ from .singularities import column_space, left_null_space, rank_at, singular_conf
 from .manipulability import (
     condition_number, isotropy, manipulability, twist_speed_form, velocity_ellipsoid,
 )
-from .display import simplify_for_display
+from .display import is_identically_zero, simplify_for_display
 from . import robots
 
 __version__ = "0.1.0"
@@ -33,5 +33,5 @@ __all__ = [
     "linear_first", "angular_first", "position_jacobian", "robots",
     "task_rows", "singular_configurations", "rank_at", "column_space", "left_null_space",
     "manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
-    "simplify_for_display",
+    "simplify_for_display", "is_identically_zero",
 ]

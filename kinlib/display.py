@@ -25,7 +25,6 @@ import numbers
 from typing import Any
 
 import numpy as np
-
 import sympy as sp
 from sympy.simplify.fu import TR10i
 
@@ -245,13 +244,14 @@ def is_identically_zero(M: Any) -> bool:
        ring; the entry is identically zero exactly when the remainder is 0.
 
     Why exact: the relations s_i² + c_i² − 1 involve distinct variables, so they form a Gröbner basis and the
-    remainder is the *unique* normal form, linear in each s_i; a nonzero polynomial of that form does not
-    vanish on the circles s_i² + c_i² = 1 (for fixed other values, it is a nonzero trig polynomial in θ_i).
-    So for polynomials in sines and cosines (every product-of-exponentials FK and Jacobian entry, and any
-    difference of two of them) the answer is True if and only if the entry is identically zero.
-    Floats count at their exact binary values. Rational functions are tested through their numerator; other forms (square roots of symbols,
-    exponentials, angles θ/2) fall back to writing sin, cos with exponentials and expanding, where True is still
-    a proof but False may mean "not shown".
+    remainder is the *unique* normal form, of degree ≤ 1 in each s_i; the functions cosᵏθ and sin θ cosᵏθ are
+    linearly independent, so a nonzero normal form is a nonzero function of the angles. Hence, for
+    polynomials in sines and cosines (every product-of-exponentials FK and Jacobian entry, and any
+    difference of two of them) the answer is True if and only if the entry is identically zero
+    (θ_i(t) and θ̇_i count as independent variables, as they are at any one instant).
+    Floats count at their exact binary values. Rational functions are tested through their numerator.
+    Other forms (square roots of symbols, exponentials, half angles θ/2) fall back to writing sin and cos
+    with exponentials and expanding: there True is still a proof, but False may mean "not shown".
 
     Much faster than ``sp.simplify(e) == 0``: no trigsimp, and no SymPy ``expand`` of large products.
     """

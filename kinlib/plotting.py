@@ -18,8 +18,12 @@ existing matplotlib artists (no re-creation), so a slider can redraw quickly.
 Functions (each returns an object to update or inspect):
 
 * ``draw_chain(chain, q, ax=None, *, planar=None, frames=True, axes=True, labels=True, params=None,
-  ranges=None, limits=None, ...)`` → :class:`ChainArtist` (``.update(q)``, ``.tool_position``, ``.artists``);
-  ``draw_home(chain, ...)``: θ = 0 with each joint's screw axis written next to it (symbols kept);
+  ranges=None, limits=None, view=None, ...)`` → :class:`ChainArtist` (``.update(q)``, ``.tool_position``,
+  ``.artists``). The view has equal scales on every axis and fits the pose (``view="pose"``, default) or
+  every pose in the joint ranges (``view="workspace"``, default when ``ranges`` is given, for sliders);
+  arrows drawn later by the functions below enlarge an automatic view. The labels θ1…θn, {s}, {b} are
+  placed where they overlap neither each other nor the drawing (3-D: at the ends of the joint axes);
+  ``draw_home(chain, ...)``: θ = 0 with each joint's screw axis listed beside the picture (symbols kept);
 * ``draw_velocity(ax, chain, q, qdot, *, rows=None, scale=1)`` → :class:`VelocityArtist` (``.velocity`` = ṗ);
   ``draw_joint_velocities(ax, chain, q, *, rows=None, joints=None, scale=1)`` → :class:`JointVelocitiesArtist`;
 * ``draw_velocity_ellipse(ax, chain, q, *, rows=None, scale=1)`` → :class:`EllipseArtist` (``.semi_axes``);
@@ -459,16 +463,6 @@ def _set_segs(c, segs, three_d):
 # ---------------------------------------------------------------------------------------------------
 # the chain
 # ---------------------------------------------------------------------------------------------------
-def _workspace_limits(chain, ranges, q=None, pad=0.12):
-    """Bounding box (3, 2) of the skeleton over a deterministic sample of the joint ranges."""
-    P = _workspace_points(chain, ranges, q)
-    box = np.stack([P.min(axis=1), P.max(axis=1)], axis=1)
-    size = float(np.max(box[:, 1] - box[:, 0]))
-    box[:, 0] -= pad * size
-    box[:, 1] += pad * size
-    return box, size
-
-
 def _workspace_points(chain, ranges, q=None, samples=400):
     """The skeleton points (3, N·(n+2)) of a deterministic sample of the joint ranges (and home, q)."""
     rng = np.random.default_rng(0)
@@ -537,6 +531,17 @@ def _to_pixels(ax, P):
         x, y, _ = proj3d.proj_transform(P[0], P[1], P[2], ax.get_proj())
         return ax.transData.transform(np.column_stack([x, y]))
     return ax.transData.transform(P[:2].T)
+
+
+def _pick(Cp, O, placed, need_lab, need_obs) -> int:
+    """Index of the first candidate (pixels, (m, 2)) at least need_lab from the labels already placed and
+    need_obs from the obstacles O (pixels, (k, 2)); else the candidate with the most room."""
+    d_obs = (np.min(np.linalg.norm(Cp[:, None, :] - O[None, :, :], axis=2), axis=1) if len(O)
+             else np.full(len(Cp), np.inf))
+    d_lab = (np.min(np.linalg.norm(Cp[:, None, :] - placed[None, :, :], axis=2), axis=1)
+             if len(placed) else np.full(len(Cp), np.inf))
+    ok = np.flatnonzero((d_lab >= need_lab) & (d_obs >= need_obs))
+    return int(ok[0]) if ok.size else int(np.argmax(np.minimum(d_lab, 2.0 * d_obs)))
 
 
 def _data_per_pixel(ax) -> float:
@@ -725,11 +730,7 @@ class ChainArtist:
         placed = np.zeros((0, 2))
         for t, C in items:
             Cp = _to_pixels(ax, C)
-            d_obs = np.min(np.linalg.norm(Cp[:, None, :] - O[None, :, :], axis=2), axis=1)
-            d_lab = (np.min(np.linalg.norm(Cp[:, None, :] - placed[None, :, :], axis=2), axis=1)
-                     if len(placed) else np.full(len(Cp), np.inf))
-            ok = np.flatnonzero((d_lab >= need_lab) & (d_obs >= need_obs))
-            k = int(ok[0]) if ok.size else int(np.argmax(np.minimum(d_lab, 2.0 * d_obs)))
+            k = _pick(Cp, O, placed, need_lab, need_obs)
             _move_text(t, C[:, k])
             placed = np.vstack([placed, Cp[k]])
 
@@ -985,7 +986,7 @@ class JointVelocitiesArtist:
         self._show_labels(V)
 
     def _place(self, p, V):
-        """Each label just beyond its arrow's tip; labels that would overlap are pushed sideways."""
+        """Each label beyond its arrow's tip, or beside it when that spot is on another arrow or label."""
         if not self.texts:
             return
         ax = self.ax
@@ -993,21 +994,21 @@ class JointVelocitiesArtist:
         px = 9 * ax.figure.dpi / 72.0
         step = 1.3 * px * _data_per_pixel(ax)
         V = V * self.scale
-        P3 = lambda x: np.r_[x, np.zeros(3 - d)] if d == 2 else x  # noqa: E731
-        placed = []
-        for t, v in zip(self.texts, V):
+        P3 = (lambda X: np.vstack([X, np.zeros((3 - d, X.shape[1]))])) if d == 2 else (lambda X: X)
+        t = np.linspace(0.15, 1.0, 12)
+        O = _to_pixels(ax, P3(np.hstack([p[:, None] + np.outer(v, t) for v in V])))
+        placed = np.zeros((0, 2))
+        for txt, v in zip(self.texts, V):
             nv = np.linalg.norm(v)
-            u = v / nv if nv > 0 else np.zeros(d)
-            w = _perp(P3(u))[:d] if nv > 0 else np.eye(d)[0]
-            base = p + v + step * u
-            best = base
-            for off in (0.0, 1.0, -1.0, 2.0, -2.0):
-                cand = base + off * step * w
-                if not placed or np.min(np.linalg.norm(_to_pixels(ax, P3(cand)[:, None])[0] - np.array(placed), axis=1)) > 1.6 * px:
-                    best = cand
-                    break
-            _move_text(t, P3(best))
-            placed.append(_to_pixels(ax, P3(best)[:, None])[0])
+            u = v / nv if nv > 0 else np.eye(d)[0]
+            w = np.array([-u[1], u[0]]) if d == 2 else _perp(u)
+            tip = p + v
+            C = np.column_stack([tip + step * u, tip + step * w, tip - step * w, tip + step * (u + w),
+                                 tip + step * (u - w), tip + 2 * step * u])
+            Cp = _to_pixels(ax, P3(C))
+            k = _pick(Cp, O, placed, 1.6 * px, 0.9 * px)
+            _move_text(txt, P3(C[:, k:k + 1])[:, 0])
+            placed = np.vstack([placed, Cp[k]])
 
     def _show_labels(self, V):
         """Hide the label of an arrow too short to carry one (< 8 % of the longest): they would pile up."""
@@ -1208,6 +1209,14 @@ def plot_joint_contributions(ax, values, *, title=None, ylabel=None, labels=None
 # ---------------------------------------------------------------------------------------------------
 # directions (column space, left null space)
 # ---------------------------------------------------------------------------------------------------
+def _beyond(v) -> dict:
+    """Text alignment that puts a label just past the head of an arrow along v (not on top of it)."""
+    n = float(np.linalg.norm(v[:2])) or 1.0
+    ux, uy = v[0] / n, v[1] / n
+    return dict(ha="left" if ux > 0.35 else "right" if ux < -0.35 else "center",
+                va="bottom" if uy > 0.35 else "top" if uy < -0.35 else "center")
+
+
 def draw_directions(ax, origin, vectors, labels=None, *, colors=None, components=None, length=None,
                     both_ways=False, linestyles=None, fontsize=9, lw=2.0):
     """Arrows from ``origin`` along each vector (a list of vectors, or a matrix whose *columns* are the
@@ -1252,8 +1261,10 @@ def draw_directions(ax, origin, vectors, labels=None, *, colors=None, components
             ax.add_patch(a)
             out.append(a)
             if lab:
-                out.append(ax.text(*(o + 1.12 * v), lab, color=c, fontsize=fontsize, ha="center", va="center",
-                                   zorder=8))
+                al = _beyond(v)
+                off = ({"left": 4, "right": -4, "center": 0}[al["ha"]], {"bottom": 4, "top": -4, "center": 0}[al["va"]])
+                out.append(ax.annotate(lab, xy=tuple(o + v), xytext=off, textcoords="offset points", color=c,
+                                       fontsize=fontsize, zorder=8, **al))
     else:
         for v, c, ls, lab in zip(vecs, colors, linestyles, labels):
             arr = _Arrows(ax, o[None], v[None], [c], linestyle=ls, lw=lw, zorder=7, label=lab)
@@ -1261,7 +1272,7 @@ def draw_directions(ax, origin, vectors, labels=None, *, colors=None, components
             if both_ways:
                 out.append(_Arrows(ax, o[None], -v[None], [c], linestyle=ls, lw=lw, zorder=7).artist)
             if lab:
-                out.append(_text(ax, o + 1.12 * v, lab, color=c, fontsize=fontsize))
+                out.append(_text(ax, o + v, lab, color=c, fontsize=fontsize, zorder=8, **_beyond(v[:2])))
     ends = [o + 1.2 * v for v in vecs] + ([o - v for v in vecs] if both_ways else []) + [o]
     _include(ax, np.column_stack(ends))
     return out

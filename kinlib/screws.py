@@ -20,7 +20,7 @@ def screw_revolute(omega, q):
     w = _unit_axis(as_vector(omega, "omega", 3, symbolic), "omega")
     q = as_vector(q, "q", 3, symbolic)
     v = -cross(w, q)
-    return sp.Matrix.vstack(w, v) if symbolic else np.concatenate([w, v])
+    return sp.Matrix.vstack(w, v) if symbolic else np.concatenate([w, v + 0.0])  # + 0.0: no −0.0 entries
 
 
 def screw_prismatic(v):
@@ -37,7 +37,7 @@ def screw_axis(q, s, h):
     q = as_vector(q, "q", 3, symbolic)
     h = _scalar(h, "h", symbolic)
     v = -cross(s, q) + h * s
-    return sp.Matrix.vstack(s, v) if symbolic else np.concatenate([s, v])
+    return sp.Matrix.vstack(s, v) if symbolic else np.concatenate([s, v + 0.0])
 
 
 def bracket(V):

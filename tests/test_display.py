@@ -10,7 +10,11 @@ from kinlib.display import is_identically_zero, simplify_for_display
 
 
 def _num(M, subs):
-    return np.array(M.xreplace(subs).evalf(30), dtype=float)
+    """M at the point subs, in floating point (lambdify: exact rational evaluation of the UR5's unsimplified
+    geometric Jacobian takes seconds)."""
+    syms = sorted(subs, key=str)
+    f = sp.lambdify(syms, sp.Matrix(M), "numpy")
+    return np.array(f(*[float(subs[k]) for k in syms]), dtype=float)
 
 
 def _random_subs(chain, seed):
