@@ -658,7 +658,10 @@ def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool) -> No
         for o in c.get("outputs", []):
             h = o.get("data", {}).get("text/html")
             if h:
-                o["data"]["text/html"] = _FA_CDN.sub(_FA_LOCAL, h if isinstance(h, str) else "".join(h))
+                h = _FA_CDN.sub(_FA_LOCAL, h if isinstance(h, str) else "".join(h))
+                if "_anim_img" in h and _FA_LOCAL not in h:      # an animation whose CDN link was dropped
+                    h = f'<link rel="stylesheet" href="{_FA_LOCAL}">\n' + h
+                o["data"]["text/html"] = h
     exporter = HTMLExporter(template_name="lab", embed_images=True, exclude_input_prompt=problems,
                             exclude_output_prompt=problems, **urls)
     body, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": title}})
