@@ -173,8 +173,3 @@ def random_thetas(rng: np.random.Generator, kinds: str, size=None) -> np.ndarray
     pr = np.array([k == "P" for k in kinds])
     th[..., pr] = rng.uniform(-1.0, 1.0, size=shape)[..., pr]
     return th
-
-
-@pytest.fixture
-def rng():
-    return np.random.default_rng(1234)
