@@ -219,7 +219,7 @@ async def _execute(nb, path: Path, timeout: int, capture_after: dict) -> dict:
                             resources={"metadata": {"path": str(path.parent)}})
     fingerprints: dict = {}
     count = 0
-    async with client.async_setup_kernel():
+    async with client.async_setup_kernel(stderr=subprocess.DEVNULL):  # quiet: ipykernel's TCP warning
         msg_id = client.kc.kernel_info()
         info = await client.async_wait_for_reply(msg_id)
         if info is not None and "language_info" in info["content"]:
@@ -640,7 +640,7 @@ def run_workbook(path: Path, timeout: int = 120):
     client = NotebookClient(nb, timeout=timeout, kernel_name="python3", record_timing=False,
                             resources={"metadata": {"path": str(Path(path).parent)}})
     try:
-        _run_async(client.async_execute)
+        _run_async(lambda: client.async_execute(stderr=subprocess.DEVNULL))
     except CellExecutionError as e:
         idx = next((k for k, c in enumerate(nb.cells) if any(o.get("output_type") == "error"
                                                               for o in c.get("outputs", []))), -1)
