@@ -5,8 +5,8 @@
 
 ``simplify_for_display(M)`` works entry by entry:
 
-1. expand the entry into a polynomial in s_i = sin θ_i, c_i = cos θ_i (and the other symbols);
-2. reduce it modulo s_i² + c_i² − 1 (every s_i^k with k ≥ 2 becomes s_i^(k−2)(1 − c_i²)),
+1. write the entry as a polynomial in s_i = sin θ_i, c_i = cos θ_i (and the other symbols);
+2. take its normal form modulo s_i² + c_i² − 1 (degree ≤ 1 in every s_i; :mod:`kinlib.trigpoly`),
    which cancels the terms that only add up to zero;
 3. fold sums of products back into sines and cosines of angle sums (``fu.TR10i``:
    cos a cos b − sin a sin b → cos(a + b)), without constant phase shifts (no √2 cos(x + π/4)),
@@ -16,7 +16,7 @@ With ``phase_shifts=True`` step 3 keeps TR10i's constant phases (a cos x − a s
 the form the printed solutions use.
 
 The result is exactly equal to the input (each step is an identity). On the UR5's space Jacobian it
-takes about a second, where ``sp.simplify`` of each entry takes minutes and ``trigsimp`` 10–15 s.
+takes a fraction of a second, where ``sp.simplify`` of each entry takes minutes and ``trigsimp`` 10–15 s.
 Numeric code is generated from the *unsimplified* expression (see :mod:`kinlib.codegen`).
 """
 from __future__ import annotations
@@ -29,57 +29,20 @@ import sympy as sp
 from sympy.simplify.fu import TR10i
 
 from ._backend import describe
+from .trigpoly import NotTrigPolynomial, TrigRing, single_angle_form
 
 __all__ = ["simplify_for_display", "is_identically_zero"]
 
 
-def _reduce_pythagoras(P: sp.Poly, pairs: list[tuple[int, int]]) -> sp.Poly:
-    """The normal form of P modulo s² + c² − 1 for each (index of s, index of c) in ``pairs``."""
-    out: dict[tuple, Any] = {}
-    stack = list(P.terms())
-    while stack:
-        m, coeff = stack.pop()
-        for i, j in pairs:
-            if m[i] >= 2:  # s^k c^l = s^(k-2) c^l - s^(k-2) c^(l+2)
-                m1 = list(m)
-                m1[i] -= 2
-                m2 = list(m1)
-                m2[j] += 2
-                stack.append((tuple(m1), coeff))
-                stack.append((tuple(m2), -coeff))
-                break
-        else:
-            out[m] = out.get(m, 0) + coeff
-    terms = {m: c for m, c in out.items() if c != 0}
-    if not terms:
-        return sp.Poly(0, *P.gens, domain=P.domain)
-    return sp.Poly.from_dict(terms, *P.gens, domain=P.domain)
-
-
 def _display_entry(e: sp.Expr, phase_shifts: bool = False) -> sp.Expr:
-    trig = e.atoms(sp.sin, sp.cos)
-    if not trig:
+    if not e.atoms(sp.sin, sp.cos):
         return sp.factor_terms(sp.expand(e)) if e.free_symbols else e
-    if any(not f.args[0].is_Symbol for f in trig):
-        e = sp.expand_trig(e)  # sin(θ1 + θ2) -> products of single-angle functions
-    e = sp.expand(e)
-    angles = sorted({f.args[0] for f in e.atoms(sp.sin, sp.cos)}, key=sp.default_sort_key)
-    if not angles:
-        return sp.factor_terms(e)
-    s = {a: sp.Dummy(f"s_{a}") for a in angles}
-    c = {a: sp.Dummy(f"c_{a}") for a in angles}
-    to_poly = {sp.sin(a): s[a] for a in angles}
-    to_poly.update({sp.cos(a): c[a] for a in angles})
-    gens = [s[a] for a in angles] + [c[a] for a in angles]
     try:
-        P = sp.Poly(e.xreplace(to_poly), *gens)
-    except sp.PolynomialError:  # e.g. trig functions inside a square root: leave the entry as it is
-        return sp.factor_terms(TR10i(e))
-    k = len(angles)
-    R = _reduce_pythagoras(P, [(i, k + i) for i in range(k)])
-    back = {s[a]: sp.sin(a) for a in angles}
-    back.update({c[a]: sp.cos(a) for a in angles})
-    folded = TR10i(R.as_expr().xreplace(back))
+        ring = TrigRing([e], opaque=True)   # every sin/cos argument is an angle; √L, 1/L ... as they are
+        reduced = ring.to_expr(ring.normal_form(e), collect=True)
+    except NotTrigPolynomial:  # e.g. trig functions inside a square root: leave the entry as it is
+        return sp.factor_terms(TR10i(sp.expand(single_angle_form(e))))
+    folded = TR10i(reduced)
     return sp.factor_terms(folded if phase_shifts else _unshift(folded))
 
 
@@ -124,91 +87,34 @@ def simplify_for_display(M: Any, phase_shifts: bool = False):
 # ----------------------------------------------------------------------------------------------
 # exact zero test
 # ----------------------------------------------------------------------------------------------
-class _NotTrigPolynomial(Exception):
-    """The expression is not a polynomial in sines, cosines and symbols (e.g. √L, 1/L, exp)."""
+def _normal_form_is_zero(e: sp.Expr) -> bool:
+    ring = TrigRing([e])                    # exact mode: NotTrigPolynomial unless a polynomial in sin/cos
+    if ring.domain.is_EX:                   # constants SymPy cannot do exact arithmetic with
+        raise NotTrigPolynomial(e)
+    return not ring.normal_form(e)
 
 
-def _is_variable(x) -> bool:
-    return isinstance(x, (sp.Symbol, sp.Derivative)) or isinstance(x, sp.core.function.AppliedUndef)
-
-
-def _single_angle_form(e: sp.Expr) -> sp.Expr:
-    """Expand sin/cos of sums and integer multiples (sin(θ1 + θ2), cos 2θ) into single-angle functions."""
-    compound = [f for f in e.atoms(sp.sin, sp.cos) if not _is_variable(f.args[0])]
-    return sp.expand_trig(e) if compound else e
-
-
-def _trig_remainder(e: sp.Expr):
-    """The normal form of e modulo sin²θ + cos²θ − 1 (one relation per angle θ), as a ring element.
-
-    e must be a polynomial in sin θ_i, cos θ_i (θ_i symbols or functions of time) and other symbols;
-    the arithmetic is done in a sparse polynomial ring (no SymPy expand), which is what makes it fast.
-    """
-    e = _single_angle_form(e)
-    if e.has(sp.Float):  # a float is taken at its exact binary value
-        e = e.xreplace({f: sp.Rational(f) for f in e.atoms(sp.Float)})
-    trig = e.atoms(sp.sin, sp.cos)
-    if any(not _is_variable(f.args[0]) for f in trig):
-        raise _NotTrigPolynomial
-    angles = sorted({f.args[0] for f in trig}, key=sp.default_sort_key)
-    variables = sorted(e.atoms(sp.Symbol, sp.Derivative, sp.core.function.AppliedUndef), key=sp.default_sort_key)
-    consts = [c for c in e.atoms(sp.Number, sp.NumberSymbol) if not isinstance(c, sp.Rational)]
-    consts += [p for p in e.atoms(sp.Pow) if p.is_number and not p.is_Rational]
-    if consts:
-        domain = sp.polys.constructor.construct_domain(consts, extension=True)[0]
-    else:
-        domain = sp.QQ
-    k = len(angles)
-    gens = [sp.sin(a) for a in angles] + [sp.cos(a) for a in angles] + variables
-    if not gens:
-        gens = [sp.Dummy()]
-    R, *G = sp.polys.rings.ring([sp.Dummy() for _ in gens], domain)
-    table = dict(zip(gens, G))
-    memo: dict = {}
-
-    def conv(x):
-        if x in table:
-            return table[x]
-        if x in memo:
-            return memo[x]
-        if x.is_number and (x.is_Rational or domain != sp.QQ):
-            try:
-                out = R(domain.from_sympy(x))
-            except Exception as err:  # a constant outside the domain, e.g. E**x
-                raise _NotTrigPolynomial from err
-        elif x.is_Add:
-            out = R.zero
-            for a in x.args:
-                out += conv(a)
-        elif x.is_Mul:
-            out = R.one
-            for a in x.args:
-                out *= conv(a)
-        elif x.is_Pow and x.exp.is_Integer and x.exp >= 0:
-            out = conv(x.base) ** int(x.exp)
-        else:
-            raise _NotTrigPolynomial
-        memo[x] = out
-        return out
-
-    p = conv(e)
-    if k == 0 or p == 0:
-        return p
-    return p.rem([G[i] ** 2 + G[k + i] ** 2 - 1 for i in range(k)])
-
-
-def _entry_is_zero(e: sp.Expr) -> bool:
+def _exact_zero(e: sp.Expr) -> bool | None:
+    """Whether e ≡ 0, decided exactly when e (or its numerator) is a polynomial in sines, cosines and
+    symbols; None when e is of another form (√L, exp, ...)."""
     if e == 0:
         return True
     try:
-        return _trig_remainder(e) == 0
-    except _NotTrigPolynomial:
+        return _normal_form_is_zero(e)
+    except NotTrigPolynomial:
         pass
     num = sp.fraction(sp.together(e))[0]   # a rational function is 0 exactly where its numerator is
     try:
-        return _trig_remainder(num) == 0
-    except _NotTrigPolynomial:
-        return sp.expand(sp.expand_trig(e).rewrite(sp.exp)) == 0
+        return _normal_form_is_zero(num)
+    except NotTrigPolynomial:
+        return None
+
+
+def _entry_is_zero(e: sp.Expr) -> bool:
+    exact = _exact_zero(e)
+    if exact is not None:
+        return exact
+    return sp.expand(sp.expand_trig(e).rewrite(sp.exp)) == 0
 
 
 def _entries(M: Any, name: str) -> list:

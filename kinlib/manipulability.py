@@ -20,7 +20,8 @@ import numpy as np
 import sympy as sp
 
 from ._backend import as_matrix, as_vector, describe, is_symbolic
-from .singularities import _TrigPoly, _angles_in, _det, _is_zero, task_rows, trig_simplify
+from .singularities import _det, _is_zero, task_rows, trig_simplify
+from .trigpoly import TrigRing, angles_in
 
 __all__ = ["manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
            "twist_speed", "singular_values", "strongest_joints"]
@@ -60,13 +61,12 @@ def singular_values(J: Any) -> np.ndarray:
 
 def _display_sqrt(G_det: sp.Expr) -> sp.Expr:
     """√D for display: positive factors with even powers come out, the rest is trig-simplified under √."""
-    angles = _angles_in([G_det])
-    tp = _TrigPoly(angles)
-    D = sp.factor(tp.reduce(tp.to_poly(G_det)))
+    ring = TrigRing([G_det], angles_in([G_det]), opaque=True)
+    D = sp.factor(ring.to_expr(ring.normal_form(G_det), trig=False))   # factored as a polynomial in s_i, c_i
     coeff, factors = sp.factor_list(D)
     outside, inside = sp.sqrt(coeff) if coeff >= 0 else sp.S.One, sp.S.One if coeff >= 0 else coeff
     for f, m in factors:
-        ft = tp.to_trig(f)
+        ft = ring.to_trig(f)
         if m % 2 == 0:
             outside *= (ft if ft.is_nonnegative else sp.Abs(sp.trigsimp(ft))) ** (m // 2)
         else:
@@ -98,7 +98,7 @@ def manipulability(J: Any, simplify: bool = False):
 
 def _gram_eigenvalues(M: sp.Matrix) -> list:
     G = _gram(M)
-    if G.free_symbols and _angles_in(list(G)):
+    if G.free_symbols and angles_in(list(G)):
         G = trig_simplify(G)
     else:
         G = G.applyfunc(sp.simplify)
@@ -163,7 +163,7 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
         return s, U
     M = _symbolic(J)
     G = M * M.T
-    G = trig_simplify(G) if _angles_in(list(G)) else G.applyfunc(sp.simplify)
+    G = trig_simplify(G) if angles_in(list(G)) else G.applyfunc(sp.simplify)
     pairs = []
     for lam, mult, vecs in G.eigenvects(simplify=True):
         lam = sp.simplify(lam)

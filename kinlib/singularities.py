@@ -13,9 +13,10 @@ periodic families; ``rank_at``, ``column_space`` and ``left_null_space`` give ex
 configuration (SymPy's ``Matrix.rank()`` on the symbolic J gives only the generic rank and hides the drop).
 
 How the determinant is solved fast: sin θ_i, cos θ_i are replaced by polynomial variables s_i, c_i,
-each entry is reduced modulo s_i² + c_i² − 1, the determinant is taken by fraction-free elimination,
-factored, and each factor that involves a single joint is solved on one period [0, 2π) and written as a
-family {b + p k : k ∈ ℤ}. Prismatic joint variables enter polynomially and are solved over ℝ.
+each entry is reduced modulo s_i² + c_i² − 1 (:class:`kinlib.trigpoly.TrigRing`), the determinant is
+taken by fraction-free elimination in that polynomial ring and factored, and each factor that involves a
+single joint is solved on one period [0, 2π) and written as a family {b + p k : k ∈ ℤ}. Prismatic joint
+variables enter polynomially and are solved over ℝ.
 """
 from __future__ import annotations
 
@@ -26,6 +27,8 @@ import numpy as np
 import sympy as sp
 
 from ._backend import as_matrix, describe, is_symbolic
+from .display import _exact_zero
+from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
 
 __all__ = [
     "ROW_NAMES", "task_rows", "singular_configurations", "representatives", "rank_at", "column_space",
@@ -151,61 +154,8 @@ def task_rows(J: Any, rows: Any):
 
 
 # ----------------------------------------------------------------------------------------------
-# trigonometric polynomials: sin θ → s, cos θ → c, modulo s² + c² − 1
+# display form (the normal form modulo sin² + cos² = 1 is kinlib.trigpoly's)
 # ----------------------------------------------------------------------------------------------
-class _TrigPoly:
-    """Rewrite expressions in sin θ_i, cos θ_i (and θ_j polynomially) as polynomials in s_i, c_i, θ_j."""
-
-    def __init__(self, angles: Sequence[sp.Symbol]):
-        self.angles = tuple(angles)
-        self.s = {a: sp.Dummy(f"s_{a}") for a in self.angles}
-        self.c = {a: sp.Dummy(f"c_{a}") for a in self.angles}
-        self.fwd = {}
-        for a in self.angles:
-            self.fwd[sp.sin(a)] = self.s[a]
-            self.fwd[sp.cos(a)] = self.c[a]
-        self.back = {v: k for k, v in self.fwd.items()}
-        self.owner = {**{v: a for a, v in self.s.items()}, **{v: a for a, v in self.c.items()}}
-
-    def to_poly(self, e: sp.Expr) -> sp.Expr:
-        e = sp.expand(sp.expand_trig(sp.sympify(e)))
-        return sp.expand(e.xreplace(self.fwd))
-
-    def reduce(self, e: sp.Expr) -> sp.Expr:
-        """The normal form modulo s² + c² − 1 (degree ≤ 1 in every s)."""
-        e = sp.expand(e)
-        for a in self.angles:
-            s, c = self.s[a], self.c[a]
-            if e.has(s):
-                p = sp.Poly(e, s)
-                if p.degree() >= 2:
-                    e = sp.expand(sp.rem(e, s**2 + c**2 - 1, s))
-        return e
-
-    def to_trig(self, e: sp.Expr) -> sp.Expr:
-        return e.xreplace(self.back)
-
-    def joints_of(self, e: sp.Expr, thetas) -> set:
-        out = set()
-        for sym in e.free_symbols:
-            if sym in self.owner:
-                out.add(self.owner[sym])
-            elif sym in thetas:
-                out.add(sym)
-        return out
-
-
-def _angles_in(exprs, candidates=None) -> list[sp.Symbol]:
-    """Symbols that appear as the argument of sin/cos after trig expansion."""
-    found = []
-    for e in exprs:
-        for f in sp.expand_trig(sp.sympify(e)).atoms(sp.sin, sp.cos):
-            for s in f.args[0].free_symbols:
-                if (candidates is None or s in candidates) and s not in found:
-                    found.append(s)
-    return sorted(found, key=str)
-
-
 def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
     """A display form: expand the trig functions, reduce with sin² + cos² = 1, then trigsimp and factor.
 
@@ -216,25 +166,28 @@ def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
     e = sp.sympify(e)
     if not isinstance(e, sp.Expr):
         raise TypeError(f"e must be a SymPy expression or Matrix, got {describe(e)}")
-    angles = _angles_in([e], set(thetas) if thetas is not None else None)
+    angles = angles_in([e], set(thetas) if thetas is not None else None)
     if not angles:
         return sp.factor(e) if e.free_symbols else sp.nsimplify(sp.radsimp(e)) if e.is_number and not e.has(sp.Float) else e
-    tp = _TrigPoly(angles)
-    p = tp.reduce(tp.to_poly(e))
-    out = sp.trigsimp(tp.to_trig(sp.factor(p)))
-    return sp.factor_terms(out)
+    try:
+        ring = TrigRing([e], angles, opaque=True)
+        p = ring.to_expr(ring.normal_form(e), trig=False)   # in s_i, c_i: factored as a polynomial
+    except NotTrigPolynomial:  # sin/cos under a root or in a denominator: trigsimp alone
+        return sp.factor_terms(sp.trigsimp(e))
+    return sp.factor_terms(sp.trigsimp(ring.to_trig(sp.factor(p))))
 
 
 # ----------------------------------------------------------------------------------------------
 # singular configurations
 # ----------------------------------------------------------------------------------------------
-def _rank_condition(J: sp.Matrix) -> tuple[str, sp.Matrix]:
-    m, n = J.shape
-    if m == n:
-        return "det J", J
-    if m < n:
-        return "det(J Jᵀ)", J * J.T
-    return "det(Jᵀ J)", J.T * J
+def _rank_det(entries: list, shape: tuple[int, int], ring: TrigRing):
+    """det J (square), det(J Jᵀ) (m < n) or det(Jᵀ J) (m > n) of J given as ring elements, row by row:
+    fraction-free elimination over the polynomial ring (exact, no expression swell)."""
+    from sympy.polys.matrices import DomainMatrix
+    m, n = shape
+    dJ = DomainMatrix([entries[i * n:(i + 1) * n] for i in range(m)], shape, ring.ring.to_domain())
+    G = dJ if m == n else dJ * dJ.transpose() if m < n else dJ.transpose() * dJ
+    return G.det()
 
 
 def _det(M: sp.Matrix) -> sp.Expr:
@@ -323,51 +276,57 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
     if J.rows == 0 or J.cols == 0:
         raise ValueError(f"J must have at least one row and one column, got {describe(J)}")
 
-    angles = _angles_in(list(J), set(thetas))
-    tp = _TrigPoly(angles)
-    Jp = J.applyfunc(tp.to_poly)
-    gens = set(tp.s.values()) | set(tp.c.values()) | set(thetas)
-    for e in Jp:
-        if e.has(sp.sin, sp.cos, sp.tan) or any(isinstance(a, sp.Pow) and a.exp.is_negative and a.base.free_symbols & gens
-                                                 for a in e.atoms(sp.Pow)) or \
-                not e.is_polynomial(*gens) or (e.free_symbols & set(angles)):
-            raise ValueError("J must be polynomial in sin θ_i, cos θ_i of the revolute joints and in the "
-                             f"prismatic joint values; got the entry {e.xreplace(tp.back)}")
-    Jp = Jp.applyfunc(tp.reduce)
-    _, G = _rank_condition(Jp)
-    D = _det(G.applyfunc(sp.expand))
+    joint_set = set(thetas)
+
+    def parameter_atom(a: sp.Expr) -> bool:  # √L, 1/L: allowed; anything else with a joint or a trig function: not
+        return not (a.free_symbols & joint_set) and not a.has(sp.sin, sp.cos, sp.tan)
+
+    def bad_entry(e):
+        return ValueError("J must be polynomial in sin θ_i, cos θ_i of the revolute joints and in the "
+                          f"prismatic joint values; got the entry {e}")
+
+    try:
+        ring = TrigRing(list(J), thetas, opaque=parameter_atom)   # s_i = sin θ_i, c_i = cos θ_i, θ_j, L, ...
+    except NotTrigPolynomial:
+        for e in J:
+            try:
+                TrigRing([e], thetas, opaque=parameter_atom)
+            except NotTrigPolynomial:
+                raise bad_entry(e) from None
+        raise
+    revolute = set(ring.found)                   # joints inside sin/cos; the others enter polynomially
+    mixed = revolute & set(ring.variables)       # θ sin θ is not a trigonometric polynomial
+    if mixed:
+        raise bad_entry(next(e for e in J if mixed & set(TrigRing([e], thetas, opaque=parameter_atom).variables)))
+    Jp = [ring.normal_form(e) for e in J]
+    D = _rank_det(Jp, J.shape, ring)
     conditions: list = []
 
     def add(cond):
         if cond not in conditions:
             conditions.append(cond)
 
-    _, factors = sp.factor_list(sp.expand(D))
-    if sp.expand(D) == 0:
+    if not D:
         raise ValueError("J never has full rank (its rank-test determinant is identically zero): "
                          "every configuration is singular")
+    _, factors = D.factor_list()
     for f, _mult in factors:
-        if not tp.joints_of(f, thetas):
+        if not ring.depends_on(f) & joint_set:
             continue
-        _, sub = sp.factor_list(tp.reduce(f))
+        _, sub = ring.reduce(f).factor_list()
         for g, _m in sub:
-            joints = tp.joints_of(g, thetas)
+            joints = ring.depends_on(g) & joint_set
             if not joints:
                 continue
             if len(joints) == 1:
                 (j,) = joints
-                revolute = j in tp.s
-                poly_in_j = g.has(j)
-                if revolute and poly_in_j:
-                    sol = None
-                else:
-                    sol = _solve_single(tp.to_trig(g), j, revolute)
+                sol = _solve_single(ring.to_expr(g), j, j in revolute)
                 if sol is sp.S.EmptySet:
                     continue
                 if sol is not None:
                     add({j: sol})
                     continue
-            expr = tp.to_trig(g)
+            expr = ring.to_expr(g)
             if sp.count_ops(expr) < 400:
                 expr = sp.trigsimp(expr)
             add(_normalize_expr(expr))
@@ -493,7 +452,12 @@ def _clean(M: sp.Matrix) -> sp.Matrix:
 
 
 def _is_zero(e: Any):
-    """Exact zero test that never mistakes a configuration's zero for a nonzero."""
+    """Exact zero test that never mistakes a configuration's zero for a nonzero.
+
+    Polynomials in sines, cosines and symbols (and rational functions of them) are decided exactly by
+    :func:`kinlib.display.is_identically_zero`'s normal form; other forms (square roots ...) numerically
+    first (a nonzero value proves nonzero), then by ``sp.simplify``.
+    """
     e = sp.sympify(e)
     if e == 0:
         return True
@@ -503,8 +467,14 @@ def _is_zero(e: Any):
         v = complex(sp.N(e, 40))
         if abs(v) > 1e-30:
             return False
+        exact = _exact_zero(e)
+        if exact is not None:
+            return exact
         return bool(sp.simplify(e) == 0 or e.equals(0))
-    # expressions in positive parameters: a random positive point proves nonzero
+    exact = _exact_zero(e)
+    if exact is not None:
+        return exact
+    # other expressions in positive parameters: a random positive point proves nonzero
     rng = np.random.default_rng(0)
     syms = sorted(e.free_symbols, key=str)
     for _ in range(3):

@@ -177,3 +177,46 @@ def test_accepts_scalars_matrices_and_lists():
 def test_bad_input(bad):
     with pytest.raises(TypeError, match="M must"):
         is_identically_zero(bad)
+
+
+# ------------------------------------------------------------------------------------------------
+# the shared normal form modulo sin² + cos² − 1 (kinlib.trigpoly), behind both functions above and
+# kinlib.singularities / kinlib.manipulability
+# ------------------------------------------------------------------------------------------------
+def _values_at(e, seed):
+    rng = random.Random(seed)
+    pt = {s: sp.Rational(rng.randint(-300, 300), 97) for s in sorted(e.free_symbols, key=str)}
+    return sp.N(e.subs(pt), 30)
+
+
+def test_normal_form_is_canonical_reduced_and_equal_to_the_input():
+    from kinlib.trigpoly import TrigRing
+    a = sp.sin(x) ** 3 * sp.cos(y) + z * sp.cos(x + y) + sp.cos(2 * x)
+    b = (sp.sin(x) * (1 - sp.cos(x) ** 2) * sp.cos(y) + z * (sp.cos(x) * sp.cos(y) - sp.sin(x) * sp.sin(y))
+         + 2 * sp.cos(x) ** 2 - 1)                                   # the same function, written differently
+    R = TrigRing([a, b])
+    assert R.normal_form(a) == R.normal_form(b)                      # canonical
+    e = R.to_expr(R.normal_form(a))
+    assert sp.Poly(e, sp.sin(x), sp.sin(y)).degree_list() <= (1, 1)  # degree ≤ 1 in every sine
+    for seed in range(3):                                            # independent: exact rational points
+        assert abs(_values_at(e - a, seed)) < 1e-25
+
+
+def test_normal_form_collects_and_has_two_modes():
+    from kinlib.trigpoly import NotTrigPolynomial, TrigRing
+    L = sp.Symbol("L", positive=True)
+    e = L * sp.cos(x) + y * sp.cos(x) - z * sp.sin(x) ** 3 - z * sp.sin(x) * sp.cos(x) ** 2
+    R = TrigRing([e])
+    assert R.to_expr(R.normal_form(e), collect=True) == (L + y) * sp.cos(x) - z * sp.sin(x)
+    # exact mode (zero tests): only polynomials in sin/cos and symbols; floats at their binary value
+    with pytest.raises(NotTrigPolynomial):
+        TrigRing([sp.sqrt(L) * sp.sin(x)])
+    R = TrigRing([0.5 * sp.sin(x)])
+    assert R.to_expr(R.normal_form(0.5 * sp.sin(x))) == sp.sin(x) / 2
+    # display mode: other subexpressions (√L) are generators of their own, floats stay floats
+    f = sp.sqrt(L) * (sp.sin(x) ** 2 + sp.cos(x) ** 2) + 0.5 * sp.sin(x)
+    R = TrigRing([f], opaque=True)
+    out = R.to_expr(R.normal_form(f))
+    assert out.has(sp.Float) and sp.nsimplify(out) == sp.sqrt(L) + sp.sin(x) / 2
+    with pytest.raises(NotTrigPolynomial):                           # sin inside a root: not a polynomial
+        TrigRing([sp.sqrt(sp.sin(x))], opaque=True)

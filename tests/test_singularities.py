@@ -229,6 +229,8 @@ def test_bad_input_singular_configurations():
         singular_configurations(sp.Matrix([[sp.sin(x), sp.sin(x)], [sp.cos(x), sp.cos(x)]]), [x, sp.Symbol("y")])
     with pytest.raises(ValueError, match="polynomial in sin"):
         singular_configurations(sp.Matrix([[sp.sin(x / 2)]]), [x])
+    with pytest.raises(ValueError, match=r"polynomial in sin.*entry x\*sin\(x\)"):
+        singular_configurations(sp.Matrix([[1, 0], [x * sp.sin(x), sp.cos(x)]]), [x, sp.Symbol("y")])
 
 
 # ------------------------------------------------------------------------------------------
@@ -361,3 +363,17 @@ def test_representatives_and_trig_simplify():
     e = sp.sin(t1) ** 2 * sp.sin(t2) + sp.cos(t1) ** 2 * sp.sin(t2) + 1
     assert trig_simplify(e) == sp.sin(t2) + 1
     assert trig_simplify(sp.Matrix([e])) == sp.Matrix([sp.sin(t2) + 1])
+
+
+def test_trig_simplify_outside_trig_polynomials_and_exact_zero_test():
+    from kinlib.singularities import _is_zero
+    t1 = sp.Symbol("theta1", real=True)
+    L1, L2 = sp.symbols("L1 L2", positive=True)
+    # sin/cos under a root or in a denominator: no polynomial normal form, trigsimp alone
+    assert trig_simplify(sp.sqrt(L1 * sp.sin(t1) ** 2 + L1 * sp.cos(t1) ** 2)) == sp.sqrt(L1)
+    assert trig_simplify(sp.sin(t1) / (sp.sin(t1) ** 2 + sp.cos(t1) ** 2)) == sp.sin(t1)
+    # the zero test behind rank/rref: exact for polynomials in the parameters and algebraic numbers
+    assert _is_zero(sp.expand((L1 + L2) ** 7) - (L1 + L2) ** 7)
+    assert not _is_zero(sp.expand((L1 + L2) ** 7) - (L1 + L2) ** 7 + L1 * sp.Rational(1, 10**30))
+    assert _is_zero(sp.sqrt(2) / 2 - 1 / sp.sqrt(2)) and not _is_zero(sp.sqrt(2) * L1 - L1)
+    assert _is_zero(sp.sqrt(6) * sp.sqrt(3) - 3 * sp.sqrt(2))
