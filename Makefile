@@ -34,8 +34,10 @@ test: $(STAMP) chromium
 test-fast: $(STAMP)
 	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(PYTEST_ARGS)
 
+# JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
+LAB_ARGS ?=
 lab: $(STAMP)
-	$(VENV)/bin/jupyter lab --notebook-dir=notebooks
+	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
 
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
 handouts: $(STAMP)
