@@ -152,8 +152,10 @@ class SerialChain:
         return sp.Matrix.hstack(*cols)
 
     def _eval(self, what: str, q):
-        if type(q) is np.ndarray and q.dtype.kind == "f" and what in self._num:  # fast path: float array
-            return self._num[what](q)
+        if type(q) is np.ndarray and q.dtype.kind == "f":  # fast path: a float array, code already generated
+            c = self._num.get(what)
+            if c is not None:
+                return c._single(q.tolist()) if q.shape == (self.n,) else c(q)
         expr = self._expr(what)
         if q is None:
             return expr
