@@ -132,6 +132,20 @@ class SerialChain:
             elif what == "jg":  # = space_to_geometric(J_s, T) without re-checking T (its SE(3) check costs seconds on big T)
                 js, p = self._expr("js"), self._expr("fk")[:3, 3]
                 e = sp.Matrix.vstack(js[:3, :], js[3:, :] - skew(p) * js[:3, :])
+            elif what == "jg_num":  # the same J, built so that cse leaves few operations (the numeric code's form):
+                # with T_{i-1} = e^{[S1]θ1}⋯e^{[S(i-1)]θ(i-1)} = (R_i, ·) and p_i the position of
+                # e^{[Si]θi}⋯e^{[Sn]θn} M, column i is [R_i ω_i; R_i (v_i + ω_i × p_i)] (S_i = [ω_i; v_i])
+                _, th, kinds, _ = _prepare(self.screws, th, "screws")
+                E = [_exp6(self.screws[:, i], th[i], kinds[i], True) for i in range(self.n)]
+                tail, cols = [self.M], []  # tail[i] = e^{[Si]θi}⋯e^{[Sn]θn} M
+                for i in reversed(range(self.n)):
+                    tail.insert(0, E[i] * tail[0])
+                R = sp.eye(3)
+                for i in range(self.n):
+                    w, v = self.screws[:3, i], self.screws[3:, i]
+                    cols.append(sp.Matrix.vstack(R * w, R * (v + cross(w, tail[i][:3, 3]))))
+                    R = R * E[i][:3, :3]
+                e = sp.Matrix.hstack(*cols)
             elif what == "skeleton":
                 e = self._skeleton_expr()
             else:  # pragma: no cover
@@ -176,7 +190,8 @@ class SerialChain:
                 raise ValueError(
                     f"{self.name} has symbolic parameters {', '.join(map(str, self.params))}: give them numbers "
                     f"first, e.g. chain.subs({str(self.params[0])}=1), or pass SymPy joint values for an exact result")
-            self._num[what] = CompiledMatrix(self._expr(what), self.thetas, f"{self.name}.{what}")
+            expr = self._expr("jg_num" if what == "jg" else what)
+            self._num[what] = CompiledMatrix(expr, self.thetas, f"{self.name}.{what}")
         return self._num[what]
 
     # --- kinematics ------------------------------------------------------------------------------

@@ -5,18 +5,22 @@ elimination (``sympy.cse``) and printed as straight-line Python twice:
 
 * over ``math`` for a single configuration: floats in, the entries packed straight into a fresh
   NumPy array (``struct.pack_into``, no intermediate list);
-* over NumPy with the batch on the last axis, in blocks of ``BLOCK`` configurations (each
-  temporary is freed after its last use, so the live ones stay in cache), giving an
-  (N, rows, cols) array (constant entries are written once, not per block).
+* over NumPy with the batch on the last axis, in blocks of ``BLOCK`` configurations, as ufunc
+  calls with ``out=`` (``_mul(a, b, out=_t3)``): every value lands in a row of one scratch array
+  allocated per call, or straight in its slot of the result, so a block allocates nothing; a
+  row is reused once its temporary is dead, each entry is written as soon as its temporaries
+  exist, and sums share their common factors (``a*(b + c)``). The result is an (N, rows, cols)
+  view (constant entries are written once, not per block).
 
 Simplified expressions would be slower: simplification destroys the shared subexpressions. The
 printer only rearranges what it prints (rationals as float literals, ``c - a*b`` rather than
-``-a*b + c``, ``x*x`` rather than ``x**2``), so the numbers agree with the expression to rounding.
+``-a*b + c``, ``(x*x)`` rather than ``x**2``), so the numbers agree with the expression to rounding.
 ``CompiledMatrix.source`` holds the generated code.
 """
 from __future__ import annotations
 
 import math
+import re
 import struct
 from typing import Sequence
 
@@ -53,7 +57,7 @@ class _Printer(PythonCodePrinter):
         b, e = expr.args
         if e.is_Integer and 2 <= int(e) <= 4:  # x*x is cheaper than x**2 for Python floats
             base = self.parenthesize(b, precedence(expr), strict=False)
-            return "*".join([base] * int(e))
+            return "(" + "*".join([base] * int(e)) + ")"  # parenthesized: a/x**2 is a/(x*x)
         return super()._print_Pow(expr, rational=rational)
 
     def _print_Add(self, expr, order=None):
@@ -89,6 +93,287 @@ def _constant(e: sp.Expr):
         return float(e)
     except TypeError:  # e.g. complex: let the generated code raise
         return None
+
+
+_UFUNCS = {"_mul": np.multiply, "_add": np.add, "_sub": np.subtract, "_neg": np.negative, "_div": np.divide,
+           "_pow": np.power}
+_UFUNC_OF = {sp.sin: "sin", sp.cos: "cos", sp.tan: "tan", sp.exp: "exp", sp.log: "log"}
+
+
+def _factors(term) -> list:
+    """What a product term is a multiple of: its plain symbols and its rational coefficient's size."""
+    c = term.as_coeff_Mul()[0]
+    fs = [f for f in sp.Mul.make_args(term) if f.is_Symbol]
+    return fs + [abs(c)] if c.is_Rational and abs(c) != 1 else fs
+
+
+def _collect(e):
+    """Factor the most shared symbol out of each sum, recursively: a*b + a*c - d -> a*(b + c) - d.
+
+    Fewer multiplications for the batched code; the value is the same to rounding."""
+    if e.is_Atom:
+        return e
+    args = [_collect(a) for a in e.args]
+    if not e.is_Add:
+        return e.func(*args, evaluate=False) if e.is_Mul else e.func(*args)
+    return _collect_sum(args)
+
+
+def _collect_sum(terms: list):
+    count: dict = {}
+    for t in terms:
+        for f in set(_factors(t)):
+            count[f] = count.get(f, 0) + 1
+    best = max(count, key=lambda f: (count[f], str(f)), default=None)
+    if best is None or count[best] < 2:
+        return sp.Add(*terms, evaluate=False) if len(terms) > 1 else terms[0]
+    inner, rest = [], []
+    for t in terms:
+        if best in _factors(t):
+            inner.append(t / best if best.is_Number else sp.Mul(*[f for f in sp.Mul.make_args(t) if f != best]))
+        else:
+            rest.append(t)
+    shared = sp.Mul(best, _collect_sum(inner), evaluate=False)
+    return sp.Add(shared, _collect_sum(rest), evaluate=False) if rest else shared
+
+
+class _BatchEmitter:
+    """Straight-line ufunc calls with ``out=``: every value of a block lands in a preallocated scratch
+    row ``_tK`` (or straight in its ``out`` slot), so a block allocates nothing.
+
+    A cse temporary holds its row from its definition to its last use; the pieces of one statement
+    hold theirs for the statement. Signs are folded into the sums (``a - b`` rather than ``a + (-b)``).
+    """
+
+    def __init__(self, printer):
+        self.pr = printer
+        self.nbuf = 0
+        self.free: list[int] = []
+        self.name: dict = {}  # cse symbol or joint symbol -> the name holding it
+        self.lines: list[str] = []
+        self._buf_of: dict = {}
+        self.negated: set = set()  # temporaries whose row holds minus their value
+
+    def _alloc(self) -> str:
+        k = self.free.pop() if self.free else self.nbuf
+        self.nbuf = max(self.nbuf, k + 1)
+        return f"_t{k}"
+
+    def _release(self, buf: str):
+        self.free.append(int(buf[2:]))
+
+    def _num(self, v) -> str:
+        return repr(float(v))
+
+    def _operand(self, e, scratch: list):
+        """(text, negated): a name or a number as it is, anything else computed into a scratch row."""
+        if e in self.name:
+            return self.name[e], e in self.negated
+        if e.is_Number:
+            return self._num(e), False
+        if e.is_Mul and e.args[0] == -1 and len(e.args) == 2 and e.args[1] in self.name:
+            return self.name[e.args[1]], e.args[1] not in self.negated  # -x: the name, negated
+        buf = self._alloc()
+        scratch.append(buf)
+        return buf, self._emit(e, buf, allow_neg=True)
+
+    def _emit(self, e, dest: str, allow_neg: bool = False) -> bool:
+        """Emit code leaving e in dest (or -e, returning True, when allow_neg); returns whether negated."""
+        scratch: list[str] = []
+        neg = False
+        if e.is_Mul:
+            coeff, factors = e.as_coeff_mul()
+            flat, divs = [], []
+            for f in factors:
+                if f.is_Pow and f.exp.is_Integer and 2 <= int(f.exp) <= 4:
+                    flat += [f.base] * int(f.exp)
+                elif f.is_Pow and f.exp.is_Integer and int(f.exp) == -1:
+                    divs.append(f.base)
+                else:
+                    flat.append(f)
+            neg = bool(coeff < 0)
+            c = abs(coeff)
+            if not flat:
+                flat, c = [sp.Float(float(c))], sp.S.One
+            ops = []
+            for f in flat:
+                txt, fneg = (self._num(f), False) if f.is_Number else self._operand(f, scratch)
+                ops.append(txt)
+                neg ^= fneg
+            if len(ops) == 1:
+                if c != 1:
+                    if neg and not allow_neg:
+                        c, neg = -c, False
+                    self.lines.append(f"_mul({ops[0]}, {self._num(c)}, out={dest})")
+                    c = sp.S.One
+                elif divs:
+                    self.lines.append(f"_div({ops[0]}, 1.0, out={dest})")
+                elif neg and not allow_neg:
+                    self.lines.append(f"_neg({ops[0]}, out={dest})")
+                    neg = False
+                else:
+                    self.lines.append(f"{dest}[...] = {ops[0]}")
+            else:
+                self.lines.append(f"_mul({ops[0]}, {ops[1]}, out={dest})")
+                for o in ops[2:]:
+                    self.lines.append(f"_mul({dest}, {o}, out={dest})")
+            if c != 1:
+                if neg and not allow_neg:
+                    c, neg = -c, False
+                self.lines.append(f"_mul({dest}, {self._num(c)}, out={dest})")
+            for d in divs:
+                txt, dneg = self._operand(d, scratch)
+                self.lines.append(f"_div({dest}, {txt}, out={dest})")
+                neg ^= dneg
+        elif e.is_Add:
+            const = sp.S.Zero
+            terms = []
+            for t in e.args:
+                if t.is_Number:
+                    const += t
+                else:
+                    terms.append(t)
+            # a computed positive term goes straight into dest; the rest are names or scratch rows
+            first = None
+            for t in terms:
+                if t not in self.name and not t.could_extract_minus_sign():
+                    first = t
+                    break
+            acc_neg = None  # None: dest not started
+            if first is not None:
+                acc_neg = self._emit(first, dest, allow_neg=True)
+                terms.remove(first)
+            pending = None  # a first term not yet combined: (text, negated)
+            for t in terms:
+                if t in self.name:
+                    txt, tneg = self.name[t], t in self.negated
+                else:
+                    txt, tneg = self._operand(t, scratch)
+                if acc_neg is None and pending is None:
+                    pending = (txt, tneg)
+                    continue
+                if pending is not None:
+                    (a, aneg), pending = pending, None
+                    if aneg == tneg:
+                        self.lines.append(f"_add({a}, {txt}, out={dest})")
+                        acc_neg = aneg
+                    elif tneg:
+                        self.lines.append(f"_sub({a}, {txt}, out={dest})")
+                        acc_neg = False
+                    else:
+                        self.lines.append(f"_sub({txt}, {a}, out={dest})")
+                        acc_neg = False
+                elif acc_neg == tneg:
+                    self.lines.append(f"_add({dest}, {txt}, out={dest})")
+                elif not acc_neg:
+                    self.lines.append(f"_sub({dest}, {txt}, out={dest})")
+                else:
+                    self.lines.append(f"_sub({txt}, {dest}, out={dest})")
+                    acc_neg = False
+            if pending is not None:  # a single term (and maybe a constant)
+                a, acc_neg = pending
+                if const != 0:
+                    k = float(const)
+                    if acc_neg:
+                        self.lines.append(f"_sub({self._num(k)}, {a}, out={dest})")
+                        acc_neg = False
+                    elif k > 0:
+                        self.lines.append(f"_add({a}, {self._num(k)}, out={dest})")
+                    else:
+                        self.lines.append(f"_sub({a}, {self._num(-k)}, out={dest})")
+                    const = sp.S.Zero
+                elif acc_neg and not allow_neg:
+                    self.lines.append(f"_neg({a}, out={dest})")
+                    acc_neg = False
+                else:
+                    self.lines.append(f"{dest}[...] = {a}")
+            if const != 0:
+                k = float(const)
+                if acc_neg:  # dest holds -(sum): value = k - dest
+                    self.lines.append(f"_sub({self._num(k)}, {dest}, out={dest})")
+                    acc_neg = False
+                elif k > 0:
+                    self.lines.append(f"_add({dest}, {self._num(k)}, out={dest})")
+                else:
+                    self.lines.append(f"_sub({dest}, {self._num(-k)}, out={dest})")
+            neg = bool(acc_neg)
+        elif isinstance(e, sp.Function) and e.func in _UFUNC_OF and len(e.args) == 1:
+            arg, aneg = self._operand(e.args[0], scratch)
+            if aneg:  # rare: fix the sign of the argument first
+                self.lines.append(f"_neg({arg}, out={dest})")
+                arg = dest
+            self.lines.append(f"{_UFUNC_OF[e.func]}({arg}, out={dest})")
+        elif e in self.name:
+            if e in self.negated and not allow_neg:
+                self.lines.append(f"_neg({self.name[e]}, out={dest})")
+            else:
+                self.lines.append(f"{dest}[...] = {self.name[e]}")
+                neg = e in self.negated
+        else:  # anything else: the NumPy expression as printed, assigned into dest
+            txt = self.pr.doprint(e.xreplace({s: (-1 if s in self.negated else 1) * sp.Symbol(n)
+                                              for s, n in self.name.items() if s.is_Symbol}))
+            self.lines.append(f"{dest}[...] = {txt}")
+        for b in scratch:
+            self._release(b)
+        if neg and not allow_neg:
+            self.lines.append(f"_neg({dest}, out={dest})")
+            neg = False
+        return neg
+
+    def emit_block(self, repl, outputs) -> list[str]:
+        """Lines computing the cse temporaries ``repl`` and writing each (slot, expr) of ``outputs``."""
+        # each output right after the last temporary it needs: temporaries die early, fewer rows live
+        where = {s: j for j, (s, _) in enumerate(repl)}
+        after: dict[int, list] = {}
+        for slot, e in outputs:
+            after.setdefault(max((where[x] for x in e.free_symbols if x in where), default=-1), []).append((slot, e))
+        stmts = [(None, e, slot) for slot, e in after.get(-1, [])]
+        for j, (s, e) in enumerate(repl):
+            stmts += [(s, e, None)] + [(None, oe, slot) for slot, oe in after.get(j, [])]
+        last = {}
+        for j, (_, e, _) in enumerate(stmts):
+            for sym in e.free_symbols:
+                last[sym] = j
+        for sym in set().union(*(e.free_symbols for _, e, _ in stmts)):
+            if str(sym).startswith("_q"):
+                self.name[sym] = str(sym)
+        for j, (s, e, slot) in enumerate(stmts):
+            e = _collect(e)
+            start = len(self.lines)
+            if s is not None:
+                if last.get(s, -1) < 0:
+                    continue  # unused temporary
+                buf = self._alloc()
+                if self._emit(e, buf, allow_neg=True):  # the row holds -s: users fold the sign in
+                    self.negated.add(s)
+                self.name[s] = str(s)
+                # bind the name where the row is first written; later calls use the name
+                pat = re.compile(rf"\b{buf}\b")
+                k = next((i for i in range(start, len(self.lines)) if pat.search(self.lines[i])), None)
+                if k is not None and self.lines[k].endswith(f"out={buf})") and pat.subn("", self.lines[k])[1] == 1:
+                    self.lines[k] = f"{s} = {self.lines[k]}"
+                    self.lines[k + 1:] = [pat.sub(str(s), ln) for ln in self.lines[k + 1:]]
+                else:
+                    self.lines[start:] = [pat.sub(str(s), ln) for ln in self.lines[start:]]
+                    self.lines.insert(start, f"{s} = {buf}")
+            else:
+                if e.is_Symbol and e in self.name and e in self.negated:
+                    self.lines.append(f"_neg({self.name[e]}, out={slot})")
+                elif e.is_Symbol and e in self.name:
+                    self.lines.append(f"{slot} = {self.name[e]}")
+                else:
+                    n0 = len(self.lines)
+                    self._emit(e, "_o")
+                    if len(self.lines) - n0 == 1:
+                        self.lines[-1] = re.sub(r"\b_o\b", slot, self.lines[-1])
+                    else:
+                        self.lines.insert(n0, f"_o = {slot}")
+            for sym in e.free_symbols:
+                if last.get(sym) == j and sym in self.name and not str(sym).startswith("_q"):
+                    self._release(self._buf_of[sym])
+            if s is not None:
+                self._buf_of[s] = buf
+        return self.lines
 
 
 class CompiledMatrix:
@@ -139,35 +424,29 @@ class CompiledMatrix:
         single += [f"    {s} = {e}" for s, e in temps]
         single += [f"    out = _empty(({r}, {c}))", f"    _pack(out, 0, {', '.join(items)})", "    return out"]
 
-        # a batch, on the last axis, block by block; constant entries written once
-        batch = ["def _batch(q):", "    N = q.shape[1]", f"    out = _empty(({r}, {c}, N))"]
+        # a batch q of shape (N, n), computed on the last axis of out, block by block; constant
+        # entries written once; each joint's block is read in place (a strided column of q)
+        batch = ["def _batch(q):", "    N = q.shape[0]", f"    out = _empty(({r}, {c}, N))"]
         for k, v in enumerate(consts):
             if v is not None:
                 batch.append(f"    out[{k // c}, {k % c}] = {v!r}")
         varying = [(k, it) for k, (it, v) in enumerate(zip(items, consts)) if v is None]
         if varying:
-            batch += [f"    for _s in range(0, N, {BLOCK}):", f"        _e = _s + {BLOCK}"]
+            em = _BatchEmitter(pr)
+            body = em.emit_block(repl, [(f"out[{k // c}, {k % c}, _s:_e]", reduced[k]) for k, _ in varying])
+            batch += [f"    _B = min(N, {BLOCK})",
+                      f"    _buf = _empty(({max(em.nbuf, 1)}, _B))  # scratch rows, reused block after block"]
+            batch += [f"    for _s in range(0, N, {BLOCK}):", f"        _e = min(_s + {BLOCK}, N)"]
+            if em.nbuf:
+                batch.append(f"        {', '.join(f'_t{i}' for i in range(em.nbuf))}, = _buf[:, :_e - _s]")
             if self.n:
-                batch.append(f"        {names} = q[:, _s:_e]")
-            # free each temporary after its last use, so the next one reuses its (cache-hot) memory
-            stmts = [(f"{s} = {e}", repl[j][1]) for j, (s, e) in enumerate(temps)]
-            stmts += [(f"out[{k // c}, {k % c}, _s:_e] = {it}", reduced[k]) for k, it in varying]
-            last = {}
-            for j, (_, e) in enumerate(stmts):
-                for sym in e.free_symbols:
-                    last[sym] = j
-            dead: dict[int, list[str]] = {}
-            for s, _ in repl:
-                dead.setdefault(last.get(s, -1), []).append(str(s))
-            for j, (line, _) in enumerate(stmts):
-                batch.append(f"        {line}")
-                if dead.get(j):
-                    batch.append(f"        del {', '.join(dead[j])}")
+                batch.append(f"        {names} = q[_s:_e].T")
+            batch += [f"        {line}" for line in body]
         batch.append("    return out")
 
         self.source = "\n".join(single) + "\n\n" + "\n".join(batch) + "\n"
         ns_single = dict(_MATH, _empty=np.empty, _pack=struct.Struct(f"{size}d").pack_into)
-        ns_batch = dict(_NUMPY, _empty=np.empty)
+        ns_batch = dict(_NUMPY, _empty=np.empty, **_UFUNCS)
         exec(compile("\n".join(single), f"<kinlib {name} single>", "exec"), ns_single)
         exec(compile("\n".join(batch), f"<kinlib {name} batch>", "exec"), ns_batch)
         self._single = ns_single["_single"]
@@ -193,7 +472,7 @@ class CompiledMatrix:
         if arr.ndim == 1 and arr.shape[0] == self.n:
             return self._single(arr.tolist())
         if arr.ndim == 2 and arr.shape[1] == self.n:
-            out = self._batch(np.ascontiguousarray(arr.T))
+            out = self._batch(arr)
             return out.transpose(2, 0, 1)
         raise ValueError(f"q must have shape ({self.n},) or (N, {self.n}) for this {self.n}-joint chain, "
                          f"got {describe(q)}")
