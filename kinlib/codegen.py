@@ -161,6 +161,15 @@ class _BatchEmitter:
     def _release(self, buf: str):
         self.free.append(int(buf[2:]))
 
+    def _add_constant(self, src: str, neg: bool, k: float, dest: str) -> None:
+        """dest = (−src if neg else src) + k, for a nonzero constant k."""
+        if neg:
+            self.lines.append(f"_sub({self._num(k)}, {src}, out={dest})")
+        elif k > 0:
+            self.lines.append(f"_add({src}, {self._num(k)}, out={dest})")
+        else:
+            self.lines.append(f"_sub({src}, {self._num(-k)}, out={dest})")
+
     def _num(self, v) -> str:
         return repr(float(v))
 
@@ -272,29 +281,16 @@ class _BatchEmitter:
             if pending is not None:  # a single term (and maybe a constant)
                 a, acc_neg = pending
                 if const != 0:
-                    k = float(const)
-                    if acc_neg:
-                        self.lines.append(f"_sub({self._num(k)}, {a}, out={dest})")
-                        acc_neg = False
-                    elif k > 0:
-                        self.lines.append(f"_add({a}, {self._num(k)}, out={dest})")
-                    else:
-                        self.lines.append(f"_sub({a}, {self._num(-k)}, out={dest})")
-                    const = sp.S.Zero
+                    self._add_constant(a, acc_neg, float(const), dest)
+                    acc_neg, const = False, sp.S.Zero
                 elif acc_neg and not allow_neg:
                     self.lines.append(f"_neg({a}, out={dest})")
                     acc_neg = False
                 else:
                     self.lines.append(f"{dest}[...] = {a}")
-            if const != 0:
-                k = float(const)
-                if acc_neg:  # dest holds -(sum): value = k - dest
-                    self.lines.append(f"_sub({self._num(k)}, {dest}, out={dest})")
-                    acc_neg = False
-                elif k > 0:
-                    self.lines.append(f"_add({dest}, {self._num(k)}, out={dest})")
-                else:
-                    self.lines.append(f"_sub({dest}, {self._num(-k)}, out={dest})")
+            if const != 0:  # when acc_neg, dest holds −(sum): the value is k − dest
+                self._add_constant(dest, acc_neg, float(const), dest)
+                acc_neg = False
             neg = bool(acc_neg)
         elif isinstance(e, sp.Function) and e.func in _UFUNC_OF and len(e.args) == 1:
             arg, aneg = self._operand(e.args[0], scratch)
