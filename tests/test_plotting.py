@@ -28,12 +28,6 @@ ROBOTS = {
 PLANAR = {"cart_pole", "planar_offset_3r", "planar_3r", "planar_rpp"}
 
 
-@pytest.fixture(autouse=True)
-def _close():
-    yield
-    plt.close("all")
-
-
 @pytest.fixture(scope="module")
 def chains():
     return {k: f() for k, f in ROBOTS.items()}

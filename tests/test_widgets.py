@@ -16,12 +16,6 @@ from kinlib import robots, widgets  # noqa: E402
 PNG = b"\x89PNG"
 
 
-@pytest.fixture(autouse=True)
-def _close():
-    yield
-    plt.close("all")
-
-
 @pytest.fixture(scope="module")
 def r3():
     return robots.planar_offset_3r(1)
