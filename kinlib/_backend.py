@@ -15,7 +15,8 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-__all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe"]
+__all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe", "exact_number",
+           "check_real_finite"]
 
 _ZERO_TOL = 1e-9
 
@@ -36,6 +37,61 @@ def describe(x: Any) -> str:
         return f"a {type(x).__name__} of shape {shape}"
     r = repr(x)
     return f"{type(x).__name__} {r[:60]}"
+
+
+def exact_number(x: Any, name: str) -> sp.Expr:
+    """The exact SymPy number a student meant by ``x``: the one place numbers become exact.
+
+    ints → Integer; floats (Python or NumPy) → the decimal of their shortest repr (0.1 → 1/10,
+    0.425 → 17/40, 2.0 → 2, 1e-3 → 1/1000), never the float's binary expansion and never a guess
+    such as nsimplify; ``fractions.Fraction`` and ``decimal.Decimal`` → the Rational they hold;
+    SymPy Floats likewise by their shortest decimal; other SymPy numbers and expressions unchanged.
+    Refused with a message naming ``name``: bool, str/bytes, None, complex numbers (also SymPy's
+    ``I`` and anything with a nonzero imaginary part), NaN and ±inf (also SymPy's ``nan``, ``oo``, ``zoo``).
+    """
+    import decimal
+    import fractions
+    if isinstance(x, (bool, np.bool_)):
+        raise TypeError(f"{name} must be a real number, got the bool {x!r}")
+    if isinstance(x, (str, bytes)) or x is None:
+        raise TypeError(f"{name} must be a real number or a SymPy expression, got {describe(x)}")
+    if isinstance(x, (complex, np.complexfloating)):
+        raise TypeError(f"{name} must be a real number, got the complex number {x!r}")
+    if isinstance(x, np.generic):
+        x = x.item()
+    if isinstance(x, float):
+        if not np.isfinite(x):
+            raise ValueError(f"{name} must be a finite real number, got {x!r}")
+        return sp.Integer(int(x)) if x.is_integer() else sp.Rational(repr(x))
+    if isinstance(x, int):
+        return sp.Integer(x)
+    if isinstance(x, fractions.Fraction):
+        return sp.Rational(x.numerator, x.denominator)
+    if isinstance(x, decimal.Decimal):
+        if not x.is_finite():
+            raise ValueError(f"{name} must be a finite real number, got {x!r}")
+        return sp.Rational(str(x))
+    if isinstance(x, sp.Basic):
+        if not isinstance(x, sp.Expr):
+            raise TypeError(f"{name} must be a real number or a SymPy expression, got {describe(x)}")
+        if isinstance(x, sp.Float):
+            return exact_number(float(x), name) if x.is_finite else exact_number(float("nan"), name)
+        check_real_finite(x, name)
+        return x
+    raise TypeError(f"{name} must be a real number or a SymPy expression, got {describe(x)}")
+
+
+def check_real_finite(e: sp.Expr, name: str) -> sp.Expr:
+    """Refuse a SymPy expression that is not real and finite (I, nan, oo, zoo, a non-real symbol)."""
+    if e.has(sp.I) or e.has(sp.nan) or e.has(sp.zoo) or e.has(sp.oo) or e.has(-sp.oo):
+        raise ValueError(f"{name} must be real and finite, got {e}")
+    bad = sorted((s for s in e.free_symbols if s.is_real is not True), key=str)
+    if bad:
+        raise ValueError(f"{name} must be real: the symbol(s) {', '.join(map(str, bad))} are not declared real "
+                         f"(use sp.Symbol(..., real=True) or positive=True), got {e}")
+    if e.is_real is False:
+        raise ValueError(f"{name} must be real, got {e}")
+    return e
 
 
 def is_symbolic(*args: Any) -> bool:
