@@ -4,19 +4,14 @@ SymPy's ``Matrix.rank()`` of the symbolic J gives the *generic* rank and hides t
 configuration; and deciding "is this entry zero?" from a float (or by guessing a closed form from one) is
 wrong at angles such as θ = 10 or θ = 1/2. Here every zero test is a proof.
 
-**How.** After substituting the joint values, every entry of J is a number built from sin a and cos a of the
-configuration's angles a, algebraic constants (√2, cos π/7, …) and the positive parameters (link lengths).
-Write each angle as a = r + qπ with r, q rational. Let g > 0 be the largest rational with every r an integer
-multiple n·g of it, and t = tan(g/2). Then
-
-    cos(n g) + i sin(n g) = (1 + i t)^{2n} / (1 + t²)^n,
-
-and cos(qπ), sin(qπ) are algebraic, so every entry is a rational function of t (and of the parameters) with
-algebraic coefficients. For g ≠ 0, t is **transcendental** (Lindemann–Weierstrass: e^{ig} is transcendental
-for algebraic g ≠ 0), so such a rational function vanishes at t = tan(g/2) *if and only if* it is identically
-zero. Rank, pivots and the canonical bases are therefore decided by exact Gaussian elimination in the field
-K(t, L1, L2, …) (K the algebraic numbers involved): no numerics at all. Parameters count as indeterminates: the
-rank found is the rank for all their values except where a stated minor vanishes (see :class:`Rank`).
+**How.** Every zero test is made in the field of :mod:`kinlib.exactfield` (the sines and cosines of the
+configuration's angles written with t = tan(g/2), which is transcendental, so "zero" there is a proof). But
+first, when J has no symbolic parameters, a 60-digit SVD (entries to 100 digits) decides every *nonzero*: a
+singular value above 10⁻²⁰·σ_max is certified nonzero (entries and SVD are accurate to ~10⁻⁵⁵·σ_max, and
+|σ_i(A) − σ_i(Ã)| ≤ ‖A − Ã‖); only a decision "this is zero" (a rank drop, a skipped pivot column, a zero
+entry) is left to exact Gaussian elimination in K(t, L1, L2, …). Parameters count as indeterminates: the
+rank found is the rank for all their positive values except where a stated expression vanishes
+(see :class:`Rank`).
 
 The canonical basis entries (rref) are then written with the configuration's own sines and cosines, as ratios
 of minors (Cramer's rule) of the evaluated J, each minor computed exactly in the polynomial ring of those sines
@@ -34,29 +29,26 @@ decomposition in mpmath with ``FALLBACK_DIGITS`` = 60 significant digits: a sing
 from __future__ import annotations
 
 import itertools
-import math
 import numbers
 import warnings
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 import sympy as sp
-from sympy.polys.constructor import construct_domain
-from sympy.polys.fields import field as _field
 from sympy.polys.matrices import DomainMatrix
 from sympy.simplify.fu import TR10i
 
 from ._backend import describe, exact_number, is_symbolic
 from .display import simplify_for_display
+from .exactfield import (
+    FALLBACK_DIGITS, MAX_MULTIPLE, ExactField, NotExact, decide_zero, exact_is_zero, mp_matrix,
+)
 from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = ["Rank", "NumericFallbackWarning", "ConditionalResultWarning", "evaluate_at", "rank_at",
            "column_space", "left_null_space", "exact_is_zero", "MAX_MULTIPLE", "FALLBACK_DIGITS"]
 
-#: the largest |n| with every angle's rational part n·g, above which the exact method is not used
-MAX_MULTIPLE = 240
-#: significant digits of the numeric fallback, and the relative size below which σ counts as zero there
-FALLBACK_DIGITS = 60
+#: the relative size (10^-40 σ_max) below which the numeric fallback counts a singular value as zero
 FALLBACK_ZERO_DIGITS = 40
 
 
@@ -102,10 +94,6 @@ class Rank(int):
 
 def _make_rank(v, exact, unless, note):
     return Rank(v, exact=exact, unless=unless, note=note)
-
-
-class _NotExact(Exception):
-    """The exact method does not apply (the message says why)."""
 
 
 # ----------------------------------------------------------------------------------------------
@@ -213,244 +201,6 @@ def _as_float(M: sp.Matrix) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------------------
-# the exact field K(t, parameters)
-# ----------------------------------------------------------------------------------------------
-def _angle_parts(a: sp.Expr) -> tuple:
-    """(r, q) with a = r + qπ, both rational; _NotExact otherwise."""
-    if a.free_symbols:
-        raise _NotExact(f"the angle {a} depends on the parameters {', '.join(map(str, a.free_symbols))}")
-    a = sp.expand(a)
-    q = a.coeff(sp.pi)
-    r = sp.expand(a - q * sp.pi)
-    if not (q.is_Rational and r.is_Rational):
-        raise _NotExact(f"the angle {a} is not a rational number plus a rational multiple of π")
-    return r, q
-
-
-def _re_im_power(m: int) -> tuple:
-    """Integer coefficient lists (low degree first) of Re and Im of (1 + i t)^m, m ≥ 0."""
-    re, im = [0] * (m + 1), [0] * (m + 1)
-    for k in range(m + 1):
-        c = math.comb(m, k)
-        if k % 2 == 0:
-            re[k] = c if k % 4 == 0 else -c
-        else:
-            im[k] = c if k % 4 == 1 else -c
-    return re, im
-
-
-class _Field:
-    """The entries of an evaluated matrix as elements of K(t, params) (see the module docstring)."""
-
-    def __init__(self, exprs: list):
-        exprs = [e.rewrite(sp.cos, sp.sin) if e.has(sp.tan, sp.cot, sp.sec, sp.csc) else e for e in exprs]
-        trig = set()
-        for e in exprs:
-            trig |= e.atoms(sp.sin, sp.cos)
-        parts = {}
-        for f in trig:
-            parts[f] = _angle_parts(f.args[0])
-        rs = [r for r, _ in parts.values() if r != 0]
-        if rs:
-            g = sp.Rational(math.gcd(*[int(r.p) for r in rs]), math.lcm(*[int(r.q) for r in rs]))
-        else:
-            g = sp.S.Zero
-        self.g = g
-        self.multiples = {f: (int(r / g) if r != 0 else 0, q) for f, (r, q) in parts.items()}
-        biggest = max((abs(n) for n, _ in self.multiples.values()), default=0)
-        if biggest > MAX_MULTIPLE:
-            raise _NotExact(f"the angles are {biggest} multiples of their common measure {g} apart "
-                            f"(the exact method goes up to {MAX_MULTIPLE})")
-        self.params = sorted(set().union(*[e.free_symbols for e in exprs]), key=str) if exprs else []
-        # algebraic constants: cos qπ, sin qπ of every angle, and every other constant in the entries
-        consts = set()
-        for n, q in self.multiples.values():
-            consts |= {sp.cos(q * sp.pi), sp.sin(q * sp.pi)}
-        repl = {f: sp.Dummy() for f in trig}
-
-        extra = set()
-
-        def algebraic(c) -> bool:
-            for f in c.atoms(sp.Function):
-                if not (isinstance(f, (sp.sin, sp.cos)) and (f.args[0] / sp.pi).is_Rational):
-                    return False
-            bare = c.xreplace({f: sp.Dummy() for f in c.atoms(sp.sin, sp.cos)})
-            return not bare.has(sp.pi, sp.E) and all(not p.is_Pow or p.exp.is_Rational
-                                                     for p in sp.preorder_traversal(bare) if isinstance(p, sp.Basic))
-
-        def scan(x):
-            if x.is_Rational or x in repl or x.is_Symbol:
-                return
-            if x is sp.pi or x is sp.E:
-                if g != 0:
-                    raise _NotExact(f"the constant {x} appears next to the transcendental sin/cos of {g}")
-                extra.add(x)
-            elif x.is_Add or x.is_Mul:
-                for arg in x.args:
-                    scan(arg)
-            elif x.is_Pow and x.exp.is_Integer:
-                scan(x.base)
-            elif x.is_number and algebraic(x):
-                consts.add(x)
-            else:
-                raise _NotExact(f"the entry part {x} is not a rational function of sines and cosines, algebraic "
-                                "numbers and parameters")
-
-        for e in exprs:
-            scan(e)
-        self.extra = sorted(extra, key=str)             # π, e: generators (transcendental; no trig angle then)
-        algebraic_consts = sorted((c for c in consts if not c.is_Rational), key=sp.default_sort_key)
-        if algebraic_consts:
-            K, _ = construct_domain(algebraic_consts, extension=True)
-            if K.is_EX:
-                raise _NotExact(f"the constants {algebraic_consts} are not algebraic numbers SymPy can do arithmetic with")
-        else:
-            K = sp.QQ
-        self.K = K
-        self.t = sp.Dummy("t")
-        gens = [self.t] + self.extra + self.params
-        self.F, *self.gens = _field(gens, K)
-        self.domain = self.F.to_domain()
-        self._gen = dict(zip(self.extra + self.params, self.gens[1:]))
-        ring = self.F.ring
-        self.ring = ring
-        tt = ring.gens[0]
-        self.one_t2 = 1 + tt ** 2
-        self._pow_cache = {0: ring.one}
-        self._atom = {}
-        cache = {}
-        for f, (n, q) in self.multiples.items():
-            m = abs(n)
-            if m not in cache:
-                re, im = _re_im_power(2 * m)
-                cache[m] = (sum((c * tt ** k for k, c in enumerate(re) if c), ring.zero),
-                            sum((c * tt ** k for k, c in enumerate(im) if c), ring.zero))
-            cn, sn = cache[m]
-            sn = sn if n >= 0 else -sn
-            cq, sq = self._kconst(sp.cos(q * sp.pi)), self._kconst(sp.sin(q * sp.pi))
-            num = cn * cq - sn * sq if isinstance(f, sp.cos) else sn * cq + cn * sq
-            self._atom[f] = (num, m)          # cos/sin(a) = num / (1 + t²)^m
-        self._memo = {}
-
-    def _kconst(self, c):
-        return self.ring(self.K.convert(c) if c.is_Rational else self.K.from_sympy(c))
-
-    def _lift(self, pair, e: int):
-        num, k = pair
-        if e == k:
-            return num
-        d = e - k
-        if d not in self._pow_cache:
-            self._pow_cache[d] = self.one_t2 ** d
-        return num * self._pow_cache[d]
-
-    def pair(self, e: sp.Expr):
-        """e = num / (1 + t²)^k as (num ∈ K[t, params], k); _NotExact for a negative power of a non-constant
-        (then :meth:`convert` works in the fraction field)."""
-        if e.has(sp.tan, sp.cot, sp.sec, sp.csc):
-            e = e.rewrite(sp.cos, sp.sin)
-        memo, R = self._memo, self.ring
-
-        def conv(x):
-            if x in memo:
-                return memo[x]
-            if x in self._atom:
-                out = self._atom[x]
-            elif x in self._gen:
-                out = (R(self._gen[x].numer), 0)
-            elif x.is_Rational or (x.is_number and not x.has(*self._atom) and not x.has(*self._gen)):
-                out = (self._kconst(x), 0)
-            elif x.is_Add:
-                parts = [conv(a) for a in x.args]
-                k = max(p[1] for p in parts)
-                out = (sum((self._lift(p, k) for p in parts), R.zero), k)
-            elif x.is_Mul:
-                num, k = R.one, 0
-                for a in x.args:
-                    pn, pk = conv(a)
-                    num, k = num * pn, k + pk
-                out = (num, k)
-            elif x.is_Pow and x.exp.is_Integer and x.exp >= 0:
-                pn, pk = conv(x.base)
-                out = (pn ** int(x.exp), pk * int(x.exp))
-            elif x.is_Pow and x.exp.is_Integer and x.base.is_number and not x.base.has(*self._atom):
-                out = (self._kconst(x), 0)
-            else:
-                raise _NotExact(f"{x} is not a polynomial")
-            memo[x] = out
-            return out
-
-        return conv(e)
-
-    def convert(self, e: sp.Expr):
-        """e as an element of the fraction field K(t, params)."""
-        try:
-            num, k = self.pair(e)
-            return self.F(num) / self.F(self.one_t2) ** k if k else self.F(num)
-        except _NotExact:
-            pass
-        if e.has(sp.tan, sp.cot, sp.sec, sp.csc):
-            e = e.rewrite(sp.cos, sp.sin)
-        if e.is_Add:
-            return sum((self.convert(a) for a in e.args), self.F.zero)
-        if e.is_Mul:
-            out = self.F.one
-            for a in e.args:
-                out *= self.convert(a)
-            return out
-        if e.is_Pow and e.exp.is_Integer:
-            return self.convert(e.base) ** int(e.exp)
-        raise _NotExact(f"cannot convert {e}")  # pragma: no cover - scan() refused it already
-
-    def matrix(self, M: sp.Matrix) -> DomainMatrix:
-        """M over the polynomial ring K[t, params]: each row multiplied by the lcm of its denominators (a
-        nonzero factor: powers of 1 + t² and of the parameters), which changes neither the rank nor the
-        pivots nor the row space."""
-        ring = self.ring
-        rows = []
-        for i in range(M.rows):
-            try:
-                pairs = [self.pair(M[i, j]) for j in range(M.cols)]
-                k = max(p[1] for p in pairs)
-                rows.append([self._lift(p, k) for p in pairs])
-                continue
-            except _NotExact:
-                pass
-            elems = [self.convert(M[i, j]) for j in range(M.cols)]
-            den = ring.one
-            for e in elems:
-                den = den.lcm(e.denom)
-            rows.append([e.numer * den.exquo(e.denom) for e in elems])
-        return DomainMatrix(rows, M.shape, ring.to_domain())
-
-    def field_matrix(self, M: sp.Matrix) -> DomainMatrix:
-        return DomainMatrix([[self.convert(M[i, j]) for j in range(M.cols)] for i in range(M.rows)],
-                            M.shape, self.domain)
-
-
-def exact_is_zero(e: Any) -> bool:
-    """Whether the number (or expression in positive parameters) e is exactly 0, proved.
-
-    e may hold sin and cos of angles r + qπ (r, q rational), algebraic numbers and positive parameters; it is
-    written in the field K(tan(g/2), params) of the module docstring, where "zero" is decided exactly.
-    Raises ValueError when e is outside that class (then no exact decision is made).
-
-    >>> import sympy as sp
-    >>> exact_is_zero(sp.sin(3)**2 + sp.cos(3)**2 - 1), exact_is_zero(sp.sin(10) - 2*sp.sin(5)*sp.cos(5))
-    (True, True)
-    >>> exact_is_zero(sp.sin(sp.Rational(1, 2)) - sp.Rational(479, 1000))
-    False
-    """
-    e = sp.sympify(e)
-    if e == 0:
-        return True
-    try:
-        return not _Field([e]).convert(e)
-    except _NotExact as err:
-        raise ValueError(f"no exact zero test for {e}: {err}") from None
-
-
-# ----------------------------------------------------------------------------------------------
 # exact rank and canonical bases
 # ----------------------------------------------------------------------------------------------
 def _ring_det(A: sp.Matrix) -> sp.Expr:
@@ -547,7 +297,7 @@ class _Analysis:
         self.A = A
         self._fld = None
         if not A.free_symbols:
-            X = _mp_matrix(A)
+            X = mp_matrix(A)
             import mpmath
             with mpmath.workdps(FALLBACK_DIGITS):
                 top = max((abs(x) for x in mpmath.svd_r(X, compute_uv=False)), default=mpmath.mpf(0))
@@ -567,30 +317,16 @@ class _Analysis:
         self.rows = list(rows)
 
     @property
-    def fld(self) -> _Field:
+    def fld(self) -> ExactField:
         if self._fld is None:
-            self._fld = _Field(list(self.A))
+            self._fld = ExactField(list(self.A))
         return self._fld
 
     def entry_is_zero(self, k: int, j: int, expr) -> bool:
         """Whether rref(A)[k, j] is 0; ``expr()`` gives its numerator (a minor) when it must be computed."""
         if self.R is not None:
             return not self.R[k][j]
-        return _decide_zero(expr())
-
-
-def _decide_zero(e: sp.Expr) -> bool:
-    """e = 0? A 60-digit value above 1e-30 proves nonzero (SymPy's evalf tracks cancellation); otherwise exactly."""
-    if e == 0:
-        return True
-    if e.is_Rational:
-        return False
-    if not e.free_symbols:
-        import mpmath
-        with mpmath.workdps(FALLBACK_DIGITS + 40):
-            if abs(_mp_value(e, {})) > mpmath.mpf(10) ** -30:
-                return False
-    return not _Field([e]).convert(e)
+        return decide_zero(expr())
 
 
 def _canonical_rows(A: sp.Matrix, an: _Analysis) -> sp.Matrix:
@@ -620,7 +356,7 @@ def _canonical_rows(A: sp.Matrix, an: _Analysis) -> sp.Matrix:
     return out
 
 
-def _never_zero(factor: sp.Expr, fld: _Field) -> bool:
+def _never_zero(factor: sp.Expr, fld: ExactField) -> bool:
     """True when the factor (an expression in the positive parameters with exact-number coefficients) is nonzero
     for every positive value of the parameters: written as a polynomial in them, all its coefficients (numbers,
     evaluated at the true t with 50 digits) share one strict sign. A nonzero polynomial in the transcendental t is
@@ -689,48 +425,9 @@ def _conditions(A: sp.Matrix, an: _Analysis) -> tuple:
 # ----------------------------------------------------------------------------------------------
 # the numeric fallback (stated precision)
 # ----------------------------------------------------------------------------------------------
-def _mp_value(e: sp.Expr, memo: dict):
-    """e to ``FALLBACK_DIGITS + 40`` digits (call inside mpmath.workdps), shared subexpressions evaluated once."""
-    import mpmath
-    if e in memo:
-        return memo[e]
-    if e.is_Rational:
-        v = mpmath.mpf(e.p) / e.q
-    elif e is sp.pi:
-        v = +mpmath.pi
-    elif e is sp.E:
-        v = mpmath.e
-    elif e.is_Add:
-        v = mpmath.fsum(_mp_value(a, memo) for a in e.args)
-    elif e.is_Mul:
-        v = mpmath.fprod(_mp_value(a, memo) for a in e.args)
-    elif e.is_Pow and e.exp.is_Rational:
-        b = _mp_value(e.base, memo)
-        v = b ** int(e.exp) if e.exp.is_Integer else b ** (mpmath.mpf(e.exp.p) / e.exp.q)
-    elif isinstance(e, sp.sin):
-        v = mpmath.sin(_mp_value(e.args[0], memo))
-    elif isinstance(e, sp.cos):
-        v = mpmath.cos(_mp_value(e.args[0], memo))
-    else:
-        v = mpmath.mpf(str(sp.N(e, mpmath.mp.dps)))
-    memo[e] = v
-    return v
-
-
-def _mp_matrix(A: sp.Matrix):
-    """A as an mpmath matrix, entries to ~100 digits (the SVD then runs at ``FALLBACK_DIGITS``)."""
-    import mpmath
-    if A.free_symbols:
-        raise ValueError("no exact decision is possible here and the numeric fallback needs numbers: J still has "
-                         f"the parameters {', '.join(map(str, sorted(A.free_symbols, key=str)))}; substitute them")
-    memo: dict = {}
-    with mpmath.workdps(FALLBACK_DIGITS + 40):
-        return mpmath.matrix([[_mp_value(A[i, j], memo) for j in range(A.cols)] for i in range(A.rows)])
-
-
 def _fallback_rank(A: sp.Matrix) -> tuple:
     import mpmath
-    X = _mp_matrix(A)
+    X = mp_matrix(A)
     with mpmath.workdps(FALLBACK_DIGITS):
         s = mpmath.svd_r(X, compute_uv=False)
         sv = sorted((abs(x) for x in s), reverse=True)
@@ -743,7 +440,7 @@ def _fallback_rank(A: sp.Matrix) -> tuple:
 def _fallback_rref(A: sp.Matrix) -> sp.Matrix:
     """Nonzero rows of rref(A), 60-digit arithmetic with partial pivoting, entries as 30-digit Floats."""
     import mpmath
-    X = _mp_matrix(A)
+    X = mp_matrix(A)
     r, sv = _fallback_rank(A)
     with mpmath.workdps(FALLBACK_DIGITS):
         m, n = X.rows, X.cols
@@ -839,8 +536,8 @@ def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = N
     if numeric:
         return _as_float(M)
     try:
-        zero = [_decide_zero(e) for e in M]
-    except _NotExact:
+        zero = [decide_zero(e) for e in M]
+    except NotExact:
         zero = [e == 0 for e in M]
     return sp.Matrix(M.rows, M.cols, [sp.S.Zero if z else _display(e) for e, z in zip(M, zero)])
 
@@ -849,17 +546,17 @@ def _analyse(M: sp.Matrix, what: str):
     """(_Analysis or None, reason): the exact analysis, or None with the reason it is out of reach."""
     try:
         return _Analysis(M), ""
-    except _NotExact as err:
+    except NotExact as err:
         return None, str(err)
 
 
 def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None) -> int:
     """rank J(θ₀) at a configuration, proved exactly (see the module docstring); a :class:`Rank` (an int).
 
-    ``subs`` as in :func:`evaluate_at` (float values: a float SVD, ``Rank.exact`` False). With symbolic link lengths the rank holds for all their positive values,
+    ``subs`` as in :func:`evaluate_at` (float values: a float SVD, and a plain int). With symbolic link lengths the rank holds for all their positive values,
     or ``Rank.unless`` names the minor whose vanishing would lower it. Out of reach of the exact method (e.g. an
-    angle √2), a 60-digit SVD decides and ``Rank.exact`` is False. A numeric J (float array, no subs): the
-    SVD with tolerance 100·max(m, n)·ε·σ_max.
+    angle √2), a 60-digit SVD decides and ``Rank.exact`` is False. A numeric J (float array, no subs) or float
+    joint values: the float SVD with tolerance 100·max(m, n)·ε·σ_max, a plain int.
 
     >>> import sympy as sp
     >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
@@ -870,8 +567,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None)
     if _is_numeric_input(J, subs):
         A = _numeric_J(J)
         s = np.linalg.svd(A, compute_uv=False)
-        return Rank(int(np.sum(s > _numeric_rank_tol(s, A.shape))), exact=False,
-                    note="float SVD, tolerance 100·max(m, n)·ε·σ_max")
+        return int(np.sum(s > _numeric_rank_tol(s, A.shape)))   # numbers in, a number out
     M, numeric = _evaluated(J, subs, thetas)
     if numeric:
         return rank_at(_as_float(M))

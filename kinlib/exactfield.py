@@ -1,0 +1,373 @@
+"""Exact numbers at a configuration: the field K(tan(g/2), parameters) in which "is it zero?" is a proof.
+
+After substituting the joint values, every entry of a Jacobian is a number built from sin a and cos a of the
+configuration's angles a, algebraic constants (√2, cos π/7, …) and the positive parameters (link lengths).
+Write each angle as a = r + qπ with r, q rational. Let g > 0 be the largest rational with every r an integer
+multiple n·g of it, and t = tan(g/2). Then
+
+    cos(n g) + i sin(n g) = (1 + i t)^{2n} / (1 + t²)^n,
+
+and cos(qπ), sin(qπ) are algebraic, so every entry is a rational function of t (and of the parameters) with
+coefficients in an algebraic number field K. For g ≠ 0, t is **transcendental** (Lindemann–Weierstrass:
+e^{ig} is transcendental for algebraic g ≠ 0), so such a rational function vanishes at t = tan(g/2) *if and
+only if* it is identically zero: exact arithmetic in K(t, L1, L2, …) decides every zero test.
+:class:`ExactField` does the conversion (numerators over powers of 1 + t², no rational-function gcds);
+:class:`NotExact` says when a number is outside this class (an angle √2, a constant π next to a
+transcendental angle, angles more than ``MAX_MULTIPLE`` common measures apart).
+
+:func:`mp_value` evaluates such numbers to ``FALLBACK_DIGITS + 40`` digits (shared subexpressions once), for the
+certified numerics of :mod:`kinlib.exact`.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import sympy as sp
+from sympy.polys.constructor import construct_domain
+from sympy.polys.fields import field as _field
+from sympy.polys.matrices import DomainMatrix
+
+__all__ = ["ExactField", "NotExact", "exact_is_zero", "decide_zero", "mp_value", "mp_matrix",
+           "MAX_MULTIPLE", "FALLBACK_DIGITS"]
+
+#: the largest |n| with every angle's rational part n·g, above which the exact method is not used
+MAX_MULTIPLE = 240
+#: significant digits of the numeric fallback and of the certified numerics
+FALLBACK_DIGITS = 60
+
+
+class NotExact(ValueError):
+    """The exact method does not apply to these numbers (the message says why)."""
+
+
+
+# ----------------------------------------------------------------------------------------------
+# the exact field K(t, parameters)
+# ----------------------------------------------------------------------------------------------
+def _angle_parts(a: sp.Expr) -> tuple:
+    """(r, q) with a = r + qπ, both rational; NotExact otherwise."""
+    if a.free_symbols:
+        raise NotExact(f"the angle {a} depends on the parameters {', '.join(map(str, a.free_symbols))}")
+    a = sp.expand(a)
+    q = a.coeff(sp.pi)
+    r = sp.expand(a - q * sp.pi)
+    if not (q.is_Rational and r.is_Rational):
+        raise NotExact(f"the angle {a} is not a rational number plus a rational multiple of π")
+    return r, q
+
+
+def _re_im_power(m: int) -> tuple:
+    """Integer coefficient lists (low degree first) of Re and Im of (1 + i t)^m, m ≥ 0."""
+    re, im = [0] * (m + 1), [0] * (m + 1)
+    for k in range(m + 1):
+        c = math.comb(m, k)
+        if k % 2 == 0:
+            re[k] = c if k % 4 == 0 else -c
+        else:
+            im[k] = c if k % 4 == 1 else -c
+    return re, im
+
+
+class ExactField:
+    """Exact numbers (and expressions in positive parameters) at a configuration as elements of K(t, params).
+
+    ``ExactField(exprs)`` finds the angles, g, K and the parameters of ``exprs`` (raises :class:`NotExact` when
+    they are outside the class of the module docstring); ``convert(e)`` is e in the fraction field (zero exactly
+    when e is zero), ``pair(e)`` its numerator over a power of 1 + t², ``matrix(M)`` M over K[t, params] with each
+    row's denominators cleared (same rank, pivots and row space).
+
+    >>> import sympy as sp
+    >>> f = ExactField([sp.sin(10), sp.cos(sp.Rational(1, 2))])
+    >>> f.g, f.multiples[sp.sin(10)]
+    (1/2, (20, 0))
+    >>> f.convert(sp.sin(10) - 2 * sp.sin(5) * sp.cos(5)) == 0
+    True
+    """
+
+    def __init__(self, exprs: list):
+        exprs = [e.rewrite(sp.cos, sp.sin) if e.has(sp.tan, sp.cot, sp.sec, sp.csc) else e for e in exprs]
+        trig = set()
+        for e in exprs:
+            trig |= e.atoms(sp.sin, sp.cos)
+        parts = {}
+        for f in trig:
+            parts[f] = _angle_parts(f.args[0])
+        rs = [r for r, _ in parts.values() if r != 0]
+        if rs:
+            g = sp.Rational(math.gcd(*[int(r.p) for r in rs]), math.lcm(*[int(r.q) for r in rs]))
+        else:
+            g = sp.S.Zero
+        self.g = g
+        self.multiples = {f: (int(r / g) if r != 0 else 0, q) for f, (r, q) in parts.items()}
+        biggest = max((abs(n) for n, _ in self.multiples.values()), default=0)
+        if biggest > MAX_MULTIPLE:
+            raise NotExact(f"the angles are {biggest} multiples of their common measure {g} apart "
+                            f"(the exact method goes up to {MAX_MULTIPLE})")
+        self.params = sorted(set().union(*[e.free_symbols for e in exprs]), key=str) if exprs else []
+        # algebraic constants: cos qπ, sin qπ of every angle, and every other constant in the entries
+        consts = set()
+        for n, q in self.multiples.values():
+            consts |= {sp.cos(q * sp.pi), sp.sin(q * sp.pi)}
+        repl = {f: sp.Dummy() for f in trig}
+
+        extra = set()
+
+        def algebraic(c) -> bool:
+            for f in c.atoms(sp.Function):
+                if not (isinstance(f, (sp.sin, sp.cos)) and (f.args[0] / sp.pi).is_Rational):
+                    return False
+            bare = c.xreplace({f: sp.Dummy() for f in c.atoms(sp.sin, sp.cos)})
+            return not bare.has(sp.pi, sp.E) and all(not p.is_Pow or p.exp.is_Rational
+                                                     for p in sp.preorder_traversal(bare) if isinstance(p, sp.Basic))
+
+        def scan(x):
+            if x.is_Rational or x in repl or x.is_Symbol:
+                return
+            if x is sp.pi or x is sp.E:
+                if g != 0:
+                    raise NotExact(f"the constant {x} appears next to the transcendental sin/cos of {g}")
+                extra.add(x)
+            elif x.is_Add or x.is_Mul:
+                for arg in x.args:
+                    scan(arg)
+            elif x.is_Pow and x.exp.is_Integer:
+                scan(x.base)
+            elif x.is_number and algebraic(x):
+                consts.add(x)
+            else:
+                raise NotExact(f"the entry part {x} is not a rational function of sines and cosines, algebraic "
+                                "numbers and parameters")
+
+        for e in exprs:
+            scan(e)
+        self.extra = sorted(extra, key=str)             # π, e: generators (transcendental; no trig angle then)
+        algebraic_consts = sorted((c for c in consts if not c.is_Rational), key=sp.default_sort_key)
+        if algebraic_consts:
+            K, _ = construct_domain(algebraic_consts, extension=True)
+            if K.is_EX:
+                raise NotExact(f"the constants {algebraic_consts} are not algebraic numbers SymPy can do arithmetic with")
+        else:
+            K = sp.QQ
+        self.K = K
+        self.t = sp.Dummy("t")
+        gens = [self.t] + self.extra + self.params
+        self.F, *self.gens = _field(gens, K)
+        self.domain = self.F.to_domain()
+        self._gen = dict(zip(self.extra + self.params, self.gens[1:]))
+        ring = self.F.ring
+        self.ring = ring
+        tt = ring.gens[0]
+        self.one_t2 = 1 + tt ** 2
+        self._pow_cache = {0: ring.one}
+        self._atom = {}
+        self._powers: dict = {}
+        for f, (n, q) in self.multiples.items():
+            self._atom[f] = self._trig(f, n, q)
+        self._memo = {}
+
+    def _trig(self, f, n: int, q) -> tuple:
+        """cos/sin(n g + qπ) = num / (1 + t²)^|n| as (num, |n|)."""
+        m, tt = abs(n), self.ring.gens[0]
+        if m not in self._powers:
+            re, im = _re_im_power(2 * m)
+            self._powers[m] = (sum((c * tt ** k for k, c in enumerate(re) if c), self.ring.zero),
+                               sum((c * tt ** k for k, c in enumerate(im) if c), self.ring.zero))
+        cn, sn = self._powers[m]
+        sn = sn if n >= 0 else -sn
+        cq, sq = self._kconst(sp.cos(q * sp.pi)), self._kconst(sp.sin(q * sp.pi))
+        return (cn * cq - sn * sq if isinstance(f, sp.cos) else sn * cq + cn * sq), m
+
+    def _new_atom(self, f) -> tuple:
+        """A sine or cosine the field was not built from: fine when its angle is a multiple of g (plus qπ with
+        cos qπ, sin qπ in K); NotExact otherwise."""
+        r, q = _angle_parts(f.args[0])
+        n = r / self.g if self.g != 0 else (sp.S.Zero if r == 0 else sp.S.Half)
+        if not n.is_Integer or abs(n) > MAX_MULTIPLE:
+            raise NotExact(f"{f} is not on the angle lattice of this field (multiples of {self.g})")
+        try:
+            out = self._trig(f, int(n), q)
+        except Exception as err:
+            raise NotExact(f"cos/sin of {q}π is outside the constants of this field") from err
+        self._atom[f] = out
+        return out
+
+    def _kconst(self, c):
+        return self.ring(self.K.convert(c) if c.is_Rational else self.K.from_sympy(c))
+
+    def __repr__(self) -> str:
+        return f"ExactField(t = tan({self.g}/2), K = {self.K}, parameters {list(self.params)})"
+
+    def _lift(self, pair, e: int):
+        num, k = pair
+        if e == k:
+            return num
+        d = e - k
+        if d not in self._pow_cache:
+            self._pow_cache[d] = self.one_t2 ** d
+        return num * self._pow_cache[d]
+
+    def pair(self, e: sp.Expr):
+        """e = num / (1 + t²)^k as (num ∈ K[t, params], k); NotExact for a negative power of a non-constant
+        (then :meth:`convert` works in the fraction field)."""
+        if e.has(sp.tan, sp.cot, sp.sec, sp.csc):
+            e = e.rewrite(sp.cos, sp.sin)
+        memo, R = self._memo, self.ring
+
+        def conv(x):
+            if x in memo:
+                return memo[x]
+            if x in self._atom:
+                out = self._atom[x]
+            elif x in self._gen:
+                out = (R(self._gen[x].numer), 0)
+            elif isinstance(x, (sp.sin, sp.cos)):
+                out = self._new_atom(x)
+            elif x.is_Rational or (x.is_number and not x.has(sp.sin, sp.cos) and not x.has(*self._gen)):
+                try:
+                    out = (self._kconst(x), 0)
+                except Exception as err:
+                    raise NotExact(f"the constant {x} is outside the constants of this field") from err
+            elif x.is_Add:
+                parts = [conv(a) for a in x.args]
+                k = max(p[1] for p in parts)
+                out = (sum((self._lift(p, k) for p in parts), R.zero), k)
+            elif x.is_Mul:
+                num, k = R.one, 0
+                for a in x.args:
+                    pn, pk = conv(a)
+                    num, k = num * pn, k + pk
+                out = (num, k)
+            elif x.is_Pow and x.exp.is_Integer and x.exp >= 0:
+                pn, pk = conv(x.base)
+                out = (pn ** int(x.exp), pk * int(x.exp))
+            elif x.is_Pow and x.exp.is_Integer and x.base.is_number and not x.base.has(*self._atom):
+                out = (self._kconst(x), 0)
+            else:
+                raise NotExact(f"{x} is not a polynomial")
+            memo[x] = out
+            return out
+
+        return conv(e)
+
+    def convert(self, e: sp.Expr):
+        """e as an element of the fraction field K(t, params)."""
+        try:
+            num, k = self.pair(e)
+            return self.F(num) / self.F(self.one_t2) ** k if k else self.F(num)
+        except NotExact:
+            pass
+        if e.has(sp.tan, sp.cot, sp.sec, sp.csc):
+            e = e.rewrite(sp.cos, sp.sin)
+        if e.is_Add:
+            return sum((self.convert(a) for a in e.args), self.F.zero)
+        if e.is_Mul:
+            out = self.F.one
+            for a in e.args:
+                out *= self.convert(a)
+            return out
+        if e.is_Pow and e.exp.is_Integer:
+            return self.convert(e.base) ** int(e.exp)
+        raise NotExact(f"cannot convert {e}")  # pragma: no cover - scan() refused it already
+
+    def matrix(self, M: sp.Matrix) -> DomainMatrix:
+        """M over the polynomial ring K[t, params]: each row multiplied by the lcm of its denominators (a
+        nonzero factor: powers of 1 + t² and of the parameters), which changes neither the rank nor the
+        pivots nor the row space."""
+        ring = self.ring
+        rows = []
+        for i in range(M.rows):
+            try:
+                pairs = [self.pair(M[i, j]) for j in range(M.cols)]
+                k = max(p[1] for p in pairs)
+                rows.append([self._lift(p, k) for p in pairs])
+                continue
+            except NotExact:
+                pass
+            elems = [self.convert(M[i, j]) for j in range(M.cols)]
+            den = ring.one
+            for e in elems:
+                den = den.lcm(e.denom)
+            rows.append([e.numer * den.exquo(e.denom) for e in elems])
+        return DomainMatrix(rows, M.shape, ring.to_domain())
+
+    def field_matrix(self, M: sp.Matrix) -> DomainMatrix:
+        return DomainMatrix([[self.convert(M[i, j]) for j in range(M.cols)] for i in range(M.rows)],
+                            M.shape, self.domain)
+
+
+def exact_is_zero(e: Any) -> bool:
+    """Whether the number (or expression in positive parameters) e is exactly 0, proved.
+
+    e may hold sin and cos of angles r + qπ (r, q rational), algebraic numbers and positive parameters; it is
+    written in the field K(tan(g/2), params) of the module docstring, where "zero" is decided exactly.
+    Raises ValueError when e is outside that class (then no exact decision is made).
+
+    >>> import sympy as sp
+    >>> exact_is_zero(sp.sin(3)**2 + sp.cos(3)**2 - 1), exact_is_zero(sp.sin(10) - 2*sp.sin(5)*sp.cos(5))
+    (True, True)
+    >>> exact_is_zero(sp.sin(sp.Rational(1, 2)) - sp.Rational(479, 1000))
+    False
+    """
+    e = sp.sympify(e)
+    if e == 0:
+        return True
+    try:
+        return not ExactField([e]).convert(e)
+    except NotExact as err:
+        raise ValueError(f"no exact zero test for {e}: {err}") from None
+
+
+
+def decide_zero(e: sp.Expr) -> bool:
+    """e = 0? A 60-digit value above 1e-30 proves nonzero (SymPy's evalf tracks cancellation); otherwise exactly."""
+    if e == 0:
+        return True
+    if e.is_Rational:
+        return False
+    if not e.free_symbols:
+        import mpmath
+        with mpmath.workdps(FALLBACK_DIGITS + 40):
+            if abs(mp_value(e, {})) > mpmath.mpf(10) ** -30:
+                return False
+    return not ExactField([e]).convert(e)
+
+
+
+def mp_value(e: sp.Expr, memo: dict):
+    """e to ``FALLBACK_DIGITS + 40`` digits (call inside mpmath.workdps), shared subexpressions evaluated once."""
+    import mpmath
+    if e in memo:
+        return memo[e]
+    if e.is_Rational:
+        v = mpmath.mpf(e.p) / e.q
+    elif e is sp.pi:
+        v = +mpmath.pi
+    elif e is sp.E:
+        v = mpmath.e
+    elif e.is_Add:
+        v = mpmath.fsum(mp_value(a, memo) for a in e.args)
+    elif e.is_Mul:
+        v = mpmath.fprod(mp_value(a, memo) for a in e.args)
+    elif e.is_Pow and e.exp.is_Rational:
+        b = mp_value(e.base, memo)
+        v = b ** int(e.exp) if e.exp.is_Integer else b ** (mpmath.mpf(e.exp.p) / e.exp.q)
+    elif isinstance(e, sp.sin):
+        v = mpmath.sin(mp_value(e.args[0], memo))
+    elif isinstance(e, sp.cos):
+        v = mpmath.cos(mp_value(e.args[0], memo))
+    else:
+        v = mpmath.mpf(str(sp.N(e, mpmath.mp.dps)))
+    memo[e] = v
+    return v
+
+
+def mp_matrix(A: sp.Matrix):
+    """A as an mpmath matrix, entries to ~100 digits (the SVD then runs at ``FALLBACK_DIGITS``)."""
+    import mpmath
+    if A.free_symbols:
+        raise ValueError("no exact decision is possible here and the numeric fallback needs numbers: J still has "
+                         f"the parameters {', '.join(map(str, sorted(A.free_symbols, key=str)))}; substitute them")
+    memo: dict = {}
+    with mpmath.workdps(FALLBACK_DIGITS + 40):
+        return mpmath.matrix([[mp_value(A[i, j], memo) for j in range(A.cols)] for i in range(A.rows)])
