@@ -18,9 +18,10 @@ of minors (Cramer's rule) of the evaluated J, each minor computed exactly in the
 and cosines (:class:`kinlib.trigpoly.TrigRing`) and folded for display.
 
 **Where an exact decision is out of reach** (an angle that is not a rational plus a rational multiple of π,
-such as √2; angles whose ratio has a numerator or denominator above ``MAX_MULTIPLE``; a constant such as π or e
-entering polynomially alongside a transcendental angle), the rank is computed from a singular value
-decomposition in mpmath with ``FALLBACK_DIGITS`` = 60 significant digits: a singular value above
+such as √2; a constant such as π or e entering polynomially alongside a transcendental angle; a rank drop at
+angles so far apart in units of their common measure g that elimination would take minutes, i.e.
+(largest multiple) × min(m, n) > ``EXACT_BUDGET`` = 100, e.g. 1/7 next to 3 on a 6×6 J), the rank is
+computed from a singular value decomposition in mpmath with ``FALLBACK_DIGITS`` = 60 significant digits: a singular value above
 ``10^-FALLBACK_ZERO_DIGITS`` · σ_max (10^-40) is certified nonzero (each entry is accurate to 60 digits and
 |σ_i(A) − σ_i(Ã)| ≤ ‖A − Ã‖), one below is reported as numerically zero, *not proven*. The result says so
 (``Rank.exact`` is False and ``Rank.note`` states the precision; the bases come with a
@@ -50,6 +51,9 @@ __all__ = ["Rank", "NumericFallbackWarning", "ConditionalResultWarning", "evalua
 
 #: the relative size (10^-40 σ_max) below which the numeric fallback counts a singular value as zero
 FALLBACK_ZERO_DIGITS = 40
+#: exact elimination only while (largest multiple n of the common angle measure g) × min(m, n) ≤ this
+#: (a 6×6 J: multiples up to 16, a few seconds; beyond, the 60-digit fallback answers, and says so)
+EXACT_BUDGET = 100
 
 
 class NumericFallbackWarning(UserWarning):
@@ -309,6 +313,10 @@ class _Analysis:
                         self.pivots, self.rows, self.rank, self.R = piv, rows, len(piv), None
                         return
         fld = self.fld
+        size = max((abs(n) for n, _ in fld.multiples.values()), default=0) * min(A.shape)
+        if size > EXACT_BUDGET:
+            raise NotExact(f"exact elimination with angles up to {size // min(A.shape)} multiples of their common "
+                           f"measure {fld.g} on a {A.rows}×{A.cols} matrix is out of reach in seconds")
         dA = fld.matrix(A).to_field()
         self.R, self.pivots = dA.rref()
         self.R = self.R.to_list()

@@ -247,6 +247,18 @@ def test_fallback_is_stated_and_agrees_with_the_oracle():
                 robots.planar_3r().thetas)
 
 
+def test_far_apart_angles_on_a_6_joint_arm_fall_back_and_say_so():
+    """1/7 next to 3 on the UR5 with the elbow stretched: exact elimination would take minutes (multiples of 1/21
+    up to 21), so the 60-digit SVD answers, flagged, and agrees with the oracle; full rank there is still exact."""
+    u = robots.ur5()
+    q = (R(1, 7), 3, 0, 1, 2, 2)
+    r = rank_at(u.jacobian_space(), q, u.thetas)
+    assert r == 5 == O.rank(O.space_jacobian(u.screws, q)) and not r.exact and "60-digit" in repr(r) + r.note
+    q2 = (R(1, 7), 3, 1, 1, 2, 2)
+    r2 = rank_at(u.jacobian_space(), q2, u.thetas)
+    assert r2 == 6 and r2.exact
+
+
 STANFORD = sp.Matrix([[0, 0, 1, 0, 0, 0], [1, 0, 0, 0, 1, 0], [0, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0],
                       [1, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0]]).T
 
