@@ -35,3 +35,21 @@ __all__ = [
     "manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
     "simplify_for_display", "is_identically_zero",
 ]
+
+# --- issue 11, item 7: matrix logarithms and the velocity kinematics after the Jacobian -------------
+from .rigid import log3
+from .screws import log6
+from .velocity import (
+    PinvReport, SingularityWarning, damped_least_squares, force_ellipsoid, inverse_velocity, joint_torques,
+    pseudoinverse,
+)
+
+__all__ += [
+    "log3", "log6", "pseudoinverse", "inverse_velocity", "damped_least_squares", "joint_torques",
+    "force_ellipsoid", "PinvReport", "SingularityWarning",
+]
+
+# --- issue 11, items 2 and 5: numeric singularity search; the singular-set answer type --------------
+from .singular_search import SingularPoints, find_singularities  # noqa: E402
+from .singularities import SingularSet  # noqa: E402
+__all__ += ["find_singularities", "SingularPoints", "SingularSet"]

@@ -16,7 +16,7 @@ import numpy as np
 import sympy as sp
 
 __all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe", "exact_number",
-           "check_real_finite"]
+           "check_real_finite", "exact_floats"]
 
 _ZERO_TOL = 1e-9
 
@@ -81,17 +81,50 @@ def exact_number(x: Any, name: str) -> sp.Expr:
     raise TypeError(f"{name} must be a real number or a SymPy expression, got {describe(x)}")
 
 
-def check_real_finite(e: sp.Expr, name: str) -> sp.Expr:
-    """Refuse a SymPy expression that is not real and finite (I, nan, oo, zoo, a non-real symbol)."""
-    if e.has(sp.I) or e.has(sp.nan) or e.has(sp.zoo) or e.has(sp.oo) or e.has(-sp.oo):
-        raise ValueError(f"{name} must be real and finite, got {e}")
-    bad = sorted((s for s in e.free_symbols if s.is_real is not True), key=str)
+def check_real_finite(e: sp.Expr, name: str, symbols: bool = True) -> sp.Expr:
+    """Refuse a SymPy expression that is not real and finite (I, nan, oo, zoo, a non-real symbol).
+
+    ``symbols=False`` skips the test that every symbol is declared real (for display helpers that
+    accept any expression).
+
+    >>> check_real_finite(sp.Symbol("L", positive=True) + 1, "L")
+    L + 1
+    >>> check_real_finite(sp.I, "q")
+    Traceback (most recent call last):
+    ...
+    ValueError: q must be real and finite, got I
+    """
+    if e.is_Atom:
+        if isinstance(e, _NOT_FINITE_TYPES):
+            raise ValueError(f"{name} must be real and finite, got {e}")
+        if symbols and e.is_Symbol and e.is_real is not True:
+            raise ValueError(f"{name} must be real: the symbol {e} is not declared real "
+                             f"(use sp.Symbol({str(e)!r}, real=True) or positive=True), got {e}")
+        return e
+    if e.atoms(*_NOT_FINITE_TYPES):   # one traversal: I, nan, oo, -oo, zoo anywhere
+        raise ValueError(f"{name} must be real and finite, got {str(e)[:200]}")
+    bad = sorted((s for s in e.free_symbols if s.is_real is not True), key=str) if symbols else []
     if bad:
         raise ValueError(f"{name} must be real: the symbol(s) {', '.join(map(str, bad))} are not declared real "
-                         f"(use sp.Symbol(..., real=True) or positive=True), got {e}")
-    if e.is_real is False:
-        raise ValueError(f"{name} must be real, got {e}")
+                         f"(use sp.Symbol(..., real=True) or positive=True), got {str(e)[:200]}")
+    if e.is_number and e.is_real is False:
+        raise ValueError(f"{name} must be real, got {str(e)[:200]}")
     return e
+
+
+_NOT_FINITE = (sp.nan, sp.zoo, sp.oo, -sp.oo, sp.I)
+_NOT_FINITE_TYPES = tuple(type(x) for x in _NOT_FINITE)
+
+
+def exact_floats(e: sp.Expr, name: str) -> sp.Expr:
+    """``e`` with every SymPy Float inside it replaced by the exact decimal it prints as (0.5·L → L/2).
+
+    >>> exact_floats(sp.Float(0.1) * sp.Symbol("L", positive=True), "M")
+    L/10
+    """
+    if not e.has(sp.Float):
+        return e
+    return e.xreplace({f: exact_number(f, name) for f in e.atoms(sp.Float)})
 
 
 def is_symbolic(*args: Any) -> bool:
@@ -108,26 +141,39 @@ def is_symbolic(*args: Any) -> bool:
     return False
 
 
-def _check_scalar(e: Any, name: str, symbolic: bool):
+def _check_scalar(e: Any, name: str, symbolic: bool, real_symbols: bool = False):
+    """One entry: exact (symbolic) or a finite real number (numeric); refused with a message naming ``name``.
+
+    Symbolic: numbers become exact (:func:`exact_number`: 0.1 → 1/10), Floats inside expressions too, and
+    expressions must be finite and free of I (:func:`check_real_finite`); with ``real_symbols`` every
+    symbol must also be declared real (joint symbols, and parameters of screws and M). Numeric: real,
+    finite numbers only.
+    """
     if isinstance(e, (str, bytes)):
         raise TypeError(f"{name} must hold numbers or SymPy expressions, got {describe(e)}")
-    if isinstance(e, bool):
+    if isinstance(e, (bool, np.bool_)):
         raise TypeError(f"{name} must hold numbers or SymPy expressions, got the bool {e!r}")
     if symbolic:
         if isinstance(e, sp.Basic):
             if not isinstance(e, sp.Expr):
                 raise TypeError(f"{name} must hold SymPy expressions, got {describe(e)}")
-            return e
-        if isinstance(e, numbers.Number) or isinstance(e, np.number):
-            return sp.sympify(e.item() if isinstance(e, np.generic) else e)
+            if isinstance(e, sp.Float):
+                return exact_number(e, name)
+            return check_real_finite(exact_floats(e, name), name, real_symbols)
+        if isinstance(e, (numbers.Number, np.number)):
+            return exact_number(e, name)
         raise TypeError(f"{name} must hold numbers or SymPy expressions, got {describe(e)}")
+    if isinstance(e, (complex, np.complexfloating)):
+        raise TypeError(f"{name} must hold real numbers, got the complex number {e!r}")
     if isinstance(e, (numbers.Real, np.integer, np.floating)):
+        if isinstance(e, (float, np.floating)) and not np.isfinite(e):
+            raise ValueError(f"{name} must hold finite real numbers, got {e!r}")
         return e
     raise TypeError(f"{name} must hold real numbers, got {describe(e)}")
 
 
 def as_matrix(x: Any, name: str, shape: tuple[int | None, int | None] | None = None,
-              symbolic: bool | None = None):
+              symbolic: bool | None = None, real_symbols: bool = False):
     """``x`` as a 2-D SymPy Matrix (symbolic) or float array (numeric), shape-checked.
 
     ``shape`` entries of ``None`` accept any size along that axis.
@@ -152,13 +198,14 @@ def as_matrix(x: Any, name: str, shape: tuple[int | None, int | None] | None = N
         for want, got in zip(shape, got_shape):
             if want is not None and want != got:
                 raise ValueError(f"{name} must be a matrix of shape {_fmt_shape(shape)}, got {describe(x)}")
-    rows = [[_check_scalar(e, name, symbolic) for e in row] for row in rows]
+    rows = [[_check_scalar(e, name, symbolic, real_symbols) for e in row] for row in rows]
     if symbolic:
         return sp.Matrix(rows) if rows else sp.zeros(*got_shape)
     return np.array(rows, dtype=float).reshape(got_shape)
 
 
-def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None):
+def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None,
+              real_symbols: bool = False):
     """``x`` as a column: SymPy Matrix (k×1) when symbolic, 1-D float array otherwise.
 
     Accepts a flat sequence, a 1-D array, or a column/row matrix.
@@ -184,13 +231,13 @@ def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | Non
         items = arr.tolist()
     if length is not None and len(items) != length:
         raise ValueError(f"{name} must be {want}, got {describe(x)} with {len(items)} entries")
-    items = [_check_scalar(e, name, symbolic) for e in items]
+    items = [_check_scalar(e, name, symbolic, real_symbols) for e in items]
     if symbolic:
         return sp.Matrix(items)
     return np.array(items, dtype=float)
 
 
-def as_screw_list(Slist: Any, name: str = "Slist", symbolic: bool | None = None):
+def as_screw_list(Slist: Any, name: str = "Slist", symbolic: bool | None = None, real_symbols: bool = True):
     """A screw list as a 6×n matrix: accepts 6×n (one screw per column) or a sequence of n 6-vectors."""
     if symbolic is None:
         symbolic = is_symbolic(Slist)
@@ -200,30 +247,30 @@ def as_screw_list(Slist: Any, name: str = "Slist", symbolic: bool | None = None)
     if isinstance(Slist, sp.MatrixBase):
         if Slist.rows != 6:
             raise ValueError(f"{name} must be {want}, got {describe(Slist)}")
-        return as_matrix(Slist, name, (6, None), symbolic)
+        return as_matrix(Slist, name, (6, None), symbolic, real_symbols)
     if isinstance(Slist, np.ndarray) and Slist.ndim == 2:
         if Slist.shape[0] != 6:
             raise ValueError(f"{name} must be {want}, got {describe(Slist)}")
-        return as_matrix(Slist, name, (6, None), symbolic)
+        return as_matrix(Slist, name, (6, None), symbolic, real_symbols)
     if isinstance(Slist, (list, tuple)):
         if len(Slist) == 0:
             raise ValueError(f"{name} must be {want}, got an empty {type(Slist).__name__}")
-        cols = [as_vector(s, f"{name}[{i}]", 6, symbolic) for i, s in enumerate(Slist)]
+        cols = [as_vector(s, f"{name}[{i}]", 6, symbolic, real_symbols) for i, s in enumerate(Slist)]
         if symbolic:
             return sp.Matrix.hstack(*cols)
         return np.column_stack(cols)
     if isinstance(Slist, np.ndarray) and Slist.ndim == 1 and Slist.shape == (6,):
-        return as_matrix(Slist.reshape(6, 1), name, (6, 1), symbolic)
+        return as_matrix(Slist.reshape(6, 1), name, (6, 1), symbolic, real_symbols)
     raise TypeError(f"{name} must be {want}, got {describe(Slist)}")
 
 
-def as_thetas(thetas: Any, n: int, name: str = "thetas", symbolic: bool | None = None):
+def as_thetas(thetas: Any, n: int, name: str = "thetas", symbolic: bool | None = None, real_symbols: bool = True):
     """n joint values (numbers or SymPy expressions) as a flat list (symbolic) or float array."""
     if symbolic is None:
         symbolic = is_symbolic(thetas)
     if isinstance(thetas, (numbers.Number, sp.Basic)) and not isinstance(thetas, bool) and n == 1:
         thetas = [thetas]
-    v = as_vector(thetas, name, n, symbolic)
+    v = as_vector(thetas, name, n, symbolic, real_symbols)
     return list(v) if symbolic else v
 
 

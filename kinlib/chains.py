@@ -5,13 +5,14 @@ Body form:   T(θ) = M e^{[B1]θ1} ⋯ e^{[Bn]θn},  with B_i = Ad_{M⁻¹} S_i.
 """
 from __future__ import annotations
 
+import numbers
 from typing import Mapping, Sequence
 
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_screw_list, as_thetas, describe, is_symbolic
-from .codegen import CompiledMatrix
+from ._backend import as_matrix, as_screw_list, as_thetas, as_vector, describe, exact_number, is_symbolic
+from .codegen import CompiledMatrix, Tape
 from .jacobians import _prepare, jacobian_body as _jacobian_body, jacobian_space as _jacobian_space
 from .rigid import adjoint, check_se3, cross, skew, trans_inv
 from .screws import _exp6
@@ -22,7 +23,7 @@ __all__ = ["fk_space", "fk_body", "SerialChain"]
 def fk_space(M, Slist, thetas):
     """T(θ) = e^{[S1]θ1} ⋯ e^{[Sn]θn} M: the end-effector pose from the space screw axes."""
     symbolic = is_symbolic(M, Slist, thetas)
-    M = check_se3(as_matrix(M, "M", None, symbolic), "M")
+    M = check_se3(as_matrix(M, "M", None, symbolic, real_symbols=True), "M")
     S, th, kinds, _ = _prepare(Slist, thetas, "Slist", symbolic)
     T = sp.eye(4) if symbolic else np.eye(4)
     for i in range(S.shape[1]):
@@ -34,7 +35,7 @@ def fk_space(M, Slist, thetas):
 def fk_body(M, Blist, thetas):
     """T(θ) = M e^{[B1]θ1} ⋯ e^{[Bn]θn}: the end-effector pose from the body screw axes."""
     symbolic = is_symbolic(M, Blist, thetas)
-    M = check_se3(as_matrix(M, "M", None, symbolic), "M")
+    M = check_se3(as_matrix(M, "M", None, symbolic, real_symbols=True), "M")
     B, th, kinds, _ = _prepare(Blist, thetas, "Blist", symbolic)
     T = M
     for i in range(B.shape[1]):
@@ -45,6 +46,27 @@ def fk_body(M, Blist, thetas):
 
 def _joint_symbols(n: int):
     return sp.symbols(f"theta1:{n + 1}", real=True)
+
+
+def _check_joint_symbols(thetas, n: int) -> tuple:
+    """n distinct SymPy symbols declared real (joint angles and slides are real numbers)."""
+    if isinstance(thetas, sp.Symbol):
+        thetas = [thetas]
+    if isinstance(thetas, sp.MatrixBase):
+        thetas = list(thetas)
+    if isinstance(thetas, (str, bytes)) or not isinstance(thetas, (list, tuple)):
+        raise TypeError(f"thetas must be {n} SymPy symbols (one per screw axis), got {describe(thetas)}")
+    thetas = tuple(thetas)
+    if len(thetas) != n or not all(isinstance(t, sp.Symbol) for t in thetas):
+        raise ValueError(f"thetas must be {n} SymPy symbols (one per screw axis), got {describe(list(thetas))}: "
+                         f"{', '.join(map(repr, thetas))[:120]}")
+    if len(set(thetas)) != n:
+        raise ValueError(f"thetas must be {n} distinct symbols, got {', '.join(map(str, thetas))}")
+    for i, t in enumerate(thetas):
+        if t.is_real is not True:
+            raise ValueError(f"thetas[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)): joint values "
+                             f"are real, got the symbol {t} with no real assumption")
+    return thetas
 
 
 class SerialChain:
@@ -60,18 +82,38 @@ class SerialChain:
     * SymPy values: the exact result at ``q`` (substituted);
     * numbers, shape (n,) or a batch (N, n): NumPy floats, from code generated once per chain from
       the unsimplified expression with common-subexpression elimination.
+
+    The chain is exact: numbers in ``M`` and ``screws`` (lists, NumPy arrays, Python/NumPy/SymPy floats)
+    become the exact decimal typed (0.1 → 1/10, 2.0 → 2; ``kinlib._backend.exact_number``), so a chain
+    built from lists equals one built from ``sp.Matrix``. Float axes that are unit only to rounding
+    (0.7071067811865476, or axes computed by rotating) are accepted when | |ω|² − 1 | ≤ 1e-9 and kept as
+    typed: results are exact for the numbers typed (type ``sp.sqrt(2)/2`` for an exactly unit axis).
+    Refused, naming the argument: NaN/inf, complex numbers and ``sp.I``, strings, bools, None, symbols not
+    declared real (joint symbols and parameters alike), wrong shapes; q likewise (NaN joint values too).
+
+    >>> chain = SerialChain([[1, 0, 0, 2.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+    ...                     [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -1.0, 0]])
+    >>> chain.screws.T, chain.params
+    (Matrix([
+    [0, 0, 1, 0,  0, 0],
+    [0, 0, 1, 0, -1, 0]]), ())
+    >>> float(chain.fk([0.0, 0.0])[0, 3])
+    2.0
     """
 
     def __init__(self, M, screws, *, name: str = "chain", thetas: Sequence[sp.Symbol] | None = None,
                  joint_points=None, description: str = ""):
-        M = check_se3(as_matrix(M, "M", None, True), "M")
+        for arg, value in (("name", name), ("description", description)):
+            if not isinstance(value, str):
+                raise TypeError(f"{arg} must be a string, got {describe(value)}")
+        # numbers become exact here (0.1 -> 1/10, 2.0 -> 2, sp.Float too); NaN, inf, I, strings, bools,
+        # non-real symbols are refused, each naming M or screws[i]
+        M = check_se3(as_matrix(M, "M", None, True, real_symbols=True), "M")
         S = as_screw_list(screws, "screws", True)
         n = S.shape[1]
         if thetas is None:
             thetas = _joint_symbols(n)
-        thetas = tuple(thetas)
-        if len(thetas) != n or not all(isinstance(t, sp.Symbol) for t in thetas):
-            raise ValueError(f"thetas must be {n} SymPy symbols (one per screw axis), got {describe(list(thetas))}")
+        thetas = _check_joint_symbols(thetas, n)
         _, _, kinds, _ = _prepare(S, list(thetas), "screws")
         self.name = name
         self.description = description
@@ -89,8 +131,9 @@ class SerialChain:
         else:
             jp = joint_points
             if isinstance(jp, (list, tuple)) and len(jp) == n and all(np.size(p) == 3 for p in jp):
-                jp = sp.Matrix.hstack(*[sp.Matrix(list(p)) for p in jp])
-            joint_points = as_matrix(jp, "joint_points", (3, n), True)
+                jp = sp.Matrix.hstack(*[as_vector(p, f"joint_points[{i}]", 3, True, real_symbols=True)
+                                        for i, p in enumerate(jp)])
+            joint_points = as_matrix(jp, "joint_points", (3, n), True, real_symbols=True)
         self.joint_points = joint_points
         syms = set().union(M.free_symbols, S.free_symbols, joint_points.free_symbols)
         self.params = tuple(sorted(syms - set(thetas), key=str))
@@ -104,14 +147,24 @@ class SerialChain:
         return adjoint(trans_inv(self.M)) * self.screws
 
     def subs(self, values: Mapping | None = None, **by_name) -> "SerialChain":
-        """A copy with parameters replaced: ``chain.subs(L=1)`` or ``chain.subs({L: 1})``."""
-        table = dict(values or {})
+        """A copy with parameters replaced: ``chain.subs(L=1)`` or ``chain.subs({L: 1})``.
+
+        Values become exact as typed (``kinlib._backend.exact_number``: 0.1 → 1/10, 2.0 → 2) or are
+        real SymPy expressions; keys are the chain's parameters (symbols or their names).
+
+        >>> from kinlib import robots
+        >>> robots.planar_offset_3r().subs(L=0.1).M[0, 3]
+        3/10
+        """
+        if values is not None and not isinstance(values, Mapping):
+            raise TypeError(f"values must be a mapping {{parameter: value}}, got {describe(values)}")
         names = {str(p): p for p in self.params}
-        for k, v in by_name.items():
-            if k not in names:
+        table = {}
+        for k, v in list((values or {}).items()) + list(by_name.items()):
+            key = names.get(k) if isinstance(k, str) else k if k in self.params else None
+            if key is None:
                 raise ValueError(f"{self.name} has no parameter {k!r}; its parameters are {sorted(names)}")
-            table[names[k]] = v
-        table = {k: sp.nsimplify(v, rational=True) if isinstance(v, float) else sp.sympify(v) for k, v in table.items()}
+            table[key] = exact_number(v, str(key))
         return SerialChain(self.M.subs(table), self.screws.subs(table), name=self.name, thetas=self.thetas,
                            joint_points=self.joint_points.subs(table), description=self.description)
 
@@ -142,8 +195,8 @@ class SerialChain:
         return self._sym[what]
 
     def _numeric_form(self, what: str) -> sp.Matrix:
-        """The same matrix as ``_expr(what)``, built so that cse leaves few operations (150–190
-        instead of 240–300 for the UR5): the form the numeric code is generated from.
+        """The same matrix as ``_expr(what)`` (exactly), by the recursions the numeric code is generated
+        from (:func:`_poe_rows`: 3×3 and 3-lists, no 4×4 products), which leave few operations.
 
         With E_i = e^{[S_i]θ_i}, S_i = [ω_i; v_i], R_i = rot(E_1)⋯rot(E_{i−1}) and points carried by
         the E's one at a time (E(x) = rot(E) x + trans(E)) rather than whole 4×4 products:
@@ -153,77 +206,97 @@ class SerialChain:
           g_i = E_{i−1}⁻¹(⋯E_1⁻¹(0)) the base origin seen from T_{i−1} = E_1⋯E_{i−1};
         * J:   column i = [R_i ω_i; R_i (v_i + ω_i × p_i)] = [ω_s; ṗ] column, p_i = E_i(⋯E_n(p_M));
         * J_b: column i = [Q_iᵀ β_i; Q_iᵀ (ν_i + β_i × u_i)] = Ad_{U_i⁻¹} B_i, with B_i = [β_i; ν_i] and
-          (Q_i, u_i) = U_i = e^{[B_{i+1}]θ_{i+1}}⋯e^{[B_n]θ_n}.
+          (Q_i, u_i) = U_i = e^{[B_{i+1}]θ_{i+1}}⋯e^{[B_n]θ_n};
+        * skeleton: the base origin, each joint point carried by E_1⋯E_{i−1}, the tool origin;
+
+        each E_i = (K0 + sin θ K1 + cos θ K2, θ a + b − cos θ b − sin θ d) with constants from S_i
+        (Rodrigues' formula, see :func:`_exp_constants`).
         """
-        _, th, kinds, _ = _prepare(self.screws, list(self.thetas), "screws")
-        n = self.n
-        if what == "jb":
-            B = self.body_screws
-            cols, Q, u = [None] * n, sp.eye(3), sp.zeros(3, 1)
-            for i in reversed(range(n)):
-                b, nu = B[:3, i], B[3:, i]
-                cols[i] = sp.Matrix.vstack(Q.T * b, Q.T * (nu + cross(b, u)))
-                E = _exp6(B[:, i], th[i], kinds[i], True)
-                Q, u = E[:3, :3] * Q, E[:3, :3] * u + E[:3, 3]
-            return sp.Matrix.hstack(*cols)
-        E = [_exp6(self.screws[:, i], th[i], kinds[i], True) for i in range(n)]
-        R = [sp.eye(3)]  # R[i] = rot(E_1)⋯rot(E_i)
-        for i in range(n):
-            R.append(R[-1] * E[i][:3, :3])
-        tail = [self.M[:3, 3]]  # tail[k] = E_{n−k+1}(⋯E_n(p_M)): tail[0] = p_M, tail[n] = p(θ)
-        for i in reversed(range(n)):
-            tail.append(E[i][:3, :3] * tail[-1] + E[i][:3, 3])
-        if what == "fk":
-            return sp.Matrix.vstack(sp.Matrix.hstack(R[n] * self.M[:3, :3], tail[n]), sp.Matrix([[0, 0, 0, 1]]))
-        cols, g = [], sp.zeros(3, 1)
-        for i in range(n):
-            w, v = self.screws[:3, i], self.screws[3:, i]
-            x = g if what == "js" else tail[n - i]
-            cols.append(sp.Matrix.vstack(R[i] * w, R[i] * (v + cross(w, x))))
-            if what == "js":
-                Einv = _exp6(self.screws[:, i], -th[i], kinds[i], True)
-                g = Einv[:3, :3] * g + Einv[:3, 3]
-        return sp.Matrix.hstack(*cols)
+        th = self.thetas
+        return sp.Matrix(_poe_rows(self, what, lambda x: x, lambda i: (sp.sin(th[i]), sp.cos(th[i]), th[i])))
 
     def _skeleton_expr(self) -> sp.Matrix:
         """Columns: the base origin, each joint point carried by the links before it, the tool origin."""
-        cols = [sp.zeros(3, 1)]
-        T = sp.eye(4)
-        _, th, kinds, _ = _prepare(self.screws, list(self.thetas), "screws")
-        for i in range(self.n):
-            q = self.joint_points[:, i]
-            cols.append(T[:3, :3] * q + T[:3, 3])
-            T = T * _exp6(self.screws[:, i], th[i], kinds[i], True)
-        cols.append(self._expr("fk")[:3, 3])
-        return sp.Matrix.hstack(*cols)
+        return self._numeric_form("skeleton")
 
     def _eval(self, what: str, q):
         if type(q) is np.ndarray and q.dtype.kind == "f":  # fast path: a float array, code already generated
             c = self._num.get(what)
             if c is not None:
-                return c._single(q.tolist()) if q.shape == (self.n,) else c(q)
-        expr = self._expr(what)
+                if q.shape == (self.n,):
+                    v = q.tolist()
+                    t = sum(v)         # nan/inf anywhere makes t − t nan (≈ 80 ns; np.isfinite(q).all() ≈ 1 µs);
+                    if t - t == 0.0:   # the rare finite q whose sum overflows just takes the checked path below
+                        return c._single(v)
+                elif q.ndim == 2 and q.shape[1] == self.n and np.isfinite(q).all():
+                    return c(q)
+        elif type(q) is list or type(q) is tuple:  # plain floats (and small ints): no array needed
+            c = self._num.get(what)
+            if c is not None and len(q) == self.n and \
+                    all(isinstance(v, float) and v - v == 0.0 or type(v) is int and -2**53 <= v <= 2**53 for v in q):
+                return c._single(q)    # floats incl. np.float64; v - v == 0.0 is False for nan and ±inf
         if q is None:
-            return expr
+            return self._expr(what)
         if is_symbolic(q):
+            expr = self._expr(what)    # numbers need only the generated code, not the whole symbolic matrix
             qs = q if not isinstance(q, sp.MatrixBase) else list(q)
             if isinstance(qs, (sp.Basic,)) and self.n == 1:
                 qs = [qs]
             if not isinstance(qs, (list, tuple)) or len(qs) != self.n:
                 raise ValueError(f"q must hold {self.n} joint values for {self.name}, got {describe(q)}")
-            vals = list(as_thetas(qs, self.n, "q", True))  # rejects strings (sympify would make symbols)
+            # exact values (0.5 -> 1/2); I, nan, oo, strings, bools, non-real symbols refused
+            vals = list(as_thetas(qs, self.n, "q", True))
             return expr.xreplace(dict(zip(self.thetas, vals))) if all(v.is_Atom for v in vals) \
                 else expr.subs(dict(zip(self.thetas, vals)), simultaneous=True)
+        q = self._joint_values(q)      # checked before any code generation (a bad q is named first)
         return self._compiled(what)(q)
 
+    def _joint_values(self, q):
+        """q as a float array (n,) or (N, n) of finite real numbers; a clear error for anything else."""
+        n = self.n
+        want = f"{n} real joint values (or an (N, {n}) batch)"
+        if type(q) in (list, tuple) and len(q) == n and all(isinstance(v, float) for v in q):
+            arr = np.array(q, dtype=float)     # the common case: plain floats
+        elif isinstance(q, np.ndarray) and q.dtype.kind in "fiu":
+            arr = q.astype(float, copy=False)
+        elif isinstance(q, (list, tuple, np.ndarray)):
+            obj = np.asarray(q, dtype=object) if not isinstance(q, np.ndarray) else q
+            if obj.ndim not in (1, 2) or obj.shape[-1] != n:
+                raise ValueError(f"q must have shape ({n},) or (N, {n}) for this {n}-joint chain, got {describe(q)}")
+            for idx in np.ndindex(obj.shape):
+                e = obj[idx]
+                if isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or \
+                        not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                    raise TypeError(f"q must hold {want}, got {describe(q)} whose entry {list(idx)} is {describe(e)}")
+            try:
+                arr = np.array(obj.tolist(), dtype=float)
+            except OverflowError:
+                raise ValueError(f"q must hold {want}, got {describe(q)} with an integer too large for a float") from None
+        else:
+            raise TypeError(f"q must hold {want}, got {describe(q)}")
+        if arr.ndim not in (1, 2) or arr.shape[-1] != n:
+            raise ValueError(f"q must have shape ({n},) or (N, {n}) for this {n}-joint chain, got {describe(q)}")
+        if not np.isfinite(arr).all():
+            bad = np.argwhere(~np.isfinite(arr))[0]
+            raise ValueError(f"q must hold {n} finite real joint values, got {describe(q)} whose entry "
+                             f"{bad.tolist()} is {float(arr[tuple(bad)])!r}")
+        return arr
+
     def _compiled(self, what: str) -> CompiledMatrix:
+        """The generated code for ``what`` (fk, js, jb, jg, skeleton), made on first use.
+
+        The recursions of :meth:`_numeric_form` are run once on a :class:`~kinlib.codegen.Tape`,
+        with the chain's exact constants rounded to floats (exact zeros kept): straight-line code
+        equal to the exact product of exponentials to rounding, in milliseconds whatever the size of
+        the chain's exact numbers (no SymPy expression of the whole chain, no ``sympy.cse``)."""
         if what not in self._num:
             if self.params:
                 raise ValueError(
                     f"{self.name} has symbolic parameters {', '.join(map(str, self.params))}: give them numbers "
                     f"first, e.g. chain.subs({str(self.params[0])}=1), or pass SymPy joint values for an exact result")
-            expr = self._expr(what + "_num" if what in ("fk", "js", "jb", "jg") else what)
-            self._num[what] = CompiledMatrix(expr, self.thetas, f"{self.name}.{what}")
+            tp = Tape(self.n)
+            rows = _poe_rows(self, what, _float_constant, lambda i: (tp.sin(i), tp.cos(i), tp.q(i)))
+            self._num[what] = tp.compile(rows, self.thetas, f"{self.name}.{what}")
         return self._num[what]
 
     # --- kinematics ------------------------------------------------------------------------------
@@ -246,3 +319,122 @@ class SerialChain:
     def skeleton(self, q=None):
         """Points to draw the chain (3×(n+2)): base origin, each joint point, tool origin; (N, 3, n+2) for a batch."""
         return self._eval("skeleton", q)
+
+
+# --- the recursions behind SerialChain._numeric_form and the generated code (issue 11, item 6) --------
+# Written once over plain 3-lists and 3×3 lists with + − ×, so the same lines run in exact SymPy
+# (the numeric forms, proved equal to the PoE expressions by tests) and on a codegen.Tape (the code:
+# constants as floats, a few µs per operation, whatever the size of the chain's exact numbers).
+_I3 = ((1, 0, 0), (0, 1, 0), (0, 0, 1))
+
+
+def _mv(A, x):
+    return [A[i][0] * x[0] + A[i][1] * x[1] + A[i][2] * x[2] for i in range(3)]
+
+
+def _mtv(A, x):  # Aᵀx
+    return [A[0][i] * x[0] + A[1][i] * x[1] + A[2][i] * x[2] for i in range(3)]
+
+
+def _mm(A, B):
+    return [[A[i][0] * B[0][j] + A[i][1] * B[1][j] + A[i][2] * B[2][j] for j in range(3)] for i in range(3)]
+
+
+def _vadd(x, y):
+    return [x[0] + y[0], x[1] + y[1], x[2] + y[2]]
+
+
+def _vcross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def _exp_constants(S, kind: str, num):
+    """The constants of E(θ) = e^{[S]θ} for S = [ω; v] (exact SymPy in, ``num`` applied to each):
+
+    revolute  rot = K0 + sin θ K1 + cos θ K2 with K0 = I + [ω]², K1 = [ω], K2 = −[ω]² (Rodrigues),
+              trans = θ a + b − cos θ b − sin θ d with a = (I + [ω]²) v, b = [ω] v, d = [ω]² v;
+    prismatic rot = I, trans = θ v.
+    """
+    w, v = list(S[:3]), list(S[3:])
+    if kind == "P":
+        return ("P", [num(x) for x in v])
+    W = [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]
+    W2 = _mm(W, W)
+    K0 = [[_I3[i][j] + W2[i][j] for j in range(3)] for i in range(3)]
+    d, b = _mv(W2, v), _mv(W, v)
+    a = _vadd(v, d)
+    return ("R", [[num(x) for x in row] for row in K0], [[num(x) for x in row] for row in W],
+            [[num(-x) for x in row] for row in W2], [num(x) for x in a], [num(x) for x in b], [num(x) for x in d])
+
+
+def _exp_apply(C, s, c, th, sign: int = 1):
+    """(rot, trans) of e^{±[S]θ} from :func:`_exp_constants` and sin θ, cos θ, θ (sign −1: the inverse)."""
+    if C[0] == "P":
+        return _I3, [x * th * sign for x in C[1]]
+    _, K0, K1, K2, a, b, d = C
+    ss, tt = s * sign, th * sign
+    rot = [[K0[i][j] + ss * K1[i][j] + c * K2[i][j] for j in range(3)] for i in range(3)]
+    trans = [tt * a[i] + b[i] - c * b[i] - ss * d[i] for i in range(3)]
+    return rot, trans
+
+
+def _body_screw_columns(M, S):
+    """B_i = Ad_{M⁻¹} S_i = [Rᵀω_i; Rᵀ(v_i + ω_i × p)] for M = (R, p), exact, as 6-lists."""
+    R = [[M[i, j] for j in range(3)] for i in range(3)]
+    p = [M[i, 3] for i in range(3)]
+    cols = []
+    for k in range(S.shape[1]):
+        w, v = list(S[:3, k]), list(S[3:, k])
+        cols.append(_mtv(R, w) + _mtv(R, _vadd(v, _vcross(w, p))))
+    return cols
+
+
+def _poe_rows(chain, what: str, num, joint):
+    """Rows of T, J_s, J_b, the geometric J or the skeleton of ``chain`` by the recursions of
+    :meth:`SerialChain._numeric_form`, in the arithmetic given by ``num`` (an exact constant into it)
+    and ``joint(i)`` → (sin θ_i, cos θ_i, θ_i)."""
+    n, kinds = chain.n, chain.joint_types
+    M = chain.M
+    pM = [num(M[i, 3]) for i in range(3)]
+    if what == "jb":
+        B = _body_screw_columns(M, chain.screws)
+        cols, Q, u = [None] * n, _I3, [0, 0, 0]
+        for i in reversed(range(n)):
+            b, nu = [num(x) for x in B[i][:3]], [num(x) for x in B[i][3:]]
+            cols[i] = _mtv(Q, b) + _mtv(Q, _vadd(nu, _vcross(b, u)))
+            rot, tr = _exp_apply(_exp_constants(B[i], kinds[i], num), *joint(i))
+            Q, u = _mm(rot, Q), _vadd(_mv(rot, u), tr)
+        return [[cols[j][r] for j in range(n)] for r in range(6)]
+    C = [_exp_constants(chain.screws[:, i], kinds[i], num) for i in range(n)]
+    E = [_exp_apply(C[i], *joint(i)) for i in range(n)]
+    if what == "skeleton":
+        cols, R, p = [[0, 0, 0]], _I3, [0, 0, 0]
+        for i in range(n):
+            cols.append(_vadd(_mv(R, [num(x) for x in chain.joint_points[:, i]]), p))
+            p, R = _vadd(_mv(R, E[i][1]), p), _mm(R, E[i][0])
+        cols.append(_vadd(_mv(R, pM), p))
+        return [[col[r] for col in cols] for r in range(3)]
+    R = [_I3]  # R[i] = rot(E_1)⋯rot(E_i)
+    for i in range(n if what == "fk" else n - 1):
+        R.append(_mm(R[-1], E[i][0]))
+    tail = [pM]  # tail[k] = E_{n−k+1}(⋯E_n(p_M)): tail[0] = p_M, tail[n] = p(θ)
+    if what in ("fk", "jg"):
+        for i in reversed(range(n)):
+            tail.append(_vadd(_mv(E[i][0], tail[-1]), E[i][1]))
+    if what == "fk":
+        RM = _mm(R[n], [[num(M[i, j]) for j in range(3)] for i in range(3)])
+        return [RM[r] + [tail[n][r]] for r in range(3)] + [[0, 0, 0, 1]]
+    cols, g = [], [0, 0, 0]
+    for i in range(n):
+        w, v = [num(x) for x in chain.screws[:3, i]], [num(x) for x in chain.screws[3:, i]]
+        x = g if what == "js" else tail[n - i]
+        cols.append(_mv(R[i], w) + _mv(R[i], _vadd(v, _vcross(w, x))))
+        if what == "js" and i < n - 1:
+            rot, tr = _exp_apply(C[i], *joint(i), sign=-1)
+            g = _vadd(_mv(rot, g), tr)
+    return [[cols[j][r] for j in range(n)] for r in range(6)]
+
+
+def _float_constant(x) -> float:
+    """An exact constant of the chain as the float the generated code uses (exact zeros stay 0.0)."""
+    return 0.0 if x == 0 else float(x)

@@ -39,7 +39,7 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ._backend import describe
 
-__all__ = ["CompiledMatrix", "compile_matrix"]
+__all__ = ["CompiledMatrix", "compile_matrix", "Tape", "TapeValue"]
 
 _MATH = {name: getattr(math, name) for name in ("sin", "cos", "tan", "sqrt", "exp", "log", "atan2", "pi", "e")}
 _NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "sqrt": np.sqrt, "exp": np.exp, "log": np.log,
@@ -444,22 +444,48 @@ class _BatchEmitter:
 
 
 class CompiledMatrix:
-    """A matrix expression in ``args`` compiled to NumPy code; call it with q of shape (n,) or (N, n)."""
+    """A matrix expression in ``args`` compiled to NumPy code; call it with q of shape (n,) or (N, n).
+
+    The code for one configuration is generated at once; the batched code on the first batched
+    call (or when ``source`` is read). :meth:`from_pieces` starts from common subexpressions that
+    are already known (a :class:`Tape`), skipping ``sympy.cse``.
+    """
 
     def __init__(self, expr: sp.MatrixBase, args: Sequence[sp.Symbol], name: str = "matrix"):
         expr = sp.Matrix(expr)
-        self.shape = expr.shape
-        self.args = tuple(args)
-        self.n = len(self.args)
-        self.name = name
-        local = [sp.Symbol(f"_q{i}") for i in range(self.n)]
+        args = tuple(args)
+        local = [sp.Symbol(f"_q{i}") for i in range(len(args))]
         # cse first, then rename the joint symbols in the (small) reduced pieces: xreplace on the
         # unreduced tree revisits every shared subtree (seconds for a dense 6-joint arm)
         tmp = sp.numbered_symbols("_x")
         repl, reduced = sp.cse(list(expr), symbols=tmp, order="none")  # canonical ordering: same code, ~6× slower
-        ren = dict(zip(self.args, local))
+        ren = dict(zip(args, local))
         repl = [(s, e.xreplace(ren)) for s, e in repl]
         reduced = [e.xreplace(ren) for e in reduced]
+        self._setup(repl, reduced, args, expr.shape, name)
+
+    @classmethod
+    def from_pieces(cls, repl, reduced, args: Sequence[sp.Symbol], shape: tuple[int, int],
+                    name: str = "matrix") -> "CompiledMatrix":
+        """Compile from cse-style pieces: ``repl`` a list of (temporary symbol ``_xK``, expression), each
+        using only earlier temporaries and the joint symbols ``_q0 … _q{n−1}`` (for ``args``), and
+        ``reduced`` the rows·cols entries (row-major) in those symbols.
+
+        >>> x0, q0 = sp.symbols("_x0 _q0")
+        >>> c = CompiledMatrix.from_pieces([(x0, sp.sin(q0))], [x0, 2 * x0], [sp.Symbol("t")], (1, 2))
+        >>> c([0.5]).round(6).tolist()
+        [[0.479426, 0.958851]]
+        """
+        self = cls.__new__(cls)
+        self._setup(list(repl), list(reduced), tuple(args), tuple(shape), name)
+        return self
+
+    def _setup(self, repl, reduced, args, shape, name):
+        self.shape = shape
+        self.args = args
+        self.n = len(args)
+        self.name = name
+        local = [sp.Symbol(f"_q{i}") for i in range(self.n)]
         # inline pure negations (_x17 = -_x16): later sums absorb the sign (c - a*b), saving a pass
         neg: dict = {}
         kept = []
@@ -476,13 +502,14 @@ class CompiledMatrix:
         if extra:
             raise ValueError(f"cannot generate numeric code for {name}: it still has the free symbols "
                              f"{sorted(map(str, extra))} besides the joint variables; give them values first")
+        self._repl, self._reduced = repl, reduced
         pr = _Printer()
         r, c = self.shape
         size = r * c
         temps = [(str(s), pr.doprint(e)) for s, e in repl]
-        consts = [_constant(e) for e in reduced]
+        self._consts = consts = [_constant(e) for e in reduced]
         items = [repr(v) if v is not None else pr.doprint(e) for v, e in zip(consts, reduced)]
-        names = ", ".join(map(str, local)) + ("," if self.n == 1 else "")
+        self._names = names = ", ".join(map(str, local)) + ("," if self.n == 1 else "")
 
         # one configuration: math functions on floats, entries packed into a fresh array
         single = ["def _single(q):"]
@@ -490,18 +517,32 @@ class CompiledMatrix:
             single.append(f"    {names} = q")
         single += [f"    {s} = {e}" for s, e in temps]
         single += [f"    out = _empty(({r}, {c}))", f"    _pack(out, 0, {', '.join(items)})", "    return out"]
+        self._single_source = "\n".join(single)
+        self._batch_source = None
+        ns_single = dict(_MATH, _empty=np.empty, _pack=struct.Struct(f"{size}d").pack_into)
+        exec(compile(self._single_source, f"<kinlib {name} single>", "exec"), ns_single)
+        self._single = ns_single["_single"]
 
+    def _batch(self, q):
+        """The batched code (generated on its first call): (N, n) in, (rows, cols, N) out."""
+        if self._batch_source is None:
+            self._make_batch()
+        return self._batch_fn(q)
+
+    def _make_batch(self) -> None:
         # a batch q of shape (N, n), computed on the last axis of out, block by block; constant
         # entries written once; each joint's block is read in place (a strided column of q)
+        repl, reduced, consts, names = self._repl, self._reduced, self._consts, self._names
+        r, c = self.shape
         batch = ["def _batch(q):", "    N = q.shape[0]", f"    out = _empty(({r}, {c}, N))"]
         for k, v in enumerate(consts):
             if v is not None:
                 batch.append(f"    out[{k // c}, {k % c}] = {v!r}")
-        varying = [(k, it) for k, (it, v) in enumerate(zip(items, consts)) if v is None]
+        varying = [k for k, v in enumerate(consts) if v is None]
         if varying:
             brepl, bred, trig = _half_angle(repl, reduced)
-            em = _BatchEmitter(pr, trig)
-            body = em.emit_block(brepl, [(f"out[{k // c}, {k % c}, _s:_e]", bred[k]) for k, _ in varying])
+            em = _BatchEmitter(_Printer(), trig)
+            body = em.emit_block(brepl, [(f"out[{k // c}, {k % c}, _s:_e]", bred[k]) for k in varying])
             batch += [f"    _B = min(N, {BLOCK})",
                       f"    _buf = _empty(({max(em.nbuf, 1)}, _B))  # scratch rows, reused block after block"]
             batch += [f"    for _s in range(0, N, {BLOCK}):", f"        _e = min(_s + {BLOCK}, N)"]
@@ -511,14 +552,18 @@ class CompiledMatrix:
                 batch.append(f"        {names} = q[_s:_e].T")
             batch += [f"        {line}" for line in body]
         batch.append("    return out")
-
-        self.source = "\n".join(single) + "\n\n" + "\n".join(batch) + "\n"
-        ns_single = dict(_MATH, _empty=np.empty, _pack=struct.Struct(f"{size}d").pack_into)
+        source = "\n".join(batch)
         ns_batch = dict(_NUMPY, _empty=np.empty, **_UFUNCS)
-        exec(compile("\n".join(single), f"<kinlib {name} single>", "exec"), ns_single)
-        exec(compile("\n".join(batch), f"<kinlib {name} batch>", "exec"), ns_batch)
-        self._single = ns_single["_single"]
-        self._batch = ns_batch["_batch"]
+        exec(compile(source, f"<kinlib {self.name} batch>", "exec"), ns_batch)
+        self._batch_fn = ns_batch["_batch"]
+        self._batch_source = source
+
+    @property
+    def source(self) -> str:
+        """The generated code: ``_single`` (one configuration) and ``_batch`` (N configurations)."""
+        if self._batch_source is None:
+            self._make_batch()
+        return self._single_source + "\n\n" + self._batch_source + "\n"
 
     def __call__(self, q):
         """Evaluate at q: shape (n,) gives (rows, cols); shape (N, n) gives (N, rows, cols)."""
@@ -544,6 +589,206 @@ class CompiledMatrix:
             return out.transpose(2, 0, 1)
         raise ValueError(f"q must have shape ({self.n},) or (N, {self.n}) for this {self.n}-joint chain, "
                          f"got {describe(q)}")
+
+
+class TapeValue:
+    """A value recorded on a :class:`Tape`: ``const + Σ coef·node`` with float constants; nodes are joint
+    values, their sines and cosines, products of two values, and sums multiplied by something.
+
+    Arithmetic (``+ - *`` with numbers or other values of the same tape) folds constants as it goes:
+    ``0·x`` is the number 0.0, ``1·x`` is x, like terms are merged; a result with no terms is a plain
+    float. Equal products and sums are one node (recorded once), so shared work is found as it is
+    built, without ``sympy.cse``.
+    """
+
+    __slots__ = ("tape", "const", "terms")
+
+    def __init__(self, tape: "Tape", const: float, terms: dict):
+        self.tape, self.const, self.terms = tape, const, terms
+
+    def __add__(self, other):
+        if type(other) is TapeValue:
+            terms = dict(self.terms)
+            for k, c in other.terms.items():
+                v = terms.get(k, 0.0) + c
+                if v == 0.0:
+                    del terms[k]
+                else:
+                    terms[k] = v
+            const = self.const + other.const
+            return TapeValue(self.tape, const, terms) if terms else const
+        other = float(other)
+        return TapeValue(self.tape, self.const + other, self.terms) if other else self
+
+    __radd__ = __add__
+
+    def __neg__(self):
+        return TapeValue(self.tape, -self.const, {k: -c for k, c in self.terms.items()})
+
+    def __sub__(self, other):
+        return self + (-other)
+
+    def __rsub__(self, other):
+        return (-self) + other
+
+    def __mul__(self, other):
+        if type(other) is not TapeValue:
+            other = float(other)
+            if other == 0.0:
+                return 0.0
+            if other == 1.0:
+                return self
+            return TapeValue(self.tape, self.const * other, {k: c * other for k, c in self.terms.items()})
+        ca, na = self._factor()
+        cb, nb = other._factor()
+        node = self.tape._node(("mul", na, nb) if na <= nb else ("mul", nb, na))
+        return TapeValue(self.tape, 0.0, {node: ca * cb})
+
+    __rmul__ = __mul__
+
+    def _factor(self) -> tuple[float, int]:
+        """(c, node) with self = c·node: a single term as it is, anything else a sum node."""
+        if not self.const and len(self.terms) == 1:
+            (k, c), = self.terms.items()
+            return c, k
+        return 1.0, self.tape._node(("sum", self.const, tuple(sorted(self.terms.items()))))
+
+
+class Tape:
+    """Straight-line code recorded from arithmetic on numbers and the joint values of an n-joint chain.
+
+    ``q(i)``, ``sin(i)``, ``cos(i)`` are the joint value θ_i and its sine and cosine as
+    :class:`TapeValue` s; any formula evaluated on them (with float constants) is recorded, each
+    distinct product and sum once. :meth:`compile` turns entries (values or numbers) into a
+    :class:`CompiledMatrix`: every node used twice or more (and every sine and cosine) becomes a
+    temporary, the rest is written inline. The cost is a few microseconds per recorded operation,
+    whatever the size of the numbers the constants came from.
+
+    >>> tp = Tape(2)
+    >>> s, c = tp.sin(0), tp.cos(0)
+    >>> x = 0.5 * c + 2.0
+    >>> f = tp.compile([[x * s, x * x - 1.0 * s * 0 + tp.q(1)]], sp.symbols("a b"))
+    >>> f([0.0, 1.0]).tolist()
+    [[0.0, 7.25]]
+    """
+
+    def __init__(self, n: int):
+        self.n = n
+        self.nodes: list[tuple] = []
+        self._index: dict = {}
+
+    def _node(self, key: tuple) -> int:
+        k = self._index.get(key)
+        if k is None:
+            k = self._index[key] = len(self.nodes)
+            self.nodes.append(key)
+        return k
+
+    def _leaf(self, kind: str, i: int) -> TapeValue:
+        if not 0 <= i < self.n:
+            raise ValueError(f"joint index must be in 0…{self.n - 1}, got {i!r}")
+        return TapeValue(self, 0.0, {self._node((kind, i)): 1.0})
+
+    def q(self, i: int) -> TapeValue:
+        """θ_i (0-based)."""
+        return self._leaf("q", i)
+
+    def sin(self, i: int) -> TapeValue:
+        """sin θ_i."""
+        return self._leaf("sin", i)
+
+    def cos(self, i: int) -> TapeValue:
+        """cos θ_i."""
+        return self._leaf("cos", i)
+
+    def operation_count(self, entries) -> int:
+        """Multiplications and additions left in the entries (each shared node counted once)."""
+        used, ops = self._used(entries), 0
+        for k in used:
+            key = self.nodes[k]
+            if key[0] == "mul":
+                ops += 1
+            elif key[0] == "sum":
+                ops += len(key[2]) - 1 + (key[1] != 0) + sum(c not in (1.0, -1.0) for _, c in key[2])
+        for e in self._flat(entries):
+            if type(e) is TapeValue:
+                ops += len(e.terms) - 1 + (e.const != 0) + sum(c not in (1.0, -1.0) for c in e.terms.values())
+        return ops
+
+    @staticmethod
+    def _flat(entries) -> list:
+        return [e for row in entries for e in row]
+
+    def _used(self, entries) -> dict:
+        """node -> number of uses, for the nodes the entries depend on."""
+        uses: dict[int, int] = {}
+        stack = [k for e in self._flat(entries) if type(e) is TapeValue for k in e.terms]
+        while stack:
+            k = stack.pop()
+            uses[k] = uses.get(k, 0) + 1
+            if uses[k] == 1:
+                key = self.nodes[k]
+                if key[0] == "mul":
+                    stack += [key[1], key[2]]
+                elif key[0] == "sum":
+                    stack += [j for j, _ in key[2]]
+        return uses
+
+    def compile(self, entries, args: Sequence[sp.Symbol], name: str = "matrix", cse: bool = True) -> "CompiledMatrix":
+        """The :class:`CompiledMatrix` of a rectangular list of rows of entries (values or numbers).
+
+        ``cse=True``: the recorded nodes are written out as one SymPy expression per entry (shared
+        subtrees are shared objects, so this costs one step per node) and ``sympy.cse`` picks the
+        temporaries: it also finds common sub-products and sub-sums the recording order hid, for the
+        fewest operations (the UR5's T, J_s, J_b, J: 120, 152, 143, 135 Python operations). ``cse=False``:
+        every node used twice or more is a temporary as recorded (faster to make, ≈ 10% more operations).
+        Constants are exact SymPy numbers equal to the floats (printed back as the same floats).
+        """
+        entries = [list(row) for row in entries]
+        shape = (len(entries), len(entries[0]) if entries else 0)
+        if any(len(row) != shape[1] for row in entries) or len(args) != self.n:
+            raise ValueError(f"entries must be a rectangular list of rows and args {self.n} symbols, "
+                             f"got {describe(entries)} and {describe(list(args))}")
+        uses = self._used(entries)
+        qs = [sp.Symbol(f"_q{i}") for i in range(self.n)]
+        expr: dict[int, sp.Expr] = {}
+        repl = []
+        num = {}
+
+        def c(v: float):  # the float as an exact SymPy number (printed back as the same float)
+            r = num.get(v)
+            if r is None:
+                r = num[v] = sp.Integer(int(v)) if v.is_integer() else sp.Rational(v)
+            return r
+
+        def value(e):
+            if type(e) is not TapeValue:
+                return c(float(e))
+            return sp.Add(*([c(e.const)] if e.const else []),
+                          *[c(co) * expr[k] if co != 1.0 else expr[k] for k, co in e.terms.items()])
+
+        for k in sorted(uses):
+            key = self.nodes[k]
+            if key[0] == "q":
+                expr[k] = qs[key[1]]
+                continue
+            if key[0] == "sin":
+                e = sp.sin(qs[key[1]])
+            elif key[0] == "cos":
+                e = sp.cos(qs[key[1]])
+            elif key[0] == "mul":
+                e = expr[key[1]] * expr[key[2]]
+            else:
+                e = value(TapeValue(self, key[1], dict(key[2])))
+            if not cse and (uses[k] > 1 or key[0] in ("sin", "cos")):
+                s = sp.Symbol(f"_x{len(repl)}")
+                repl.append((s, e))
+                e = s
+            expr[k] = e
+        reduced = [value(e) for e in self._flat(entries)]
+        if cse:
+            repl, reduced = sp.cse(reduced, symbols=sp.numbered_symbols("_x"), order="none")
+        return CompiledMatrix.from_pieces(repl, reduced, args, shape, name)
 
 
 def compile_matrix(expr: sp.MatrixBase, args: Sequence[sp.Symbol], name: str = "matrix") -> CompiledMatrix:

@@ -28,7 +28,7 @@ import numpy as np
 import sympy as sp
 from sympy.simplify.fu import TR10i
 
-from ._backend import describe
+from ._backend import check_real_finite, describe
 from .trigpoly import NotTrigPolynomial, TrigRing, single_angle_form
 
 __all__ = ["simplify_for_display", "is_identically_zero"]
@@ -77,11 +77,22 @@ def simplify_for_display(M: Any, phase_shifts: bool = False):
     a cos x − a sin x as √2 a cos(x + π/4), the form of the printed solutions (problem set, eqs. 17–20).
     For display only: the numeric fast path evaluates the unsimplified expression.
     """
+    if not isinstance(phase_shifts, (bool, np.bool_)):
+        raise TypeError(f"phase_shifts must be True or False, got {describe(phase_shifts)}")
     if isinstance(M, sp.MatrixBase):
+        for e in M:
+            _finite(e, "M")
         return sp.Matrix(M).applyfunc(lambda e: _display_entry(e, phase_shifts))
-    if isinstance(M, (str, bytes)) or not isinstance(M, (sp.Basic, int, float)):
+    if isinstance(M, (str, bytes, bool, np.bool_)) or not isinstance(M, (sp.Expr, int, float)):
         raise TypeError(f"M must be a SymPy Matrix or expression, got {describe(M)}")
-    return _display_entry(sp.sympify(M), phase_shifts)
+    return _display_entry(_finite(sp.sympify(M), "M"), phase_shifts)
+
+
+def _finite(e: Any, name: str) -> sp.Expr:
+    """e if it is a finite, real SymPy expression (any symbols); refused otherwise (I, nan, oo, zoo, ...)."""
+    if not isinstance(e, sp.Expr):
+        raise TypeError(f"{name} must hold SymPy expressions or numbers, got an entry {describe(e)}")
+    return check_real_finite(e, name, symbols=False)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -119,22 +130,23 @@ def _entry_is_zero(e: sp.Expr) -> bool:
 
 def _entries(M: Any, name: str) -> list:
     if isinstance(M, sp.MatrixBase):
-        return list(M)
-    if isinstance(M, (str, bytes)) or isinstance(M, bool):
+        return [_finite(e, name) for e in M]
+    if isinstance(M, (str, bytes, bool, np.bool_)) or M is None:
         raise TypeError(f"{name} must be a SymPy expression or Matrix (or numbers), got {describe(M)}")
+    if isinstance(M, (complex, np.complexfloating)):
+        raise TypeError(f"{name} must be real, got the complex number {M!r}")
     if isinstance(M, (sp.Expr, numbers.Number)):
-        return [sp.sympify(M)]
+        return [_finite(sp.sympify(M), name)]
     if isinstance(M, (list, tuple, np.ndarray)):
-        if any(isinstance(e, (str, bytes, bool)) for e in np.asarray(M, dtype=object).flat):
-            raise TypeError(f"{name} must hold SymPy expressions or numbers, got {describe(M)} with a string or bool")
+        if any(isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None
+               for e in np.asarray(M, dtype=object).flat):
+            raise TypeError(f"{name} must hold real SymPy expressions or numbers, got {describe(M)} with a "
+                            f"string, bool, None or complex entry")
         try:
             flat = list(sp.Matrix(M))
         except Exception as err:
             raise TypeError(f"{name} must be a SymPy expression or Matrix (or numbers), got {describe(M)}") from err
-        for e in flat:
-            if not isinstance(e, sp.Expr):
-                raise TypeError(f"{name} must hold SymPy expressions or numbers, got an entry {describe(e)}")
-        return flat
+        return [_finite(e, name) for e in flat]
     raise TypeError(f"{name} must be a SymPy expression or Matrix (or numbers), got {describe(M)}")
 
 

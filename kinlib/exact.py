@@ -156,7 +156,8 @@ def _table(subs: Any, thetas: Any) -> tuple:
     else:
         vals = list(subs) if not isinstance(subs, np.ndarray) else subs.reshape(-1).tolist()
         if thetas is None:
-            raise ValueError("subs is a sequence of joint values: give thetas= (the joint symbols, in order) too")
+            raise ValueError(f"subs is a sequence of joint values (got {describe(subs)}): give thetas= (the joint "
+                             "symbols, in order) too, or a mapping {joint symbol: value}")
         thetas = _joint_symbols(thetas)
         if len(vals) != len(thetas):
             raise ValueError(f"subs must hold {len(thetas)} joint values (one per joint "
@@ -179,8 +180,11 @@ def _table(subs: Any, thetas: Any) -> tuple:
 
 def _evaluated(J: Any, subs: Any, thetas: Any) -> tuple:
     """(J at the configuration as an exact SymPy Matrix, numeric?) — numeric when a joint value is a float."""
+    if not isinstance(J, (sp.MatrixBase, list, tuple, np.ndarray)):
+        raise TypeError(f"J must be a matrix (m×n Jacobian), got {describe(J)}")
     if subs is not None and not is_symbolic(J):
-        raise TypeError(f"subs only applies to a symbolic J; J is numeric ({describe(J)}): call without subs")
+        raise TypeError(f"subs only applies to a symbolic J (SymPy expressions in the joint symbols); got a "
+                        f"numeric J ({describe(J)}): call without subs")
     M = _jacobian(J)
     numeric = False
     if subs is not None:
@@ -188,7 +192,8 @@ def _evaluated(J: Any, subs: Any, thetas: Any) -> tuple:
         M = M.xreplace(table)
     left = sorted((s for s in M.free_symbols if not s.is_positive), key=str)
     if left:
-        raise ValueError(f"J still depends on {', '.join(map(str, left))}: this needs J at a configuration; give a "
+        raise ValueError(f"J must be taken at a configuration: it still depends on {', '.join(map(str, left))} (got "
+                         f"{describe(J)}{' and subs ' + sp.sstr(subs) if subs is not None else ', no subs'}); give a "
                          "value for every joint in subs (only positive parameters such as link lengths may stay symbolic)")
     for e in M:   # the values may have brought in I, oo, nan (checked cheaply: entries can be large trees)
         if e.has(sp.I, sp.nan, sp.zoo, sp.oo, -sp.oo):

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_screw_list, as_thetas, describe, is_symbolic
+from ._backend import as_matrix, as_screw_list, as_thetas, as_vector, describe, is_symbolic
 from .rigid import check_se3, check_so3, cross, skew
 from .screws import _exp6, _screw_kind
 
@@ -180,7 +180,6 @@ def linear_first(J):
     if isinstance(J, sp.MatrixBase) or (np.ndim(J) == 2):
         X = as_matrix(J, "J", (6, None), symbolic)
     else:
-        from ._backend import as_vector
         X = as_vector(J, "J", 6, symbolic)
         if symbolic:
             X = sp.Matrix(X)
@@ -205,15 +204,25 @@ def position_jacobian(p, thetas):
         exprs = list(p)
     else:
         raise TypeError(f"p must be a sequence or column of SymPy expressions (the position map), got {describe(p)}")
+    if not exprs:
+        raise ValueError("p must hold at least one coordinate, got an empty sequence")
     for i, e in enumerate(exprs):
-        if isinstance(e, (str, bytes)) or not isinstance(e, (sp.Expr, int, float)):
+        if isinstance(e, (str, bytes, bool, np.bool_)) or not isinstance(e, (sp.Expr, int, float, np.integer, np.floating)):
             raise TypeError(f"p[{i}] must be a SymPy expression in the joint symbols, got {describe(e)}")
+    exprs = [as_vector([e], f"p[{i}]", 1, True)[0] for i, e in enumerate(exprs)]  # exact, real and finite
     if isinstance(thetas, sp.Symbol):
         thetas = [thetas]
     if not isinstance(thetas, (list, tuple, sp.MatrixBase)):
         raise TypeError(f"thetas must be a sequence of SymPy symbols (the joint variables), got {describe(thetas)}")
     ths = list(thetas)
+    if not ths:
+        raise ValueError("thetas must hold at least one joint symbol, got an empty sequence")
     for i, t in enumerate(ths):
         if not isinstance(t, sp.Symbol):
             raise TypeError(f"thetas[{i}] must be a SymPy Symbol (a joint variable), got {describe(t)}")
-    return sp.Matrix([sp.sympify(e) for e in exprs]).jacobian(ths)
+        if t.is_real is not True:
+            raise ValueError(f"thetas[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)), got the symbol "
+                             f"{t} with no real assumption")
+    if len(set(ths)) != len(ths):
+        raise ValueError(f"thetas must hold distinct symbols, got {', '.join(map(str, ths))}")
+    return sp.Matrix(exprs).jacobian(ths)

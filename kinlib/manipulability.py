@@ -14,6 +14,8 @@ batch of Jacobians (N, m, n) gives (N,) results.
 """
 from __future__ import annotations
 
+import itertools
+import numbers
 from typing import Any
 
 import numpy as np
@@ -21,24 +23,43 @@ import sympy as sp
 
 from ._backend import as_matrix, as_vector, describe, is_symbolic
 from .singularities import _det, _is_zero, task_rows, trig_simplify
+from .exact import exact_is_zero
 from .trigpoly import TrigRing, angles_in
 
 __all__ = ["manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
            "twist_speed", "singular_values", "strongest_joints"]
 
 
-def _numeric(J: Any, name: str = "J") -> np.ndarray:
-    """A float array of shape (m, n) or (N, m, n)."""
-    if isinstance(J, (str, bytes)) or J is None or np.isscalar(J):
-        raise TypeError(f"{name} must be a matrix (m, n) or a batch (N, m, n), got {describe(J)}")
-    try:
-        A = np.asarray(J, dtype=float)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must hold real numbers, got {describe(J)}") from None
-    if A.ndim not in (2, 3) or 0 in A.shape:
-        raise ValueError(f"{name} must be a matrix (m, n) or a batch (N, m, n), got {describe(J)}")
-    if not np.all(np.isfinite(A)):
-        raise ValueError(f"{name} must hold finite numbers (no nan/inf)")
+def _numeric(J: Any, name: str = "J", ndims: tuple = (2, 3)) -> np.ndarray:
+    """A float array of shape (m, n) or (N, m, n) of finite real numbers (no bools, strings, complex).
+
+    ``ndims=(1, 2)``: a vector (n,) or a batch of them (N, n) instead.
+    """
+    want = ("a matrix (m, n) or a batch (N, m, n)" if ndims == (2, 3) else "a vector (n,) or a batch (N, n)") + \
+        " of real numbers"
+    if isinstance(J, (str, bytes)) or J is None or np.isscalar(J) or isinstance(J, sp.Basic):
+        raise TypeError(f"{name} must be {want}, got {describe(J)}")
+    if isinstance(J, np.ndarray) and J.dtype.kind in "fiu":
+        A = J.astype(float, copy=False)
+    else:
+        try:
+            obj = J if isinstance(J, np.ndarray) else np.asarray(J, dtype=object)
+        except (TypeError, ValueError):
+            raise TypeError(f"{name} must be {want}, got {describe(J)}") from None
+        if obj.dtype.kind != "O":   # bool, complex, string arrays
+            raise TypeError(f"{name} must be {want}, got {describe(J)}")
+        for e in obj.flat:
+            if isinstance(e, (bool, np.bool_)) or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                raise TypeError(f"{name} must be {want}, got {describe(J)} with an entry {describe(e)}")
+        try:
+            A = np.array(obj.tolist(), dtype=float)
+        except (TypeError, ValueError):
+            raise TypeError(f"{name} must be {want}, got {describe(J)}") from None
+    if A.ndim not in ndims or 0 in A.shape:
+        raise ValueError(f"{name} must be {want}, got {describe(J)}")
+    if not np.isfinite(A).all():
+        raise ValueError(f"{name} must hold finite numbers (no nan/inf), got {describe(J)} with "
+                         f"{int((~np.isfinite(A)).sum())} nan/inf entries")
     return A
 
 
@@ -96,21 +117,110 @@ def manipulability(J: Any, simplify: bool = False):
     return _display_sqrt(D)
 
 
-def _gram_eigenvalues(M: sp.Matrix) -> list:
-    G = _gram(M)
-    if G.free_symbols and angles_in(list(G)):
-        G = trig_simplify(G)
-    else:
-        G = G.applyfunc(sp.simplify)
-    ev = G.eigenvals(multiple=True, simplify=True)
-    return [sp.simplify(e) for e in ev]
+def _exact_sign(e: sp.Expr, what: str) -> int:
+    """Sign of a constant e, decided exactly (is_zero / is_positive) or by 50-digit evaluation with a clear gap."""
+    if e.is_zero or e == 0:
+        return 0
+    if e.is_positive:
+        return 1
+    if e.is_negative:
+        return -1
+    v = sp.N(e, 50)
+    if v.is_real and abs(v) > sp.Float("1e-40", 50):
+        return 1 if v > 0 else -1
+    try:
+        if exact_is_zero(e):
+            return 0
+    except ValueError:
+        pass
+    raise ValueError(f"could not decide the sign of {what} = {e} exactly")
+
+
+def _kappa_parts(J: Any, what: str):
+    """Symbolic κ from the k×k Gram matrix G (k = min(m, n)): ('one',) when κ = 1, ('singular',) when κ = ∞
+    everywhere, or ('ratio', top, bottom) with κ = top/bottom, both ≥ 0 (bottom = 0 at singular points).
+
+    k = 2: λ± = (t ± √(t² − 4d))/2 (t = trace G, d = det G, t² − 4d = (a − c)² + 4b² ≥ 0), so
+    κ = √(λ₊/λ₋) = (t + √(t² − 4d)) / (2√d). A constant G: its exact eigenvalues.
+    """
+    M = _symbolic(J)
+    k = min(M.shape)
+    if k == 1:
+        return ("one",)
+    # G as normal forms modulo sin² + cos² = 1 (canonical and fast; no trigsimp of big expressions)
+    ring = TrigRing(list(M), angles_in(list(M)), opaque=True)
+    E = [[ring.normal_form(M[i, j]) for j in range(M.cols)] for i in range(M.rows)]
+    A = E if M.rows <= M.cols else [list(col) for col in zip(*E)]          # k×N
+    R = ring.ring
+    G = [[ring.reduce(sum((x * y for x, y in zip(A[i], A[j])), R.zero)) for j in range(k)] for i in range(k)]
+    if all(not g or g.is_ground for row in G for g in row):
+        Gc = sp.Matrix(k, k, lambda i, j: ring.to_expr(G[i][j]) if G[i][j] else sp.S.Zero)
+        ev = [sp.radsimp(e) for e in Gc.eigenvals(multiple=True)]
+        if any(_exact_sign(e, "an eigenvalue of the Gram matrix") == 0 for e in ev):
+            return ("singular",)
+        top = bottom = ev[0]
+        for e in ev[1:]:
+            if _exact_sign(e - top, "a difference of eigenvalues") > 0:
+                top = e
+            if _exact_sign(e - bottom, "a difference of eigenvalues") < 0:
+                bottom = e
+        if _exact_sign(top - bottom, "a difference of eigenvalues") == 0:
+            return ("one",)
+        return ("ratio", sp.radsimp(sp.sqrt(top)), sp.radsimp(sp.sqrt(bottom)))
+    if k > 2:
+        raise ValueError(
+            f"{what} of a symbolic J with k = min(m, n) = {k} ≥ 3 has no readable closed form (the Gram "
+            "eigenvalues are roots of a cubic or worse): evaluate it numerically, e.g. "
+            f"{what}(chain.subs(L=1).jacobian_geometric(q)) with float joint values q, or pick 2 task rows "
+            "with task_rows(J, [...]) (a 2-row J has a closed form), or give J at a configuration "
+            "(no free symbols) for the exact value")
+    t = G[0][0] + G[1][1]
+    d = ring.reduce(G[0][0] * G[1][1] - G[0][1] * G[0][1])
+    disc = ring.reduce(t * t - 4 * d)
+    if not disc:
+        return ("one",)
+    if not d:
+        return ("singular",)
+    return ("ratio", _show(ring, t) + _sqrt_form(ring, disc), 2 * _sqrt_form(ring, d))
+
+
+def _show(ring, p, limit: int = 120) -> sp.Expr:
+    """A ring element in sin/cos: factored as a polynomial, angle sums folded when small."""
+    e = ring.to_trig(sp.factor(ring.to_expr(p, trig=False)))
+    return sp.trigsimp(e) if sp.count_ops(e) < limit else e
+
+
+def _sqrt_form(ring, p) -> sp.Expr:
+    """√p for display (p ≥ 0): squared factors taken out (|f| unless f ≥ 0 is known), the rest under the root."""
+    coeff, factors = sp.factor_list(ring.to_expr(p, trig=False))
+    outside, inside = sp.S.One, coeff
+    for f, m in factors:
+        ft = ring.to_trig(f)
+        if m >= 2:
+            ft_out = _show(ring, ring.from_expr(ft)) if ft.has(sp.sin, sp.cos) else ft
+            outside *= (ft_out if ft.is_nonnegative else sp.Abs(ft_out)) ** (m // 2)
+        if m % 2:
+            inside *= ft
+    if inside.has(sp.sin, sp.cos):
+        inside = _show(ring, ring.reduce(ring.from_expr(inside)))
+    return outside * sp.sqrt(inside)
 
 
 def condition_number(J: Any):
     """κ = σ_max / σ_min (≥ 1; ∞ at a singular configuration), over the k = min(m, n) singular values.
 
-    Numeric J (or a batch): floats. SymPy J: √(λ_max/λ_min) of the Gram matrix, exact (with Max/Min left
-    unevaluated where the eigenvalues cannot be ordered).
+    Numeric J (or a batch): floats. SymPy J: exact, from the k×k Gram matrix G = J Jᵀ (or Jᵀ J) with
+    eigenvalues λ = σ²: for k = 2, κ = √(λ₊/λ₋) = (t + √(t² − 4d)) / (2√d) with t = trace G, d = det G
+    (trig-simplified; d = 0 exactly at the singular configurations, where κ = ∞ — SymPy gives zoo);
+    k = 1 gives 1; with no free symbols the exact eigenvalues of the constant G; k ≥ 3 with free joint
+    symbols is refused (ValueError) with the numeric alternative named.
+
+    >>> import sympy as sp
+    >>> condition_number(sp.Matrix([[2, 0], [0, 1]]))
+    2
+    >>> t = sp.Symbol("t", real=True)
+    >>> condition_number(sp.Matrix([[1, sp.cos(t)], [0, sp.sin(t)]]))
+    (Abs(cos(t)) + 1)/Abs(sin(t))
     """
     if not is_symbolic(J):
         s = np.linalg.svd(_numeric(J), compute_uv=False)
@@ -118,16 +228,23 @@ def condition_number(J: Any):
         with np.errstate(divide="ignore", invalid="ignore"):
             out = np.where(smin > 1e-12 * np.maximum(smax, 1e-300), smax / np.where(smin > 0, smin, 1), np.inf)
         return float(out) if np.ndim(out) == 0 else out
-    ev = _gram_eigenvalues(_symbolic(J))
-    if any(_is_zero(e) for e in ev):
-        return sp.oo
-    if len(set(ev)) == 1:
+    parts = _kappa_parts(J, "condition_number")
+    if parts[0] == "one":
         return sp.S.One
-    return sp.sqrt(sp.Max(*ev) / sp.Min(*ev))
+    if parts[0] == "singular":
+        return sp.oo
+    return sp.factor_terms(parts[1] / parts[2])
 
 
 def isotropy(J: Any):
-    """1/κ = σ_min / σ_max ∈ [0, 1]: 1 when the velocity ellipsoid is a sphere (circle), 0 at a singularity."""
+    """1/κ = σ_min / σ_max ∈ [0, 1]: 1 when the velocity ellipsoid is a sphere (circle), 0 at a singularity.
+
+    SymPy J as for :func:`condition_number`: for k = 2, 2√d / (t + √(t² − 4d)) (0 where d = det G = 0).
+
+    >>> import sympy as sp
+    >>> isotropy(sp.Matrix([[2, 0], [0, 1]]))
+    1/2
+    """
     if not is_symbolic(J):
         s = np.linalg.svd(_numeric(J), compute_uv=False)
         smax, smin = s[..., 0], s[..., -1]
@@ -135,12 +252,12 @@ def isotropy(J: Any):
             ratio = smin / np.where(smax > 0, smax, 1)
             out = np.where((smax > 0) & (ratio > 1e-12), ratio, 0.0)
         return float(out) if np.ndim(out) == 0 else out
-    ev = _gram_eigenvalues(_symbolic(J))
-    if any(_is_zero(e) for e in ev):
-        return sp.S.Zero
-    if len(set(ev)) == 1:
+    parts = _kappa_parts(J, "isotropy")
+    if parts[0] == "one":
         return sp.S.One
-    return sp.sqrt(sp.Min(*ev) / sp.Max(*ev))
+    if parts[0] == "singular":
+        return sp.S.Zero
+    return sp.factor_terms(parts[2] / parts[1])
 
 
 def velocity_ellipsoid(J: Any, rows: Any = None):
@@ -200,8 +317,8 @@ def twist_speed(J: Any, qdot: Any, simplify: bool = False):
     """V·V = θ̇ᵀ (Jᵀ J) θ̇ = ‖J θ̇‖², the squared size of the twist V = J θ̇ (problem 6.2)."""
     if not is_symbolic(J, qdot):
         A = _numeric(J)
-        q = np.asarray(qdot, dtype=float) if not isinstance(qdot, (str, bytes)) else None
-        if q is None or q.shape[-1:] != (A.shape[-1],):
+        q = _numeric(qdot, "qdot", (1, 2))
+        if q.shape[-1:] != (A.shape[-1],):
             raise ValueError(f"qdot must hold {A.shape[-1]} joint rates, got {describe(qdot)}")
         V = np.einsum("...ij,...j->...i", A, q)
         return np.sum(V * V, axis=-1)
@@ -223,9 +340,12 @@ def strongest_joints(row: Any, tol: float = 1e-9):
     elif isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
         raise TypeError(f"row must be the n entries of one row of J, got {describe(row)}")
     else:
-        vals = list(np.asarray(row, dtype=object).reshape(-1))
+        arr = np.asarray(row, dtype=object)
+        if arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
+            raise ValueError(f"row must be the n entries of one row of J, got {describe(row)}")
+        vals = list(arr.reshape(-1))
     if not vals:
-        raise ValueError("row must hold at least one entry")
+        raise ValueError(f"row must hold at least one entry, got {describe(row)}")
     if is_symbolic(vals):
         vals = [sp.sympify(v) for v in vals]
         if any(not v.is_number or not v.is_real for v in vals):

@@ -5,13 +5,15 @@ SymPy Matrix) or numeric input (a NumPy float array).
 """
 from __future__ import annotations
 
+import math
+import numbers
 import random
 
 import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from ._backend import as_matrix, as_vector, describe, is_symbolic, is_zero
+from ._backend import as_matrix, as_vector, check_real_finite, describe, exact_floats, exact_number, is_symbolic, is_zero
 
 __all__ = [
     "skew", "unskew", "exp3", "rp_to_trans", "trans_to_rp", "trans_inv", "adjoint",
@@ -50,13 +52,29 @@ def unskew(W):
     return sp.Matrix(v) if symbolic else np.array(v, dtype=float)
 
 
+#: Typed decimals (floats made exact, 0.7071067811865476 → 7071067811865476/10¹⁶) that are a unit vector
+#: only to rounding are accepted when | |ω|² − 1 | ≤ this: the chain is then exact in the numbers typed.
+UNIT_ROUNDING = sp.Rational(1, 10**9)
+
+
 def _unit_axis(omega, name: str):
-    """Check that ω is a unit vector; return it (SymPy column or float array)."""
+    """Check that ω is a unit vector; return it (SymPy column or float array).
+
+    Numeric: | |ω| − 1 | ≤ 1e-6. Exact: |ω|² = 1 exactly, except for an axis of plain rational numbers
+    (typically typed or computed floats made exact: [0.7071067811865476, 0.7071067811865476, 0]) where
+    | |ω|² − 1 | ≤ 1e-9 is accepted and the typed decimals are kept as they are (never rounded to a
+    "nice" value): results are exact for the numbers typed. Type sp.sqrt(2)/2 for an exactly unit axis.
+    """
     symbolic = isinstance(omega, sp.MatrixBase)
     if symbolic:
         n2 = (omega.T * omega)[0]
-        if not is_zero(n2 - 1):
-            raise ValueError(f"{name} must be a unit vector (|ω| = 1), got {list(omega)} with |ω|² = {sp.simplify(n2)}")
+        if n2 != 1 and not (n2.is_Rational and abs(n2 - 1) <= UNIT_ROUNDING) and not is_zero(n2 - 1):
+            hint = ""
+            if n2.is_Rational and abs(n2 - 1) < sp.Rational(1, 1000):
+                hint = (f" (|ω|² − 1 = {float(n2 - 1):.3g}; decimals are accepted when |ω|² is 1 to within 1e-9: "
+                        f"type more digits, or exact values such as sp.sqrt(2)/2)")
+            raise ValueError(f"{name} must be a unit vector (|ω| = 1), got {list(omega)} with "
+                             f"|ω|² = {sp.simplify(n2)}{hint}")
     else:
         n = float(np.sqrt(omega @ omega))
         if abs(n - 1.0) > _TOL:
@@ -76,20 +94,21 @@ def exp3(omega, theta):
 
 
 def _scalar(x, name: str, symbolic: bool):
-    if isinstance(x, (str, bytes)) or isinstance(x, bool):
-        raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
+    """A joint value / pitch: exact (symbolic; 0.1 → 1/10) or a finite float; anything else refused."""
     if symbolic:
-        try:
-            e = sp.sympify(x, strict=True)
-        except (sp.SympifyError, TypeError):
-            raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}") from None
-        if not isinstance(e, sp.Expr):
-            raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
-        return e
-    try:
-        return float(x)
-    except (TypeError, ValueError):
-        raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}") from None
+        if isinstance(x, sp.Basic) and not isinstance(x, sp.Float):
+            if not isinstance(x, sp.Expr):
+                raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
+            return check_real_finite(exact_floats(x, name), name)
+        return exact_number(x, name)
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (numbers.Real, np.integer, np.floating)):
+        if isinstance(x, (complex, np.complexfloating)):
+            raise TypeError(f"{name} must be a real number, got the complex number {x!r}")
+        raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
+    x = float(x)
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be a finite real number, got {x!r}")
+    return x
 
 
 def rp_to_trans(R, p):
@@ -177,3 +196,228 @@ def adjoint(T):
     out[3:, 3:] = R
     out[3:, :3] = skew(p) @ R
     return out
+
+
+# ----------------------------------------------------------------------------------------------
+# The matrix logarithm of SO(3) (issue 11, item 7), and two helpers it shares with
+# kinlib.screws.log6 and kinlib.velocity (public names so those modules may import them).
+# ----------------------------------------------------------------------------------------------
+def real_array(x, name: str, want: str) -> np.ndarray:
+    """``x`` as a float array after refusing str/bytes/None/bool/complex entries and NaN/±inf.
+
+    ``want`` describes the expected value for the error message (e.g. "a 3×3 rotation matrix").
+    Shapes are checked by the caller.
+    """
+    import numbers
+    if isinstance(x, (str, bytes)) or x is None or isinstance(x, (bool, np.bool_, numbers.Number)):
+        raise TypeError(f"{name} must be {want}, got {describe(x)}")
+    try:
+        a = np.asarray(x)
+    except Exception:
+        raise TypeError(f"{name} must be {want}, got {describe(x)}") from None
+    if a.dtype.kind == "b":
+        raise TypeError(f"{name} must hold real numbers, got booleans ({describe(x)})")
+    if a.dtype.kind == "c":
+        raise TypeError(f"{name} must hold real numbers, got complex numbers ({describe(x)})")
+    if a.dtype.kind not in "iuf":
+        for e in a.reshape(-1):
+            if isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None \
+                    or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)}")
+        a = a.astype(float)
+    a = a.astype(float, copy=False)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must hold finite real numbers, got NaN or ±inf in {describe(x)}")
+    return a
+
+
+def proved_zero(e, what: str = "an entry") -> bool:
+    """Decide e = 0 for a constant SymPy expression (no free symbols) with a proof, never a guess.
+
+    * nonzero: SymPy's ``evalf(30, strict=True)`` returns a value with 30 correct digits (its error
+      tracking raises ``PrecisionExhausted`` rather than return a digit it cannot guarantee) that is not 0;
+    * zero: a normal form (:func:`kinlib.is_identically_zero`, the sin² + cos² = 1 reduction), the
+      minimal polynomial x of an algebraic number, or ``sp.simplify(e) == 0``.
+
+    Anything else raises ``ValueError`` (an honest "cannot decide"), never a silent answer.
+
+    >>> proved_zero(sp.sin(3)**2 + sp.cos(3)**2 - 1), proved_zero(sp.sqrt(2)/2 - sp.Rational(7, 10))
+    (True, False)
+    """
+    e = sp.sympify(e)
+    if e == 0:
+        return True
+    if e.free_symbols:
+        raise ValueError(f"proved_zero decides constants only, got {what} = {e} with symbols")
+    try:
+        v = e.evalf(30, strict=True)
+        if v.is_Number and v != 0:
+            return False
+        if v.is_number and (sp.re(v) != 0 or sp.im(v) != 0) and v.is_comparable is not False:
+            return False
+    except (sp.core.evalf.PrecisionExhausted, TypeError, ValueError):
+        pass
+    from .display import is_identically_zero  # local import: display imports nothing from here
+    try:
+        if is_identically_zero(e):
+            return True
+    except Exception:  # pragma: no cover - a route that fails is just not a proof
+        pass
+    x = sp.Dummy("x")
+    try:
+        if sp.minimal_polynomial(e, x) == x:
+            return True
+    except Exception:  # not algebraic (sin 3 ...), or too hard
+        pass
+    if sp.simplify(e) == 0:
+        return True
+    raise ValueError(f"could not decide exactly whether {what} = {e} is zero (30 digits cannot tell it "
+                     f"from 0 and no exact identity was found); evaluate numerically (NumPy input) instead")
+
+
+def _log3_numeric(A: np.ndarray):
+    """(vector ω̂θ, axis ω̂, angle θ) for a batch (N, 3, 3) of rotation matrices."""
+    ax = 0.5 * np.stack([A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0], A[:, 1, 0] - A[:, 0, 1]], axis=-1)
+    s = np.linalg.norm(ax, axis=-1)                                  # = sin θ
+    c = np.clip((np.trace(A, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)   # = cos θ
+    theta = np.arctan2(s, c)                                         # θ ∈ [0, π], accurate near 0 and π
+    vec = ax / np.sinc(theta / np.pi)[:, None]                       # sin θ ω̂ · θ / sin θ  (θ ≤ π/2 branch)
+    big = c < 0                                                      # θ > π/2: the axis from the symmetric part
+    if np.any(big):
+        Ab = A[big]
+        B = 0.5 * (Ab + np.swapaxes(Ab, 1, 2)) - c[big][:, None, None] * np.eye(3)   # (1 − cos θ) ω̂ω̂ᵀ
+        k = np.argmax(np.diagonal(B, axis1=1, axis2=2), axis=-1)
+        col = B[np.arange(len(k)), :, k]
+        w = col / np.linalg.norm(col, axis=-1)[:, None]              # ω̂ up to sign, ω̂_k > 0
+        d = np.einsum("ij,ij->i", w, ax[big])                        # = sin θ (ω̂·ω̂) with the right sign
+        # at θ = π (to rounding) either sign is a logarithm: Modern Robotics' choice, the first of
+        # ω̂_3, ω̂_2, ω̂_1 with 1 + r_kk = 2ω̂_k² not near 0 (|·| ≥ 1e-6, its NearZero) is positive
+        diag1 = 1.0 + np.diagonal(Ab, axis1=1, axis2=2)
+        kk = np.where(diag1[:, 2] >= 1e-6, 2, np.where(diag1[:, 1] >= 1e-6, 1, 0))
+        mr_sign = np.sign(w[np.arange(len(kk)), kk])
+        sign = np.where(d > 1e-14, 1.0, np.where(d < -1e-14, -1.0, np.where(mr_sign == 0, 1.0, mr_sign)))
+        vec[big] = (sign * theta[big])[:, None] * w
+    axis = np.where((theta > 0)[:, None], vec / np.where(theta > 0, theta, 1.0)[:, None], [0.0, 0.0, 1.0])
+    return vec, axis, theta
+
+
+def _log3_exact(R: sp.Matrix):
+    """(ω̂, θ, exactly_zero) for an exact SymPy rotation matrix; see :func:`log3`."""
+    from ._backend import check_real_finite, exact_number
+    from .display import is_identically_zero, simplify_for_display
+    for e in R:
+        check_real_finite(e, "R")
+    if not R.free_symbols:
+        R = R.applyfunc(lambda e: exact_number(e, "R"))
+        D = R.T * R - sp.eye(3)
+        for i in range(3):
+            for j in range(i, 3):
+                if not proved_zero(D[i, j], f"(RᵀR − I)[{i}, {j}]"):
+                    raise ValueError(f"R must be exactly a rotation matrix (RᵀR = I) for an exact logarithm, got "
+                                     f"{R.tolist()} with (RᵀR − I)[{i}, {j}] = {D[i, j]} ≠ 0; "
+                                     f"give exact entries (sp.sqrt(2)/2, not 0.7071) or a NumPy array for a numeric log")
+        if not proved_zero(R.det() - 1, "det R − 1"):
+            raise ValueError(f"R must be a rotation matrix with det R = 1, got det R = {sp.simplify(R.det())}")
+        simp = sp.radsimp
+        c = simp(sp.expand((R.trace() - 1) / 2))
+        if proved_zero(c - 1, "cos θ − 1"):
+            return sp.Matrix([0, 0, 1]), sp.S.Zero, True
+        if proved_zero(c + 1, "cos θ + 1"):
+            # θ = π, Modern Robotics' three branches: ω̂ = (r_k + e_k)/√(2(1 + r_kk)) for the first k = 3, 2, 1
+            # with 1 + r_kk ≠ 0 (r_k the k-th column of R)
+            for k in (2, 1, 0):
+                d = 1 + R[k, k]
+                if not proved_zero(d, f"1 + r{k + 1}{k + 1}"):
+                    w = (R[:, k] + sp.eye(3)[:, k]) / sp.sqrt(2 * d)
+                    return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), sp.pi, False
+            raise AssertionError("unreachable: a rotation by π has some 1 + r_kk = 2ω̂_k² ≠ 0")  # pragma: no cover
+        theta = sp.acos(c)
+        s = sp.sqrt(simp(1 - c ** 2))                                # sin θ > 0 for 0 < θ < π
+        w = sp.Matrix([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (2 * s)
+        return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), theta, False
+    # free symbols: the closed form valid for 0 < θ < π (sin θ ≠ 0)
+    if is_identically_zero(R - sp.eye(3)):
+        return sp.Matrix([0, 0, 1]), sp.S.Zero, True
+    c = simplify_for_display((R.trace() - 1) / 2)
+    s = sp.sqrt(simplify_for_display(1 - c ** 2))
+    w = simplify_for_display(sp.Matrix([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / 2) / s
+    return w, sp.acos(c), False
+
+
+_LOG3_FORMS = ("matrix", "vector", "axis_angle")
+
+
+def _check_form(form, forms, name="form"):
+    if not isinstance(form, str) or form not in forms:
+        raise ValueError(f"{name} must be one of {', '.join(map(repr, forms))}, got {describe(form)}")
+
+
+def log3(R, form: str = "matrix"):
+    """The matrix logarithm of SO(3): [ω̂]θ ∈ so(3) with e^{[ω̂]θ} = R, θ ∈ [0, π] (Modern Robotics' MatrixLog3).
+
+    Lynch & Park, Algorithm 3.1 (section 3.2.3.3):
+
+    * R = I:          θ = 0 (ω̂ undefined; ``form="axis_angle"`` returns the convention ω̂ = ẑ = (0, 0, 1));
+    * tr R = −1:      θ = π, ω̂ = (r_k + e_k)/√(2(1 + r_kk)) for the first k = 3, 2, 1 with 1 + r_kk ≠ 0
+                      (−ω̂ is as good a logarithm: this is the book's choice);
+    * otherwise:      θ = arccos((tr R − 1)/2) ∈ (0, π),  [ω̂] = (R − Rᵀ)/(2 sin θ).
+
+    ``form``: "matrix" → [ω̂]θ (3×3); "vector" → ω̂θ (the exponential coordinates, a 3-vector);
+    "axis_angle" → (ω̂, θ). The inverse of :func:`exp3`: ``exp3(*log3(R, "axis_angle")) == R``.
+
+    Exact (SymPy R without symbols): RᵀR = I and det R = 1 are proved first (else ValueError); θ = 0 and θ = π
+    are decided exactly; θ = acos(…) stays exact (π/4 for √2/2 entries, 2π/7 for cos(2π/7) ...).
+    SymPy R with free symbols: the closed form θ = acos((tr R − 1)/2), [ω̂]θ = θ (R − Rᵀ)/(2 sin θ), valid where
+    0 < θ < π (substitute values first for θ = 0 or π); R = I identically is recognised.
+    Numbers: floats, (3, 3) or a batch (N, 3, 3) (→ (N, 3, 3), (N, 3), or ((N, 3), (N,))); θ = atan2(|axial|, cos θ)
+    (accurate near 0 and π); for θ > π/2 the axis comes from the symmetric part (R + Rᵀ)/2 − cos θ I = (1 − cos θ)ω̂ω̂ᵀ.
+    R must be orthogonal with det 1 to 1e-6 (else ValueError).
+
+    >>> import sympy as sp
+    >>> h = sp.sqrt(2) / 2
+    >>> log3(sp.Matrix([[h, -h, 0], [h, h, 0], [0, 0, 1]]))
+    Matrix([
+    [   0, -pi/4, 0],
+    [pi/4,     0, 0],
+    [   0,     0, 0]])
+    >>> log3(sp.diag(1, -1, -1), form="axis_angle")
+    (Matrix([
+    [1],
+    [0],
+    [0]]), pi)
+    >>> import numpy as np
+    >>> np.round(log3(np.diag([1.0, -1.0, -1.0]), form="vector"), 6)
+    array([3.141593, 0.      , 0.      ])
+    """
+    _check_form(form, _LOG3_FORMS)
+    if is_symbolic(R):
+        Rm = check_so3(R, "R")
+        w, theta, zero = _log3_exact(Rm)
+        if form == "axis_angle":
+            return w, theta
+        vec = sp.zeros(3, 1) if zero else w * theta
+        return vec if form == "vector" else skew(vec)
+    A = real_array(R, "R", "a 3×3 rotation matrix or a batch (N, 3, 3) of them")
+    if A.shape[-2:] != (3, 3) or A.ndim not in (2, 3):
+        raise ValueError(f"R must be a 3×3 rotation matrix or a batch (N, 3, 3) of them, got {describe(A)}")
+    single = A.ndim == 2
+    B = A[None] if single else A
+    err = np.abs(np.swapaxes(B, 1, 2) @ B - np.eye(3)).max(axis=(1, 2)) if len(B) else np.zeros(0)
+    det = np.linalg.det(B) if len(B) else np.zeros(0)
+    bad = np.flatnonzero((err > _TOL) | (np.abs(det - 1) > _TOL))
+    if bad.size:
+        i = bad[0]
+        where = "" if single else f"[{i}]"
+        raise ValueError(f"R{where} must be a rotation matrix in SO(3) (RᵀR = I, det R = 1 to {_TOL:g}), got RᵀR − I "
+                         f"of size {err[i]:.3g} and det R = {det[i]:.6g}")
+    vec, axis, theta = _log3_numeric(B)
+    if single:
+        vec, axis, theta = vec[0], axis[0], float(theta[0])
+    if form == "axis_angle":
+        return axis, theta
+    if form == "vector":
+        return vec + 0.0
+    W = np.zeros(vec.shape[:-1] + (3, 3))
+    W[..., 0, 1], W[..., 0, 2], W[..., 1, 2] = -vec[..., 2], vec[..., 1], -vec[..., 0]
+    W[..., 1, 0], W[..., 2, 0], W[..., 2, 1] = vec[..., 2], -vec[..., 1], vec[..., 0]
+    return W + 0.0

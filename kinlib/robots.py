@@ -9,23 +9,27 @@ from __future__ import annotations
 
 import sympy as sp
 
+from ._backend import describe, exact_number
 from .chains import SerialChain
 
 __all__ = ["cart_pole", "planar_offset_3r", "spatial_rppr", "planar_3r", "planar_rpp", "ur5", "length"]
 
 
 def length(value, name: str):
-    """A link length: a positive symbol named ``name`` when ``value`` is None, else ``value`` made exact."""
+    """A link length: a positive symbol named ``name`` when ``value`` is None, else ``value`` made exact.
+
+    Numbers become the exact decimal typed (``kinlib._backend.exact_number``: 0.425 → 17/40, 2.0 → 2);
+    SymPy expressions must be real and finite (symbols declared real or positive). Strings, bools,
+    complex numbers, NaN and inf are refused.
+
+    >>> length(0.425, "L1"), length(None, "L").is_positive
+    (17/40, True)
+    """
+    if not isinstance(name, str):
+        raise TypeError(f"name must be a string, got {describe(name)}")
     if value is None:
         return sp.Symbol(name, positive=True)
-    if isinstance(value, (str, bytes)) or isinstance(value, bool):
-        raise TypeError(f"{name} must be a number or a SymPy expression, got {value!r}")
-    if isinstance(value, float):
-        return sp.nsimplify(value, rational=True)
-    try:
-        return sp.sympify(value, strict=True)
-    except (sp.SympifyError, TypeError):
-        raise TypeError(f"{name} must be a number or a SymPy expression, got {value!r}") from None
+    return exact_number(value, name)
 
 
 def _T(p, R=None):
@@ -101,3 +105,123 @@ def ur5(W1=None, W2=None, L1=None, L2=None, H1=None, H2=None) -> SerialChain:
               [0, 1, 0, -H1, 0, L1 + L2], [0, 0, -1, -W1, L1 + L2, 0], [0, 1, 0, H2 - H1, 0, L1 + L2])
     pts = _cols([0, 0, 0], [0, 0, H1], [L1, 0, H1], [L1 + L2, 0, H1], [L1 + L2, W1, H1], [L1 + L2, W1, H1 - H2])
     return SerialChain(M, S, name="ur5", joint_points=pts, description="UR5 (Modern Robotics Example 4.5)")
+
+
+# --- issue 11, item 6: a student's own arm from URDF joint placements --------------------------------
+_URDF_KINDS = {"revolute": "R", "continuous": "R", "prismatic": "P", "fixed": None}
+#: largest difference between a typed rpy angle and the angle of its exact rational rotation (radians)
+URDF_ANGLE_TOL = sp.Rational(1, 10**18)
+
+
+def _rational_cos_sin(a: sp.Rational) -> tuple[sp.Rational, sp.Rational]:
+    """(cos â, sin â) = ((1 − t²)/(1 + t²), 2t/(1 + t²)) for the rational t of smallest denominator
+    (a continued-fraction convergent of tan(a/2), computed with 50 digits) with |â − a| ≤ URDF_ANGLE_TOL
+    (modulo 2π): an exact rational point on the unit circle at the typed angle, to 1e-18 rad."""
+    import mpmath
+    if a == 0:
+        return sp.Integer(1), sp.Integer(0)
+    with mpmath.workdps(50):
+        am = mpmath.mpf(a.p) / a.q
+        x, tol = mpmath.tan(am / 2), mpmath.mpf(URDF_ANGLE_TOL.p) / URDF_ANGLE_TOL.q
+        h0, h1, k0, k1 = 0, 1, 1, 0
+        for _ in range(200):
+            ai = int(mpmath.floor(x))
+            h0, h1, k0, k1 = h1, ai * h1 + h0, k1, ai * k1 + k0
+            d = 2 * mpmath.atan(mpmath.mpf(h1) / k1) - am
+            if abs(d - 2 * mpmath.pi * mpmath.nint(d / (2 * mpmath.pi))) <= tol or x == ai:
+                break
+            x = 1 / (x - ai)
+    t = sp.Rational(h1, k1)
+    return (1 - t**2) / (1 + t**2), 2 * t / (1 + t**2)
+
+
+def _urdf_rotation(rpy, where: str) -> sp.Matrix:
+    """R = Rz(yaw) Ry(pitch) Rx(roll), URDF's fixed-axis roll-pitch-yaw, exact (see :func:`from_urdf_joints`)."""
+    cs = []
+    for k, v in enumerate(_urdf_triple(rpy, f"{where} rpy")):
+        if v.is_Rational:
+            cs.append(_rational_cos_sin(v))
+        else:  # a SymPy expression (sp.pi/2, a symbol): exactly its cosine and sine
+            cs.append((sp.cos(v), sp.sin(v)))
+    (cr, sr), (cp, sp_), (cy, sy) = cs
+    Rx = sp.Matrix([[1, 0, 0], [0, cr, -sr], [0, sr, cr]])
+    Ry = sp.Matrix([[cp, 0, sp_], [0, 1, 0], [-sp_, 0, cp]])
+    Rz = sp.Matrix([[cy, -sy, 0], [sy, cy, 0], [0, 0, 1]])
+    return Rz * Ry * Rx
+
+
+def _urdf_triple(v, what: str) -> list:
+    if isinstance(v, (str, bytes)) or not hasattr(v, "__len__") or len(v) != 3:
+        raise ValueError(f"{what} must be 3 numbers, got {describe(v)}")
+    return [exact_number(x, f"{what}[{i}]") for i, x in enumerate(v)]
+
+
+def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description: str = "") -> SerialChain:
+    """A :class:`~kinlib.chains.SerialChain` from URDF joint placements, base link to tool.
+
+    ``joints``: a sequence of ``(type, xyz, rpy, axis)`` as in URDF ``<joint>`` elements, in order from
+    the base: ``type`` 'revolute' (or 'continuous'), 'prismatic' or 'fixed'; ``xyz``, ``rpy`` the
+    ``<origin>`` of the child link frame in the parent's (metres, radians; rpy = roll, pitch, yaw
+    about the fixed x, y, z axes); ``axis`` the joint axis in the child frame (ignored for 'fixed';
+    any nonzero vector, normalized exactly). ``tool``: ``(xyz, rpy)`` of the end-effector frame in
+    the last link's frame (like a final fixed joint), or None.
+
+    With the home placements T_k = T_{k−1} [[R(rpy_k), xyz_k], [0, 1]] (T_0 = I; joint values 0), a
+    revolute joint k has the space screw axis S_k = [ω_k; −ω_k × p_k] with ω_k = R_k â_k and p_k the
+    origin of T_k, a prismatic one S_k = [0; R_k â_k]; M = T_last · tool. (Lynch & Park §4.1.1.)
+
+    Exact numbers: xyz and axis entries are the decimals typed (0.0388353 → 388353/10⁷, via
+    ``kinlib._backend.exact_number``). The sine and cosine of a typed rpy angle a are irrational, so a is
+    represented by an exact *rational* rotation: cos â = (1 − t²)/(1 + t²), sin â = 2t/(1 + t²) with t
+    the first continued-fraction convergent of tan(a/2) with |â − a| ≤ 1e-18 rad (``URDF_ANGLE_TOL``),
+    far below a float's resolution. So every rotation is exactly orthogonal, every ω exactly a unit
+    vector, the whole chain rational (no sin(314159/100000) inside every entry, which would make
+    the symbolic work heavy), and its numbers equal the URDF's to rounding. The numbers are long
+    (1.5708 is not π/2: nothing is guessed); for exact right angles give SymPy angles (``sp.pi/2``),
+    whose cosine and sine are used as they are; SymPy symbols in xyz make a symbolic chain.
+
+    >>> arm = from_urdf_joints([("revolute", (0, 0, 0.1), (0, 0, 0), (0, 0, 1)),
+    ...                         ("revolute", (0, 0, 0.2), (sp.pi / 2, 0, 0), (0, 0, 1))],
+    ...                        tool=((0, 0, 0.3), (0, 0, 0)), name="two_link")
+    >>> arm.screws.T
+    Matrix([
+    [0,  0, 1,    0, 0, 0],
+    [0, -1, 0, 3/10, 0, 0]])
+    >>> arm.M
+    Matrix([
+    [1, 0,  0,     0],
+    [0, 0, -1, -3/10],
+    [0, 1,  0,  3/10],
+    [0, 0,  0,     1]])
+    """
+    if isinstance(joints, (str, bytes)) or not isinstance(joints, (list, tuple)):
+        raise TypeError(f"joints must be a list of (type, xyz, rpy, axis) tuples, got {describe(joints)}")
+    R, p = sp.eye(3), sp.zeros(3, 1)
+    screws = []
+    steps = list(enumerate(joints)) + ([(len(joints), ("fixed",) + tuple(tool) + (None,))] if tool is not None else [])
+    if tool is not None and (not isinstance(tool, (list, tuple)) or len(tool) != 2):
+        raise ValueError(f"tool must be (xyz, rpy) or None, got {describe(tool)}")
+    for k, joint in steps:
+        where = "tool" if k == len(joints) else f"joints[{k}]"
+        if not isinstance(joint, (list, tuple)) or len(joint) != 4:
+            raise ValueError(f"{where} must be (type, xyz, rpy, axis), got {describe(joint)}")
+        kind, xyz, rpy, axis = joint
+        if kind not in _URDF_KINDS:
+            raise ValueError(f"{where} type must be one of {sorted(_URDF_KINDS)}, got {kind!r}")
+        p = p + R * sp.Matrix(_urdf_triple(xyz, f"{where} xyz"))
+        R = R * _urdf_rotation(rpy, where)
+        if _URDF_KINDS[kind] is None:
+            continue
+        a = sp.Matrix(_urdf_triple(axis, f"{where} axis"))
+        n2 = (a.T * a)[0]
+        if n2 == 0:
+            raise ValueError(f"{where} axis must be a nonzero vector, got {list(a)}")
+        w = R * (a if n2 == 1 else a / sp.sqrt(n2))
+        screws.append(list(w) + list(-w.cross(p)) if _URDF_KINDS[kind] == "R" else [0, 0, 0] + list(w))
+    if not screws:
+        raise ValueError(f"joints must hold at least one revolute or prismatic joint, got {describe(joints)}")
+    M = sp.Matrix.vstack(sp.Matrix.hstack(R, p), sp.Matrix([[0, 0, 0, 1]]))
+    return SerialChain(M, sp.Matrix(screws).T, name=name, description=description or f"{len(screws)}-joint arm from URDF")
+
+
+__all__ += ["from_urdf_joints"]

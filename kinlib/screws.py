@@ -17,8 +17,8 @@ __all__ = ["screw_revolute", "screw_prismatic", "screw_axis", "bracket", "unbrac
 def screw_revolute(omega, q):
     """S = [ω; −ω × q]: a revolute joint about the unit axis ω through the point q."""
     symbolic = is_symbolic(omega, q)
-    w = _unit_axis(as_vector(omega, "omega", 3, symbolic), "omega")
-    q = as_vector(q, "q", 3, symbolic)
+    w = _unit_axis(as_vector(omega, "omega", 3, symbolic, real_symbols=True), "omega")
+    q = as_vector(q, "q", 3, symbolic, real_symbols=True)
     v = -cross(w, q)
     return sp.Matrix.vstack(w, v) if symbolic else np.concatenate([w, v + 0.0])  # + 0.0: no −0.0 entries
 
@@ -26,15 +26,15 @@ def screw_revolute(omega, q):
 def screw_prismatic(v):
     """S = [0; v]: a prismatic joint sliding along the unit direction v."""
     symbolic = is_symbolic(v)
-    v = _unit_axis(as_vector(v, "v", 3, symbolic), "v")
+    v = _unit_axis(as_vector(v, "v", 3, symbolic, real_symbols=True), "v")
     return sp.Matrix.vstack(sp.zeros(3, 1), v) if symbolic else np.concatenate([np.zeros(3), v])
 
 
 def screw_axis(q, s, h):
     """S = [s; −s × q + h s]: the screw axis through q along the unit direction s with pitch h."""
     symbolic = is_symbolic(q, s, h)
-    s = _unit_axis(as_vector(s, "s", 3, symbolic), "s")
-    q = as_vector(q, "q", 3, symbolic)
+    s = _unit_axis(as_vector(s, "s", 3, symbolic, real_symbols=True), "s")
+    q = as_vector(q, "q", 3, symbolic, real_symbols=True)
     h = _scalar(h, "h", symbolic)
     v = -cross(s, q) + h * s
     return sp.Matrix.vstack(s, v) if symbolic else np.concatenate([s, v + 0.0])
@@ -88,7 +88,7 @@ def exp6(S, theta):
     ω = 0:   [[I, v θ], [0, 1]].
     """
     symbolic = is_symbolic(S, theta)
-    S = as_vector(S, "S", 6, symbolic)
+    S = as_vector(S, "S", 6, symbolic, real_symbols=True)
     theta = _scalar(theta, "theta", symbolic)
     kind = _screw_kind(S, "S")
     return _exp6(S, theta, kind, symbolic)
@@ -118,3 +118,140 @@ def _exp6(S, theta, kind: str, symbolic: bool):
     T[:3, :3] += s * W + (1.0 - c) * W2
     T[:3, 3] = (theta * v) + (1.0 - c) * (W @ v) + (theta - s) * (W2 @ v)
     return T
+
+
+# ----------------------------------------------------------------------------------------------
+# The matrix logarithm of SE(3) (issue 11, item 7)
+# ----------------------------------------------------------------------------------------------
+_LOG6_FORMS = ("matrix", "vector", "screw_angle")
+
+
+def _log6_exact(T: sp.Matrix):
+    """(ω̂, θ_rot, vθ, p) for an exact SymPy transform; θ_rot = 0 exactly when R = I."""
+    from ._backend import check_real_finite, exact_number
+    from .display import is_identically_zero
+    from .rigid import check_se3, log3, proved_zero
+    for e in T:
+        check_real_finite(e, "T")
+    if not T.free_symbols:
+        T = T.applyfunc(lambda e: exact_number(e, "T"))
+        for j, want in enumerate((0, 0, 0, 1)):
+            if not proved_zero(T[3, j] - want, f"T[3, {j}] − {want}"):
+                raise ValueError(f"T must be a homogeneous transform with last row [0, 0, 0, 1], got last row "
+                                 f"{list(T[3, :])}")
+    else:
+        T = check_se3(T, "T")
+    R, p = T[:3, :3], T[:3, 3]
+    try:
+        w, theta = log3(R, form="axis_angle")
+    except ValueError as err:
+        raise ValueError(f"the rotation part of T: {err}") from None
+    if theta == 0:
+        return w, theta, p, p
+    W = skew(w)
+    c, s = sp.cos(theta), sp.sin(theta)          # cos(acos x) = x and sin(acos x) = √(1 − x²): exact
+    k = 1 - theta / 2 * s / (1 - c)              # 1 − (θ/2) cot(θ/2); cot(θ/2) = sin θ/(1 − cos θ), 0 at θ = π
+    vt = (sp.eye(3) - theta / 2 * W + k * W * W) * p
+    simp = (lambda e: sp.radsimp(sp.simplify(e))) if not T.free_symbols else sp.factor_terms
+    return w, theta, vt.applyfunc(simp), p
+
+
+def _pure_translation_zero(p) -> bool:
+    from .display import is_identically_zero
+    from .rigid import proved_zero
+    if isinstance(p, sp.MatrixBase):
+        if p.free_symbols:
+            return is_identically_zero(p)
+        return all(proved_zero(e, "p") for e in p)
+    return not np.any(p)
+
+
+def log6(T, form: str = "matrix"):
+    """The matrix logarithm of SE(3): [S]θ ∈ se(3) with e^{[S]θ} = T (Modern Robotics' MatrixLog6).
+
+    Lynch & Park, Algorithm 3.2 (section 3.3.3.2), for T = [[R, p], [0, 1]]:
+
+    * R = I:  ω = 0, v = p/|p|, θ = |p| (a pure translation; T = I gives θ = 0);
+    * else:   [ω̂]θ = log3(R) (θ ∈ (0, π]) and
+              vθ = G⁻¹(θ) p θ = (I − ½[ω̂]θ + (1 − (θ/2) cot(θ/2)) [ω̂]²) p,
+              i.e. G⁻¹(θ) = I/θ − [ω̂]/2 + (1/θ − ½ cot(θ/2)) [ω̂]².
+
+    ``form``: "matrix" → [S]θ = [[[ω̂]θ, vθ], [0, 0]] (4×4); "vector" → Sθ = [ω̂θ; vθ] (angular first);
+    "screw_angle" → (S, θ) with S = [ω̂; v] (|ω̂| = 1) or [0; v] (|v| = 1), θ ≥ 0 (T = I: the convention
+    S = [0, 0, 1, 0, 0, 0], θ = 0). The inverse of :func:`exp6`: ``exp6(*log6(T, "screw_angle")) == T``.
+
+    Exact for SymPy T (R's logarithm as in :func:`kinlib.rigid.log3`, cot(θ/2) = sin θ/(1 − cos θ) exact); with
+    free symbols the closed form holds where 0 < θ < π. Numbers: floats, (4, 4) or a batch (N, 4, 4)
+    (1 − (θ/2)cot(θ/2) by its series θ²/12 + θ⁴/720 + θ⁶/30240 below θ = 0.01).
+
+    >>> import sympy as sp
+    >>> T = sp.Matrix([[1, 0, 0, 0], [0, 0, -1, 0], [0, 1, 0, 3], [0, 0, 0, 1]])
+    >>> log6(T)
+    Matrix([
+    [0,    0,     0,      0],
+    [0,    0, -pi/2, 3*pi/4],
+    [0, pi/2,     0, 3*pi/4],
+    [0,    0,     0,      0]])
+    >>> log6(sp.Matrix([[1, 0, 0, 3], [0, 1, 0, 4], [0, 0, 1, 0], [0, 0, 0, 1]]), form="screw_angle")[1]
+    5
+    """
+    from ._backend import describe
+    from .rigid import log3, real_array
+    if not isinstance(form, str) or form not in _LOG6_FORMS:
+        raise ValueError(f"form must be one of {', '.join(map(repr, _LOG6_FORMS))}, got {describe(form)}")
+    if is_symbolic(T):
+        Tm = as_matrix(T, "T", (4, 4), True)
+        w, theta, vt, p = _log6_exact(Tm)
+        if form == "screw_angle":
+            if theta != 0:
+                return sp.Matrix.vstack(w, (vt / theta).applyfunc(sp.radsimp if not Tm.free_symbols else sp.factor_terms)), theta
+            if _pure_translation_zero(p):
+                return sp.Matrix([0, 0, 1, 0, 0, 0]), sp.S.Zero
+            d = sp.sqrt(sp.expand((p.T * p)[0, 0]))
+            return sp.Matrix.vstack(sp.zeros(3, 1), p / d), d
+        wt = w * theta if theta != 0 else sp.zeros(3, 1)
+        if form == "vector":
+            return sp.Matrix.vstack(wt, vt)
+        return sp.Matrix.vstack(sp.Matrix.hstack(skew(wt), vt), sp.zeros(1, 4))
+    A = real_array(T, "T", "a 4×4 transform or a batch (N, 4, 4) of them")
+    if A.shape[-2:] != (4, 4) or A.ndim not in (2, 3):
+        raise ValueError(f"T must be a 4×4 homogeneous transform or a batch (N, 4, 4) of them, got {describe(A)}")
+    single = A.ndim == 2
+    B = A[None] if single else A
+    bot = np.abs(B[:, 3, :] - [0.0, 0.0, 0.0, 1.0]).max(axis=-1) if len(B) else np.zeros(0)
+    if np.any(bot > 1e-6):
+        i = int(np.flatnonzero(bot > 1e-6)[0])
+        raise ValueError(f"T{'' if single else f'[{i}]'} must be a homogeneous transform with last row [0, 0, 0, 1], "
+                         f"got last row {B[i, 3].tolist()}")
+    try:
+        w, theta = log3(B[:, :3, :3], form="axis_angle")
+    except ValueError as err:
+        raise ValueError(f"the rotation part of T: {err}") from None
+    p = B[:, :3, 3]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half = theta / 2
+        k = np.where(theta < 1e-2, theta ** 2 / 12 + theta ** 4 / 720 + theta ** 6 / 30240,
+                     1.0 - half / np.tan(np.where(theta < 1e-2, 1.0, half)))
+    wp = np.cross(w, p)
+    vt = p - (half[:, None] * wp) + k[:, None] * np.cross(w, wp)
+    wt = w * theta[:, None]
+    if form == "screw_angle":
+        pn = np.linalg.norm(p, axis=-1)
+        rot = theta > 0
+        tr = ~rot & (pn > 0)
+        S = np.zeros((len(B), 6))
+        S[:, 2] = 1.0
+        S[rot, :3] = w[rot]
+        S[rot, 3:] = vt[rot] / theta[rot][:, None]
+        S[tr, 2] = 0.0
+        S[tr, 3:] = p[tr] / pn[tr][:, None]
+        ang = np.where(rot, theta, pn)
+        return (S[0] + 0.0, float(ang[0])) if single else (S + 0.0, ang)
+    V = np.concatenate([wt, vt], axis=-1) + 0.0
+    if form == "vector":
+        return V[0] if single else V
+    X = np.zeros((len(B), 4, 4))
+    X[:, 0, 1], X[:, 0, 2], X[:, 1, 2] = -wt[:, 2], wt[:, 1], -wt[:, 0]
+    X[:, 1, 0], X[:, 2, 0], X[:, 2, 1] = wt[:, 2], -wt[:, 1], wt[:, 0]
+    X[:, :3, 3] = vt
+    return (X[0] if single else X) + 0.0

@@ -20,7 +20,9 @@ variables enter polynomially and are solved over ℝ.
 """
 from __future__ import annotations
 
+import itertools
 import numbers
+import time
 from typing import Any, Mapping, Sequence
 
 import numpy as np
@@ -29,9 +31,10 @@ import sympy as sp
 from ._backend import as_matrix, describe, is_symbolic
 from .display import _exact_zero
 from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
+from .trigsign import generator_kinds, proves_nonzero
 
 __all__ = [
-    "ROW_NAMES", "task_rows", "singular_configurations", "representatives", "rank_at", "column_space",
+    "ROW_NAMES", "task_rows", "singular_configurations", "SingularSet", "representatives", "rank_at", "column_space",
     "left_null_space", "evaluate_at", "trig_simplify", "periodic_family", "K",
 ]
 
@@ -180,16 +183,6 @@ def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
 # ----------------------------------------------------------------------------------------------
 # singular configurations
 # ----------------------------------------------------------------------------------------------
-def _rank_det(entries: list, shape: tuple[int, int], ring: TrigRing):
-    """det J (square), det(J Jᵀ) (m < n) or det(Jᵀ J) (m > n) of J given as ring elements, row by row:
-    fraction-free elimination over the polynomial ring (exact, no expression swell)."""
-    from sympy.polys.matrices import DomainMatrix
-    m, n = shape
-    dJ = DomainMatrix([entries[i * n:(i + 1) * n] for i in range(m)], shape, ring.ring.to_domain())
-    G = dJ if m == n else dJ * dJ.transpose() if m < n else dJ.transpose() * dJ
-    return G.det()
-
-
 def _det(M: sp.Matrix) -> sp.Expr:
     try:
         from sympy.polys.matrices import DomainMatrix
@@ -251,23 +244,242 @@ def _normalize_expr(e: sp.Expr) -> sp.Expr:
     return e
 
 
-def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequence[sp.Symbol] | None = None) -> list:
-    """Where J(θ) loses rank, in closed form: a list of conditions (empty when there is none).
+class SingularSet(list):
+    """The answer of :func:`singular_configurations`: a list of conditions, plus
 
-    The rank test is det J = 0 (square), det(J Jᵀ) = 0 (more joints than rows) or det(Jᵀ J) = 0 (fewer).
-    Each condition is either
+    * ``complete`` (bool): True when the conditions are *all* the singular configurations (then ``[]``
+      means there is none); False when a closed form was out of reach (time budget, size), and the list
+      holds only what was found, maybe nothing;
+    * ``note`` (str): how the answer was obtained, and for an incomplete one what is missing and the
+      numeric alternative (:func:`kinlib.singular_search.find_singularities`).
+
+    It is a plain list otherwise: ``conds == []``, ``conds[0]``, ``len(conds)`` work as before.
+    """
+
+    def __init__(self, conditions=(), complete: bool = True, note: str = ""):
+        super().__init__(conditions)
+        self.complete = bool(complete)
+        self.note = note
+
+    def __repr__(self) -> str:
+        body = super().__repr__()
+        return body if self.complete else f"SingularSet({body}, complete=False, note={self.note!r})"
+
+
+class _OutOfTime(Exception):
+    pass
+
+
+_MAX_PRODUCT = 2_000_000   # term pairs in one polynomial product (about a second of pure-Python arithmetic)
+
+
+def _mul(a, b, deadline: float):
+    if time.monotonic() > deadline or len(a.terms()) * len(b.terms()) > _MAX_PRODUCT:
+        raise _OutOfTime
+    return a * b
+
+
+def _bareiss(rows: list, ring, deadline: float):
+    """det of a square matrix of ring elements, not reduced (so factors such as sin θ3 stay visible):
+    fraction-free elimination with exact divisions; the clock and the sizes are checked before each product."""
+    A = [list(r) for r in rows]
+    n = len(A)
+    R = ring.ring
+    sign, prev = 1, R.one
+    for k in range(n - 1):
+        piv = [i for i in range(k, n) if A[i][k]]
+        if not piv:
+            return R.zero
+        i0 = min(piv, key=lambda i: len(A[i][k].terms()))
+        if i0 != k:
+            A[k], A[i0] = A[i0], A[k]
+            sign = -sign
+        for i in range(k + 1, n):
+            for j in range(k + 1, n):
+                x = _mul(A[i][j], A[k][k], deadline) - _mul(A[i][k], A[k][j], deadline)
+                A[i][j] = x.exquo(prev) if prev != R.one else x
+        prev = A[k][k]
+    return A[n - 1][n - 1] * sign
+
+
+def _minors_reduced(rows: list, ring, deadline: float) -> list:
+    """All maximal minors of a k×n matrix (k ≤ n) of ring elements, reduced at every step: Laplace
+    expansion along the rows, sharing the minors of the first rows among the column sets (2ⁿ products
+    at most, every intermediate in normal form, so no expression swell); in combinations() order."""
+    k, n = len(rows), len(rows[0])
+    R = ring.ring
+    prev = {(): R.one}
+    for r in range(k):
+        cur = {}
+        for S in itertools.combinations(range(n), r + 1):
+            acc = R.zero
+            for idx, j in enumerate(S):
+                a, sub = rows[r][j], prev.get(S[:idx] + S[idx + 1:])
+                if a and sub:
+                    term = _mul(a, sub, deadline)
+                    acc = acc + term if (r + idx) % 2 == 0 else acc - term
+            cur[S] = ring.reduce(acc)
+        prev = cur
+    return [prev[S] for S in itertools.combinations(range(n), k)]
+
+
+def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float) -> list:
+    """The k×k minors of J (k = min(m, n)): rank J < k ⇔ all of them vanish. First as plain polynomials in
+    s_i, c_i (Bareiss: factors stay visible); when those grow too large, reduced modulo s_i² + c_i² − 1
+    at every step (smaller, but a factor such as sin θ3 may then hide inside a bigger one)."""
+    m, n = shape
+    rows = [entries[i * n:(i + 1) * n] for i in range(m)]
+    if m > n:
+        rows = [list(c) for c in zip(*rows)]
+        m, n = n, m
+    start = time.monotonic()
+    raw_deadline = min(deadline, start + max(1.0, (deadline - start) / 8))
+    try:
+        return [_bareiss([[r[j] for j in cols] for r in rows], ring, raw_deadline)
+                for cols in itertools.combinations(range(n), m)]
+    except _OutOfTime:
+        if time.monotonic() > deadline:
+            raise
+    return _minors_reduced(rows, ring, deadline)
+
+
+def _cheap_points(g_expr: sp.Expr, joint: sp.Symbol, revolute: bool):
+    """Exact zeros of a single-variable factor on one period where sin and cos are rational (kπ/2), or
+    rational prismatic values; None when the zeros are of another kind."""
+    sol = _solve_single(g_expr, joint, revolute)
+    if sol is None:
+        return None
+    if sol is sp.S.EmptySet:
+        return []
+    pts = [p for p in sol] if isinstance(sol, sp.FiniteSet) else representatives(sol)
+    if revolute:
+        ok = all(sp.sin(p).is_Rational and sp.cos(p).is_Rational for p in pts)
+    else:
+        ok = all(p.is_Rational for p in pts)
+    return pts if ok else None
+
+
+def _solve_system(qs: list, ring, ctx: dict, depth: int = 0):
+    """All common zeros of the ring elements qs as a list of {joint: set of points (one period)}, each a
+    conjunction; None when it cannot be done this way (a factor with several joints or awkward zeros)."""
+    if time.monotonic() > ctx["deadline"] or depth > len(ctx["thetas"]):
+        return None
+    qs = [q for q in qs if q]
+    if not qs:
+        return [{}]
+    if any(q.is_ground or proves_nonzero(ring, q, ctx["kinds"]) for q in qs):
+        return []
+    best = None
+    for q in sorted(qs, key=lambda q: len(q.terms())):
+        _, facs = q.factor_list()
+        branches = []
+        for f, _m in facs:
+            joints = ring.depends_on(f) & ctx["joint_set"]
+            if not joints:
+                if proves_nonzero(ring, f, ctx["kinds"]):
+                    continue
+                branches = None
+                break
+            if len(joints) != 1 or ring.depends_on(f) - ctx["joint_set"]:
+                branches = None
+                break
+            (j,) = joints
+            pts = _cheap_points(ring.to_expr(f), j, j in ctx["revolute"])
+            if pts is None:
+                branches = None
+                break
+            branches += [(j, p) for p in pts]
+        if branches is not None:
+            best = branches
+            break
+    if best is None:
+        return None
+    by_point: dict = {}
+    for j, p in best:
+        if j in ctx["revolute"]:
+            i = ring.angles.index(j)
+            subs = [(ring.gens[i], ring.domain.from_sympy(sp.sin(p))),
+                    (ring.gens[len(ring.angles) + i], ring.domain.from_sympy(sp.cos(p)))]
+        else:
+            subs = [(ring.gens[2 * len(ring.angles) + ring.variables.index(j)], ring.domain.from_sympy(p))]
+        sub = _solve_system([q.subs(subs) for q in qs], ring, ctx, depth + 1)
+        if sub is None:
+            return None
+        for s in sub:
+            key = (j, tuple(sorted(((k, tuple(sorted(v, key=float))) for k, v in s.items()), key=str)))
+            by_point.setdefault(key, set()).add(p)
+    out = []
+    for (j, rest), pts in by_point.items():
+        d = {k: set(v) for k, v in rest}
+        d[j] = pts
+        out.append(d)
+    return out
+
+
+def _factor_conditions(G, ring, ctx: dict, add) -> None:
+    """The conditions 'f = 0' for the factors f of G that can vanish (impossible ones dropped with proof)."""
+    _, factors = G.factor_list()
+    for f, _mult in factors:
+        _, sub = ring.reduce(f).factor_list()
+        for g, _m in sub:
+            if g.is_ground or proves_nonzero(ring, g, ctx["kinds"]):
+                continue
+            joints = ring.depends_on(g) & ctx["joint_set"]
+            if len(joints) == 1:
+                (j,) = joints
+                sol = _solve_single(ring.to_expr(g), j, j in ctx["revolute"])
+                if sol is sp.S.EmptySet:
+                    continue
+                if sol is not None:
+                    add({j: sol})
+                    continue
+            add(_display_condition(g, ring, ctx["deadline"]))
+
+
+def _display_condition(p, ring, deadline: float) -> sp.Expr:
+    """'p = 0' for display: factored in sin/cos, angle sums folded (trigsimp) when small and time allows."""
+    expr = ring.to_trig(sp.factor(ring.to_expr(p, trig=False))) if len(p.terms()) < 200 else ring.to_expr(p)
+    if sp.count_ops(expr) < 150 and time.monotonic() < deadline:
+        expr = sp.trigsimp(expr)
+    return _normalize_expr(expr)
+
+
+def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequence[sp.Symbol] | None = None,
+                            *, time_budget: float = 40.0) -> SingularSet:
+    """Where J(θ) loses rank, in closed form: a list of conditions (``[]``: no singular configuration).
+
+    J (m×n) has full rank k = min(m, n) unless every k×k minor vanishes (for square J: det J = 0; in
+    general Σ minors² = det(J Jᵀ) or det(Jᵀ J), Cauchy–Binet). With G = gcd of the minors and q_i =
+    minor_i / G, the singular set is {G = 0} ∪ {all q_i = 0}. Each condition is
 
     * ``{θ_i: S}``: joint i in the SymPy Set S, the whole periodic family, e.g.
       ``{theta2: ImageSet(Lambda(k, pi*k - pi/4), Integers)}`` (θ2 = −π/4 + kπ); for a prismatic
-      joint a FiniteSet of values; or
+      joint a FiniteSet of values. A dict with several joints means all of them at once
+      (planar 3R's ṗ rows: ``{θ2: {kπ}, θ3: {kπ}}``);
     * an expression that must vanish, where a factor involves several joints (the UR5's shoulder
-      singularity), written back in sin/cos and trig-simplified.
+      singularity), written back in sin/cos; a sum of squares when it stands for "all q_i = 0";
+    * an expression in the parameters only (e.g. ``L1 - L2``): when the link lengths make it vanish,
+      *every* configuration is singular.
+
+    Conditions that cannot vanish are dropped only with a proof (:mod:`kinlib.trigsign`: a positive
+    constant plus squares, positive lengths, bounds |sin|, |cos| ≤ 1); so every returned condition does
+    make J drop rank, and every rank drop is covered. The answer is a :class:`SingularSet` (a list):
+    ``.complete`` is False when the closed form was out of reach within ``time_budget`` seconds (then
+    use :func:`kinlib.singular_search.find_singularities` on a numeric chain), ``.note`` says how.
 
     ``thetas``: the n joint symbols, one per column of J. A joint need not appear in J (a space Jacobian
     never depends on the last joint). Every other symbol in J is a parameter: it must be declared
-    positive (the link lengths of :mod:`kinlib.robots` are) or be listed in ``params``; parameter-only
-    factors are taken to be nonzero (generic link lengths).
+    positive (the link lengths of :mod:`kinlib.robots` are) or be listed in ``params`` (then any real).
+
+    >>> from kinlib import robots
+    >>> r = robots.planar_3r()
+    >>> singular_configurations(task_rows(r.jacobian_space(), "planar"), r.thetas)
+    [{theta2: ImageSet(Lambda(k, pi*k), Integers)}]
+    >>> conds = singular_configurations(task_rows(r.jacobian_geometric(), ["vx", "vy"]), r.thetas)
+    >>> conds, conds.complete           # tool position only: stretched *and* folded at once
+    ([{theta2: ImageSet(Lambda(k, pi*k), Integers), theta3: ImageSet(Lambda(k, pi*k), Integers)}], True)
     """
+    t0 = time.monotonic()
     if not is_symbolic(J):
         raise TypeError(f"J must be a symbolic Jacobian (a SymPy Matrix in the joint symbols), got {describe(J)}")
     J = _jacobian(J, "J", True)
@@ -275,7 +487,9 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
     _check_params(J, thetas, params)
     if J.rows == 0 or J.cols == 0:
         raise ValueError(f"J must have at least one row and one column, got {describe(J)}")
-
+    if isinstance(time_budget, bool) or not isinstance(time_budget, (int, float)) or not time_budget >= 0:
+        raise ValueError(f"time_budget must be a number of seconds ≥ 0, got {describe(time_budget)}")
+    deadline = t0 + float(time_budget)
     joint_set = set(thetas)
 
     def parameter_atom(a: sp.Expr) -> bool:  # √L, 1/L: allowed; anything else with a joint or a trig function: not
@@ -298,45 +512,80 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
     mixed = revolute & set(ring.variables)       # θ sin θ is not a trigonometric polynomial
     if mixed:
         raise bad_entry(next(e for e in J if mixed & set(TrigRing([e], thetas, opaque=parameter_atom).variables)))
-    Jp = [ring.normal_form(e) for e in J]
-    D = _rank_det(Jp, J.shape, ring)
+    ctx = {"deadline": deadline, "thetas": thetas, "joint_set": joint_set, "revolute": revolute,
+           "kinds": generator_kinds(ring)}
     conditions: list = []
 
     def add(cond):
         if cond not in conditions:
             conditions.append(cond)
 
-    if not D:
-        raise ValueError("J never has full rank (its rank-test determinant is identically zero): "
-                         "every configuration is singular")
-    _, factors = D.factor_list()
-    for f, _mult in factors:
-        if not ring.depends_on(f) & joint_set:
-            continue
-        _, sub = ring.reduce(f).factor_list()
-        for g, _m in sub:
-            joints = ring.depends_on(g) & joint_set
-            if not joints:
-                continue
-            if len(joints) == 1:
-                (j,) = joints
-                sol = _solve_single(ring.to_expr(g), j, j in revolute)
-                if sol is sp.S.EmptySet:
-                    continue
-                if sol is not None:
-                    add({j: sol})
-                    continue
-            expr = ring.to_expr(g)
-            if sp.count_ops(expr) < 400:
-                expr = sp.trigsimp(expr)
-            add(_normalize_expr(expr))
-
     def key(c):
         if isinstance(c, dict):
-            (j,) = c
-            return (0, thetas.index(j), str(c[j]))
-        return (1, 0, str(c))
-    return sorted(conditions, key=key)
+            return (0, tuple(sorted(thetas.index(j) for j in c)), str(c))
+        return (1 if c.free_symbols & joint_set else 2, 0, str(c))
+
+    def out_of_reach(stage: str):
+        return SingularSet(sorted(conditions, key=key), complete=False, note=(
+            f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
+            "(maybe none) are singular, others may be missing. For a numeric search use "
+            "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths."))
+
+    k = min(J.shape)
+    what = "det J" if J.rows == J.cols else f"the {k}×{k} minors of J"
+    Jp = [ring.normal_form(e) for e in J]
+    try:
+        minors = _maximal_minors(Jp, J.shape, ring, deadline)
+    except _OutOfTime:
+        return out_of_reach(f"computing {what}")
+    minors = [q for q in minors if ring.reduce(q)]
+    if not minors:
+        raise ValueError("J never has full rank (its rank-test determinant is identically zero): "
+                         "every configuration is singular")
+    try:
+        G = minors[0]
+        for q in minors[1:]:
+            if G.is_ground:
+                break
+            G = G.gcd(q)
+            if time.monotonic() > deadline:
+                raise _OutOfTime
+    except _OutOfTime:
+        return out_of_reach(f"the gcd of {what}")
+    except Exception:  # noqa: BLE001  (a gcd SymPy cannot take, e.g. over an algebraic domain: no common part)
+        G = ring.ring.one
+    _factor_conditions(G, ring, ctx, add)
+    if time.monotonic() > deadline:
+        return out_of_reach(f"factoring {what}")
+    note = f"from the factors of {'det J' if J.rows == J.cols else 'the gcd of ' + what}"
+    qs = []
+    for q in minors:
+        q = ring.reduce(q.exquo(G) if not G.is_ground else q)
+        if not any(q == p or q == -p for p in qs):
+            qs.append(q)
+    if qs and not any(q.is_ground for q in qs) and not any(proves_nonzero(ring, q, ctx["kinds"]) for q in qs):
+        # lower-dimensional part: all q_i = 0 together
+        total = sum(len(q.terms()) for q in qs)
+        S = None
+        if total <= 2000:
+            S = ring.reduce(sum((q * q for q in qs), ring.ring.zero))
+        if S is not None and proves_nonzero(ring, S, ctx["kinds"]):
+            pass
+        else:
+            sol = _solve_system(qs, ring, ctx)
+            if sol is not None:
+                for d in sol:
+                    add({j: periodic_family(sorted(v, key=float)) if j in revolute else sp.FiniteSet(*v)
+                         for j, v in sorted(d.items(), key=lambda kv: thetas.index(kv[0]))})
+                note += "; where all of them vanish together: solved joint by joint"
+            elif time.monotonic() > deadline:
+                return out_of_reach("the common zeros of the minors")
+            elif total <= 2000:
+                add(sp.Add(*[_display_condition(q, ring, deadline) ** 2 for q in qs]))
+                note += "; the sum of squares is zero exactly where the minors (divided by their gcd) vanish together"
+            else:
+                return out_of_reach("the common zeros of the minors are too large for a closed form")
+    return SingularSet(sorted(conditions, key=key), complete=True, note=note)
 
 
 def representatives(family: sp.Set, lo=0, hi=2 * sp.pi) -> list:
@@ -372,180 +621,22 @@ def representatives(family: sp.Set, lo=0, hi=2 * sp.pi) -> list:
 
 
 # ----------------------------------------------------------------------------------------------
-# exact values at a configuration
+# exact values at a configuration: kinlib.exact (re-exported here, where they have always been imported from)
 # ----------------------------------------------------------------------------------------------
-def _is_number_like(v: Any) -> bool:
-    return isinstance(v, (numbers.Real, np.integer, np.floating)) and not isinstance(v, (bool, np.bool_))
+from .exact import column_space, evaluate_at, exact_is_zero, left_null_space, rank_at  # noqa: E402
 
 
-def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
-    """J at a configuration, exact when J and the values are exact.
-
-    ``subs``: a mapping {joint symbol: value}, or a sequence of values matched to ``thetas``. Values are
-    numbers (SymPy numbers such as π/4, ints) or expressions in positive parameters (θ3 = −L2). Any
-    Python float selects the numeric backend (a float array). After substitution J may still contain
-    positive parameters (link lengths), never a joint. Entries are simplified, so a zero is a zero.
-    """
-    if subs is None:
-        if is_symbolic(J):
-            M = _jacobian(J, "J", True)
-            return _clean(M)
-        return _jacobian(J, "J", False)
-    if not is_symbolic(J):
-        raise TypeError(f"subs only applies to a symbolic J; J is numeric ({describe(J)}): call without subs")
-    M = _jacobian(J, "J", True)
-    if isinstance(subs, Mapping):
-        table = dict(subs)
-    elif isinstance(subs, (str, bytes)) or not isinstance(subs, (Sequence, np.ndarray, sp.MatrixBase)):
-        raise TypeError(f"subs must be a mapping {{joint symbol: value}} or a sequence of joint values, got {describe(subs)}")
-    else:
-        vals = list(subs)
-        if thetas is None:
-            raise ValueError("subs is a sequence of joint values: give thetas= (the joint symbols, in order) too")
-        thetas = _check_thetas(thetas, len(thetas) if not isinstance(thetas, sp.Symbol) else 1)
-        if len(vals) != len(thetas):
-            raise ValueError(f"subs must hold {len(thetas)} joint values (one per joint "
-                             f"{', '.join(map(str, thetas))}), got {len(vals)}")
-        table = dict(zip(thetas, vals))
-    numeric = False
-    clean = {}
-    for k, v in table.items():
-        if not isinstance(k, sp.Symbol):
-            raise TypeError(f"subs keys must be SymPy symbols (joints), got {describe(k)}")
-        if isinstance(v, (float, np.floating)):
-            numeric = True
-        if _is_number_like(v):
-            clean[k] = sp.Float(float(v)) if isinstance(v, (float, np.floating)) else sp.Integer(int(v))
-        elif isinstance(v, sp.Expr) and not isinstance(v, sp.MatrixBase):
-            bad = [s for s in v.free_symbols if not s.is_positive]
-            if bad or v.has(sp.I) or v.is_real is False:
-                raise ValueError(f"subs[{k}] must be a real number (or an expression in positive parameters), got {v}")
-            clean[k] = v
-        else:
-            raise TypeError(f"subs[{k}] must be a number, got {describe(v)}")
-    M = M.xreplace(clean)
-    left = sorted((s for s in M.free_symbols if not s.is_positive), key=str)
-    if left:
-        raise ValueError(f"J still depends on {', '.join(map(str, left))} after the substitution: give a value for "
-                         "every joint (only positive parameters such as link lengths may stay symbolic)")
-    if numeric:
-        if M.free_symbols:
-            raise ValueError(f"float joint values need a numeric J; J has parameters "
-                             f"{', '.join(map(str, sorted(M.free_symbols, key=str)))}")
-        return np.array(M.evalf(), dtype=float)
-    return _clean(M)
-
-
-def _clean_entry(e: sp.Expr) -> sp.Expr:
-    if e.is_number:
-        if e.has(sp.Float):
-            return e
-        e = sp.nsimplify(sp.radsimp(sp.expand_trig(e)), [sp.pi]) if e.has(sp.sin, sp.cos) else sp.radsimp(e)
-        return sp.simplify(e) if sp.count_ops(e) > 8 else e
-    if e.has(sp.sin, sp.cos):
-        return trig_simplify(e)
-    return sp.factor(sp.radsimp(e))
-
-
-def _clean(M: sp.Matrix) -> sp.Matrix:
-    return M.applyfunc(_clean_entry)
-
-
-def _is_zero(e: Any):
-    """Exact zero test that never mistakes a configuration's zero for a nonzero.
-
-    Polynomials in sines, cosines and symbols (and rational functions of them) are decided exactly by
-    :func:`kinlib.display.is_identically_zero`'s normal form; other forms (square roots ...) numerically
-    first (a nonzero value proves nonzero), then by ``sp.simplify``.
-    """
+def _is_zero(e: Any) -> bool:
+    """Exact zero test: numbers and expressions in positive parameters by :func:`kinlib.exact.exact_is_zero`;
+    polynomials in the sines and cosines of joint symbols by the trig normal form; otherwise ``sp.simplify``."""
     e = sp.sympify(e)
     if e == 0:
         return True
-    if e.is_zero is not None:
-        return e.is_zero
-    if e.is_number:
-        v = complex(sp.N(e, 40))
-        if abs(v) > 1e-30:
-            return False
-        exact = _exact_zero(e)
-        if exact is not None:
-            return exact
-        return bool(sp.simplify(e) == 0 or e.equals(0))
+    try:
+        return exact_is_zero(e)
+    except ValueError:
+        pass
     exact = _exact_zero(e)
     if exact is not None:
         return exact
-    # other expressions in positive parameters: a random positive point proves nonzero
-    rng = np.random.default_rng(0)
-    syms = sorted(e.free_symbols, key=str)
-    for _ in range(3):
-        pt = {s: sp.Rational(int(rng.integers(2, 97)), int(rng.integers(2, 97))) for s in syms}
-        if abs(complex(sp.N(e.subs(pt), 40))) > 1e-30:
-            return False
     return bool(sp.simplify(e) == 0)
-
-
-def _numeric_rank_tol(s: np.ndarray, shape) -> float:
-    return max(shape) * np.finfo(float).eps * (s[0] if s.size else 0.0) * 100
-
-
-def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None) -> int:
-    """rank J at a configuration: exact (entries simplified before any zero test) for SymPy J and values.
-
-    ``subs`` as in :func:`evaluate_at` ({θ_i: value} or values with ``thetas``). A numeric J (or float
-    values) uses the SVD with a relative tolerance.
-    """
-    M = evaluate_at(J, subs, thetas)
-    if isinstance(M, np.ndarray):
-        s = np.linalg.svd(M, compute_uv=False)
-        return int(np.sum(s > _numeric_rank_tol(s, M.shape)))
-    _require_constant(M, "rank_at")
-    return int(M.rank(iszerofunc=_is_zero, simplify=True))
-
-
-def _require_constant(M: sp.Matrix, what: str):
-    left = sorted((s for s in M.free_symbols if not s.is_positive), key=str)
-    if left:
-        raise ValueError(f"{what} needs J at a configuration: J depends on {', '.join(map(str, left))} "
-                         "(give subs=...; a basis of the symbolic J can be undefined at special configurations)")
-
-
-def _rref_rows(A: sp.Matrix) -> sp.Matrix:
-    """The nonzero rows of rref(A), entries cleaned: the canonical basis of A's row space."""
-    R, piv = A.rref(iszerofunc=_is_zero, simplify=True)
-    rows = R[: len(piv), :]
-    return rows.applyfunc(lambda e: sp.radsimp(sp.simplify(e)) if e != 0 else e)
-
-
-def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
-    """A basis of range J (the twists/velocities the robot can produce) at a configuration, as columns.
-
-    Exact J: the canonical basis, the nonzero rows of rref(Jᵀ) (leading entries 1), so equal subspaces give
-    equal matrices; always defined because J is evaluated (and simplified) first. Numeric J: an
-    orthonormal basis from the SVD. The result is m×r (r = rank).
-    """
-    M = evaluate_at(J, subs, thetas)
-    if isinstance(M, np.ndarray):
-        U, s, _ = np.linalg.svd(M)
-        r = int(np.sum(s > _numeric_rank_tol(s, M.shape)))
-        return U[:, :r]
-    _require_constant(M, "column_space")
-    if M.is_zero_matrix:
-        return sp.zeros(M.rows, 0)
-    return _rref_rows(M.T).T
-
-
-def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
-    """A basis of null Jᵀ (directions the robot cannot move: yᵀ J = 0) at a configuration, as columns.
-
-    Exact J: canonical (rref) basis; numeric J: orthonormal from the SVD. m×(m − r), empty when full rank.
-    """
-    M = evaluate_at(J, subs, thetas)
-    if isinstance(M, np.ndarray):
-        U, s, _ = np.linalg.svd(M)
-        r = int(np.sum(s > _numeric_rank_tol(s, M.shape)))
-        return U[:, r:]
-    _require_constant(M, "left_null_space")
-    vecs = M.T.nullspace(iszerofunc=_is_zero, simplify=True)
-    if not vecs:
-        return sp.zeros(M.rows, 0)
-    return _rref_rows(sp.Matrix.hstack(*vecs).T).T

@@ -17,6 +17,7 @@ x = sp.Symbol("x", real=True)
 
 PLANAR = robots.planar_offset_3r()
 PLANAR1 = robots.planar_offset_3r(1)
+PLANAR1.fk(np.zeros(3))  # code generated: the fast path is what is checked below
 
 CASES = [
     # --- wrong shapes ---------------------------------------------------------------------
@@ -116,6 +117,45 @@ CASES = [
      r"screws must be a 6×n matrix .* got an array of shape \(5, 1\)"),
     ("chain thetas count", lambda: kinlib.SerialChain(np.eye(4), [Z], thetas=sp.symbols("a b")), ValueError,
      r"thetas must be 1 SymPy symbols \(one per screw axis\), got a list"),
+    # --- issue 11: values that used to pass silently or crash inside NumPy/SymPy ---------------------
+    ("complex joint value (numeric)", lambda: PLANAR1.fk([0.1 + 1j, 0, 0]), TypeError,
+     r"q must hold 3 real joint values .* got a list of shape \(3,\) whose entry \[0\] is complex"),
+    ("sp.I as a joint value", lambda: PLANAR.fk([sp.I, 0, 0]), ValueError, r"q must be real and finite, got I"),
+    ("numeric string as a joint value", lambda: PLANAR1.fk(["1.5", 0, 0]), TypeError,
+     r"q must hold 3 real joint values .* whose entry \[0\] is the string '1\.5'"),
+    ("bool as a joint value", lambda: PLANAR1.jacobian_space([True, 0, 0]), TypeError,
+     r"q must hold 3 real joint values .* whose entry \[0\] is bool True"),
+    ("NaN joint value, fast path", lambda: PLANAR1.fk(np.array([np.nan, 0.0, 0.0])), ValueError,
+     r"q must hold 3 finite real joint values, got an array of shape \(3,\) .* whose entry \[0\] is nan"),
+    ("inf joint value (was 'math domain error')", lambda: PLANAR1.fk([np.inf, 0.0, 0.0]), ValueError,
+     r"q must hold 3 finite real joint values, got a list of shape \(3,\) whose entry \[0\] is inf"),
+    ("NaN in a batch", lambda: PLANAR1.jacobian_body(np.array([[0, 0, 0], [0, np.nan, 0]], dtype=float)), ValueError,
+     r"q must hold 3 finite real joint values, got an array of shape \(2, 3\) .* whose entry \[1, 1\]"),
+    ("NaN screw in SerialChain", lambda: kinlib.SerialChain(np.eye(4), [[0, 0, 1, 0, np.nan, 0]]), ValueError,
+     r"screws\[0\] must be a finite real number, got nan"),
+    ("inf in M", lambda: kinlib.SerialChain(np.diag([1, 1, 1, np.inf]), [Z]), ValueError,
+     r"M must be a finite real number, got inf"),
+    ("sp.oo in a screw", lambda: kinlib.SerialChain(np.eye(4), [sp.Matrix([0, 0, 1, sp.oo, 0, 0])]), ValueError,
+     r"screws\[0\] must be real and finite, got oo"),
+    ("non-real joint symbol", lambda: kinlib.SerialChain(np.eye(4), [Z], thetas=[sp.Symbol("q1")]), ValueError,
+     r"thetas\[0\] must be a real symbol \(sp\.Symbol\('q1', real=True\)\).* got the symbol q1"),
+    ("non-real parameter in M", lambda: kinlib.SerialChain(sp.Matrix(4, 4, lambda i, j: sp.Symbol("a") if (i, j) == (0, 3)
+                                                                        else int(i == j)), [Z]), ValueError,
+     r"M must be real: the symbol a is not declared real \(use sp\.Symbol\('a', real=True\) or positive=True\), got a"),
+    ("complex thetas", lambda: kinlib.jacobian_space(S2, [1 + 2j, 0]), TypeError,
+     r"thetas must hold real numbers, got the complex number \(1\+2j\)"),
+    ("sp.I in thetas", lambda: kinlib.jacobian_space(S2, [sp.I, 0]), ValueError, r"thetas must be real and finite, got I"),
+    ("theta oo", lambda: kinlib.exp6(Z, sp.oo), ValueError, r"theta must be real and finite, got oo"),
+    ("theta nan", lambda: kinlib.exp3([0, 0, 1], float("nan")), ValueError, r"theta must be a finite real number, got nan"),
+    ("theta a NumPy bool", lambda: kinlib.exp6(Z, np.True_), TypeError, r"theta must be a number or a SymPy expression, got bool"),
+    ("manipulability of 1j·I", lambda: kinlib.manipulability(1j * np.eye(2)), TypeError,
+     r"J must be a matrix \(m, n\) or a batch \(N, m, n\) of real numbers, got an array of shape \(2, 2\) and dtype complex128"),
+    ("robot length a numeric string", lambda: robots.planar_3r(1, "1.5", 1), TypeError,
+     r"L2 must be a real number or a SymPy expression, got the string '1\.5'"),
+    ("subs a complex value", lambda: PLANAR.subs(L=1j), TypeError, r"L must be a real number, got the complex number 1j"),
+    ("subs an unknown parameter", lambda: PLANAR.subs(H=1), ValueError, r"planar_offset_3r has no parameter 'H'"),
+    ("float axis unit only to 3e-9", lambda: kinlib.SerialChain(np.eye(4), [[0.70710678, 0.70710678, 0, 0, 0, 0]]),
+     ValueError, r"angular part ω of screws column 1 must be a unit vector .* got \[35355339/50000000, .*sp\.sqrt\(2\)/2"),
 ]
 
 

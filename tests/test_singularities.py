@@ -176,16 +176,27 @@ def test_prismatic_factor_is_solved_over_the_reals(rng):
     assert sigma_min(Jn(rng.uniform(-3, 3), 0.5)) > 0.1
 
 
-def test_more_joints_than_rows_gives_a_vanishing_expression(rng):
-    """planar_3r's (ṗx, ṗy) rows: det(J Jᵀ) is a sum of squares of minors; zero iff sin θ2 = sin θ3 = 0."""
+def test_more_joints_than_rows_gives_a_joint_condition(rng):
+    """planar_3r's (ṗx, ṗy) rows: all 2×2 minors vanish iff sin θ2 = sin θ3 = 0, one condition on two joints
+    (it was a sum of squares of the minors before issue 11)."""
     r = robots.planar_3r(1, 1, 1)
     J = task_rows(r.jacobian_geometric(), ["vx", "vy"])
     conds = singular_configurations(J, r.thetas)
-    assert len(conds) == 1 and isinstance(conds[0], sp.Expr)
-    f = sp.lambdify(r.thetas, conds[0], "numpy")
-    assert abs(f(0.3, 0.0, np.pi)) < 1e-12
+    fam = sp.ImageSet(sp.Lambda(K, pi * K), sp.Integers)
+    assert conds == [{r.thetas[1]: fam, r.thetas[2]: fam}] and conds.complete
+    S = np_screws(r)
     for _ in range(5):
-        assert abs(f(*rng.uniform(-3, 3, 3))) > 1e-6
+        q = rng.uniform(-3, 3, 3)
+        assert sigma_min(_geo_rows(S, r, q)) > 1e-6 or min(abs(np.sin(q[1])), abs(np.sin(q[2]))) < 1e-2
+        q[1], q[2] = np.pi * rng.integers(-2, 3), np.pi * rng.integers(-2, 3)
+        assert sigma_min(_geo_rows(S, r, q)) < 1e-9
+
+
+def _geo_rows(S, chain, q):
+    """(ṗx, ṗy) rows of the geometric Jacobian from modern_robotics: ṗ = v_s + ω_s × p."""
+    Js = mr.JacobianSpace(S, q)
+    p = mr.FKinSpace(np.array(chain.M, dtype=float), S, q)[:3, 3]
+    return (Js[3:] + np.cross(Js[:3].T, p).T)[:2]
 
 
 def test_single_joint_robot_and_cart_pole():
@@ -222,9 +233,9 @@ def test_bad_input_singular_configurations():
     x = sp.Symbol("x", real=True)  # not a joint, not positive: not a parameter either
     with pytest.raises(ValueError, match="x.*not among the joints"):
         singular_configurations(J + sp.Matrix(3, 3, lambda i, j: x if i == j == 0 else 0), r.thetas)
-    # ... unless declared a parameter
+    # ... unless declared a parameter (any real: x = 0 makes every configuration singular, so it is reported)
     assert singular_configurations(J.subs(sp.Symbol("L", positive=True), x), r.thetas, params=[x]) == \
-        singular_configurations(J, r.thetas)
+        singular_configurations(J, r.thetas) + [x]
     with pytest.raises(ValueError, match="identically zero"):
         singular_configurations(sp.Matrix([[sp.sin(x), sp.sin(x)], [sp.cos(x), sp.cos(x)]]), [x, sp.Symbol("y")])
     with pytest.raises(ValueError, match="polynomial in sin"):
@@ -329,11 +340,11 @@ def test_rank_at_bad_input():
         rank_at(J, [0, 0], thetas=r.thetas)
     with pytest.raises(ValueError, match="give thetas"):
         rank_at(J, [0, 0, 0])
-    with pytest.raises(TypeError, match="must be a number"):
+    with pytest.raises(TypeError, match=r"subs\[theta1\] must be a real number .* got the string 'pi'"):
         rank_at(J, {r.thetas[0]: "pi", r.thetas[1]: 0})
     with pytest.raises(ValueError, match="real number"):
         rank_at(J, {r.thetas[0]: r.thetas[2], r.thetas[1]: 0})
-    with pytest.raises(ValueError, match="real number"):
+    with pytest.raises(ValueError, match=r"subs\[theta1\] must be real and finite, got I"):
         rank_at(J, {r.thetas[0]: sp.I, r.thetas[1]: 0})
     with pytest.raises(ValueError, match="still depends on theta2"):
         rank_at(J, {r.thetas[0]: 0})
@@ -343,9 +354,9 @@ def test_rank_at_bad_input():
         rank_at(J, 3)
     with pytest.raises(TypeError, match="subs only applies"):
         rank_at(np.eye(3), {r.thetas[0]: 0})
-    with pytest.raises(ValueError, match="needs J at a configuration"):
+    with pytest.raises(ValueError, match="J must be taken at a configuration: it still depends on theta1, theta2"):
         column_space(J)
-    with pytest.raises(ValueError, match="needs J at a configuration"):
+    with pytest.raises(ValueError, match="J must be taken at a configuration: it still depends on theta1, theta2"):
         left_null_space(J)
     with pytest.raises(TypeError, match="J must be a matrix"):
         rank_at("J")

@@ -1,0 +1,363 @@
+"""Velocity kinematics after the Jacobian: inverse velocity, damped least squares, statics, force ellipsoid.
+
+Lynch & Park, *Modern Robotics*, sections 5.3–5.4 and 6.3. For a Jacobian J (m×n: m task rows, n joints)
+with V = J θ̇ (twists [ω; v], angular first):
+
+* inverse velocity kinematics  θ̇ = J⁺ V, the Moore–Penrose pseudoinverse: J⁺ = Jᵀ(J Jᵀ)⁻¹ when J has full
+  row rank (n ≥ m: the smallest-norm θ̇ that achieves V exactly), J⁺ = (Jᵀ J)⁻¹Jᵀ when it has full column
+  rank (n ≤ m: the least-squares θ̇), and in general J⁺ = Σ_{σ_i > tol} v_i u_iᵀ/σ_i from the SVD
+  J = Σ σ_i u_i v_iᵀ (:func:`pseudoinverse`, :func:`inverse_velocity`);
+* damped least squares  θ̇ = Jᵀ(J Jᵀ + λ²I)⁻¹ V = Σ σ_i/(σ_i² + λ²) v_i u_iᵀ V, bounded near singularities,
+  → J⁺V as λ → 0 (:func:`damped_least_squares`);
+* statics  τ = Jᵀ F (:func:`joint_torques`), with the wrench F = [m; f] (moment first, like [ω; v]) in the
+  frame of the Jacobian: a space Jacobian J_s pairs with the space wrench F_s, a body Jacobian J_b with the
+  body wrench F_b, the geometric Jacobian [ω_s; ṗ] with [moment about the tool point, in {s}; force in {s}];
+  power balance τᵀθ̇ = Fᵀ V;
+* the force ellipsoid {F : ‖Jᵀ F‖ ≤ 1} (:func:`force_ellipsoid`): semi-axes 1/σ_i along the same u_i as the
+  velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1} (semi-axes σ_i, :func:`kinlib.manipulability.velocity_ellipsoid`),
+  the duality of section 5.4: where the arm moves fast it resists force weakly, and vice versa.
+
+One API, two backends: SymPy J → exact SymPy results (the pseudoinverse needs a constant J: substitute a
+configuration first); numbers → NumPy floats, batches (N, m, n) allowed.
+"""
+from __future__ import annotations
+
+import warnings
+from typing import Any, NamedTuple
+
+import numpy as np
+import sympy as sp
+
+from ._backend import as_matrix, as_vector, check_real_finite, describe, exact_number, is_symbolic
+from .manipulability import velocity_ellipsoid
+from .rigid import proved_zero, real_array
+from .singularities import task_rows
+
+__all__ = ["pseudoinverse", "inverse_velocity", "damped_least_squares", "joint_torques", "force_ellipsoid",
+           "PinvReport", "SingularityWarning"]
+
+_EPS = np.finfo(float).eps
+#: joint-rate amplification 1/σ_min (relative to 1/σ_max) above which a numeric pseudoinverse warns
+_WARN_COND = 1e8
+
+
+class SingularityWarning(UserWarning):
+    """J is singular or nearly singular: a pseudoinverse dropped directions, or amplifies V enormously."""
+
+
+class PinvReport(NamedTuple):
+    """What a pseudoinverse used: the rank kept, the singular values, the cut-off (numeric only)."""
+    rank: Any
+    singular_values: Any
+    tol: Any
+
+
+# ----------------------------------------------------------------------------------------------
+# input checks
+# ----------------------------------------------------------------------------------------------
+def _numeric_J(J: Any, name: str = "J") -> np.ndarray:
+    A = real_array(J, name, "a Jacobian (m, n) or a batch (N, m, n) of real numbers")
+    if A.ndim not in (2, 3) or 0 in A.shape:
+        raise ValueError(f"{name} must be a Jacobian (m, n) or a batch (N, m, n) with m, n ≥ 1, got {describe(J)}")
+    return A
+
+
+def _exact_J(J: Any, name: str = "J") -> sp.Matrix:
+    M = as_matrix(J, name, None, True)
+    if M.rows == 0 or M.cols == 0:
+        raise ValueError(f"{name} must have at least one row and one column, got {describe(M)}")
+    return M.applyfunc(lambda e: exact_number(e, name))      # Floats → the decimal typed; refuses I, nan, oo
+
+
+def _numeric_vectors(x: Any, name: str, m: int, what: str) -> np.ndarray:
+    a = real_array(x, name, f"{what} of length {m} (or a batch (N, {m}))")
+    if a.ndim not in (1, 2) or a.shape[-1] != m:
+        raise ValueError(f"{name} must be {what} of length {m} (or a batch (N, {m})) to match J, got {describe(x)}")
+    return a
+
+
+def _apply(M: np.ndarray, x: np.ndarray, name: str) -> np.ndarray:
+    """M x for M (…, p, q) and x (…, q), broadcasting the batch axes."""
+    if M.ndim == 3 and x.ndim == 2 and M.shape[0] != x.shape[0]:
+        raise ValueError(f"{name}: a batch of {x.shape[0]} vectors does not match a batch of {M.shape[0]} Jacobians")
+    return np.einsum("...ij,...j->...i", M, x) + 0.0
+
+
+def _exact_vector(x: Any, name: str, m: int, what: str) -> sp.Matrix:
+    v = as_vector(x, name, m, True)
+    for e in v:
+        check_real_finite(exact_number(e, name), name)
+    return v.applyfunc(lambda e: exact_number(e, name))
+
+
+def _damping(lam: Any) -> sp.Expr:
+    """λ as an exact number or expression, checked real, finite and ≥ 0."""
+    e = exact_number(lam, "damping")
+    if e.is_negative:
+        raise ValueError(f"damping must be ≥ 0 (λ in Jᵀ(J Jᵀ + λ²I)⁻¹), got {lam!r}")
+    if e.is_nonnegative is not True:
+        raise ValueError(f"damping must be ≥ 0 (λ in Jᵀ(J Jᵀ + λ²I)⁻¹): could not show {e} ≥ 0; declare its "
+                         f"symbols positive (sp.Symbol('lam', positive=True)) or give a number")
+    return e
+
+
+# ----------------------------------------------------------------------------------------------
+# pseudoinverse
+# ----------------------------------------------------------------------------------------------
+def _svd_pinv(A: np.ndarray, rtol):
+    """(J⁺ batch, rank, σ, tol) for A (N, m, n) via the SVD, cutting σ_i ≤ tol = rtol·σ_max."""
+    m, n = A.shape[-2:]
+    if rtol is None:
+        rtol = max(m, n) * _EPS
+    U, s, Vt = np.linalg.svd(A, full_matrices=False)
+    tol = rtol * s[..., :1]
+    keep = s > tol
+    sinv = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+    P = np.swapaxes(Vt, -1, -2) @ (sinv[..., :, None] * np.swapaxes(U, -1, -2))
+    return P, keep.sum(axis=-1), s, tol[..., 0]
+
+
+def _warn(rank, s, tol, k: int, stacklevel: int = 3):
+    rank, s, tol = np.atleast_1d(rank), np.atleast_2d(s), np.atleast_1d(tol)
+    deficient = rank < k
+    smin_kept = np.where(rank > 0, s[np.arange(len(s)), np.maximum(rank - 1, 0)], 0.0)
+    smax = s[:, 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        amp = np.where(smin_kept > 0, smax / smin_kept, np.inf)
+    near = ~deficient & (amp > _WARN_COND)
+    where = lambda mask: "" if len(rank) == 1 else f" ({int(mask.sum())} of {len(rank)} Jacobians, first at index {int(np.flatnonzero(mask)[0])})"
+    if deficient.any():
+        i = int(np.flatnonzero(deficient)[0])
+        warnings.warn(f"J is singular{where(deficient)}: rank {int(rank[i])} < {k}, singular values "
+                      f"{np.array2string(s[i], precision=3)}; the {k - int(rank[i])} smallest (≤ tol = {tol[i]:.3g}) "
+                      f"were dropped, so J⁺V has no component along their directions (the minimum-norm "
+                      f"least-squares θ̇); pass rtol to change the cut-off", SingularityWarning, stacklevel=stacklevel)
+    if near.any():
+        i = int(np.flatnonzero(near)[0])
+        warnings.warn(f"J is nearly singular{where(near)}: σ_max/σ_min = {amp[i]:.3g} > {_WARN_COND:.0e}, so J⁺ "
+                      f"amplifies V by up to 1/σ_min = {1 / smin_kept[i]:.3g}; consider damped_least_squares",
+                      SingularityWarning, stacklevel=stacklevel)
+
+
+def _exact_pinv(M: sp.Matrix, name: str = "J"):
+    """(J⁺, rank) for a constant exact J, every zero test a proof (kinlib.rigid.proved_zero)."""
+    if M.free_symbols:
+        syms = ", ".join(sorted(map(str, M.free_symbols)))
+        raise ValueError(f"{name} must be constant for an exact pseudoinverse (its form changes where the rank drops), "
+                         f"got entries in {syms}: substitute a configuration first (J.subs({{...}})), or use "
+                         f"damped_least_squares with damping > 0, which is exact for every configuration")
+    iz = lambda e: proved_zero(e, f"an entry in the elimination of {name}")
+    m, n = M.shape
+    if all(iz(e) for e in M):
+        return sp.zeros(n, m), 0
+    B, C = M.rank_decomposition(iszerofunc=iz)     # M = B C, B: m×r pivot columns, C: r×n (rref rows)
+    r = B.cols
+    if r == m == n:                              # invertible: J⁺ = J⁻¹
+        P = M.inv(method="LU", iszerofunc=iz)
+    elif r == m:                                 # full row rank: J⁺ = Jᵀ (J Jᵀ)⁻¹
+        P = M.T * (M * M.T).inv(method="LU", iszerofunc=iz)
+    elif r == n:                                 # full column rank: J⁺ = (Jᵀ J)⁻¹ Jᵀ
+        P = (M.T * M).inv(method="LU", iszerofunc=iz) * M.T
+    else:                                        # J⁺ = Cᵀ (C Cᵀ)⁻¹ (Bᵀ B)⁻¹ Bᵀ
+        P = C.T * (C * C.T).inv(method="LU", iszerofunc=iz) * (B.T * B).inv(method="LU", iszerofunc=iz) * B.T
+    return P.applyfunc(tidy), r
+
+
+def tidy(e: sp.Expr) -> sp.Expr:
+    """An exact constant in a readable form (an identity, never a numeric guess): one fraction whose
+    numerator and denominator are reduced modulo sin² + cos² = 1 (:func:`kinlib.simplify_for_display`);
+    expressions without sines and cosines by ``radsimp(simplify(·))``."""
+    from .display import simplify_for_display
+    if not e.has(sp.sin, sp.cos):
+        return sp.radsimp(sp.simplify(e))
+    num, den = sp.fraction(sp.together(e))
+    return simplify_for_display(sp.expand(num)) / simplify_for_display(sp.expand(den))
+
+
+def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
+    """The Moore–Penrose pseudoinverse J⁺ (n×m) of a Jacobian J (m×n).
+
+    J⁺ = Jᵀ(J Jᵀ)⁻¹ for full row rank, (Jᵀ J)⁻¹Jᵀ for full column rank, and in general
+    J⁺ = Σ_{σ_i > tol} v_i u_iᵀ / σ_i from the SVD J = Σ σ_i u_i v_iᵀ; J J⁺ J = J, J⁺ J J⁺ = J⁺.
+
+    Numbers (m, n) or a batch (N, m, n): the SVD with the rank cut-off tol = rtol·σ_max, rtol = max(m, n)·ε
+    by default (ε = 2.2e-16, NumPy's matrix_rank convention). A :class:`SingularityWarning` is issued when a
+    singular value was dropped (rank < min(m, n)) or when the kept ones span more than 1e8 (J⁺ amplifies V
+    by 1/σ_min); ``full_output=True`` returns (J⁺, PinvReport(rank, singular values, tol)) as well.
+    SymPy J: exact, for a constant (evaluated) J only; the rank is decided with proved zero tests; the report
+    holds the exact rank.
+
+    >>> import sympy as sp
+    >>> pseudoinverse(sp.Matrix([[1, 0], [0, 2], [0, 0]]))
+    Matrix([
+    [1,   0, 0],
+    [0, 1/2, 0]])
+    >>> import numpy as np
+    >>> P, rep = pseudoinverse(np.array([[1.0, 1.0], [1.0, 1.0]]), full_output=True)   # warns: rank 1 < 2
+    >>> P, rep.rank
+    (array([[0.25, 0.25],
+           [0.25, 0.25]]), 1)
+    """
+    if is_symbolic(J):
+        if rtol is not None:
+            raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
+        P, r = _exact_pinv(_exact_J(J))
+        return (P, PinvReport(r, None, None)) if full_output else P
+    A = _numeric_J(J)
+    rtol = _rtol(rtol)
+    batch = A.ndim == 3
+    P, rank, s, tol = _svd_pinv(A if batch else A[None], rtol)
+    _warn(rank, s, tol, min(A.shape[-2:]))
+    if not batch:
+        P, rank, s, tol = P[0], int(rank[0]), s[0], float(tol[0])
+    return (P + 0.0, PinvReport(rank, s, tol)) if full_output else P + 0.0
+
+
+def _rtol(rtol: Any):
+    if rtol is None:
+        return None
+    r = float(exact_number(rtol, "rtol"))
+    if not 0 <= r < 1:
+        raise ValueError(f"rtol must be a relative cut-off in [0, 1), got {rtol!r}")
+    return r
+
+
+def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False):
+    """Inverse velocity kinematics θ̇ = J⁺ V: the joint rates of least norm that best achieve the twist V.
+
+    J⁺ as in :func:`pseudoinverse` (Jᵀ(J Jᵀ)⁻¹ for full row rank: J θ̇ = V exactly; (Jᵀ J)⁻¹Jᵀ for full column
+    rank: the least-squares θ̇). Numbers: the SVD with tol = rtol·σ_max (default rtol = max(m, n)·ε), a
+    :class:`SingularityWarning` at or near a singularity, ``full_output=True`` → (θ̇, PinvReport). Batches: J
+    (N, m, n) and/or V (N, m). SymPy: exact, J constant (V may hold symbols).
+
+    >>> import sympy as sp
+    >>> inverse_velocity(sp.Matrix([[0, 1], [1, 1]]), [1, 2]).T      # planar 2R at θ = (0, π/2), L = 1: ṗ = (1, 2)
+    Matrix([[1, 1]])
+    """
+    if is_symbolic(J, V):
+        if rtol is not None:
+            raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
+        M = _exact_J(J)
+        v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
+        P, r = _exact_pinv(M)
+        out = (P * v).applyfunc(sp.radsimp)
+        return (out, PinvReport(r, None, None)) if full_output else out
+    A = _numeric_J(J)
+    v = _numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
+    batch = A.ndim == 3
+    P, rank, s, tol = _svd_pinv(A if batch else A[None], _rtol(rtol))
+    _warn(rank, s, tol, min(A.shape[-2:]))
+    out = _apply(P if batch else P[0], v, "V")
+    if not batch:
+        rank, s, tol = int(rank[0]), s[0], float(tol[0])
+    return (out, PinvReport(rank, s, tol)) if full_output else out
+
+
+# ----------------------------------------------------------------------------------------------
+# damped least squares
+# ----------------------------------------------------------------------------------------------
+def damped_least_squares(J: Any, V: Any, damping: Any):
+    """Damped least squares θ̇ = Jᵀ(J Jᵀ + λ²I)⁻¹ V = (Jᵀ J + λ²I)⁻¹ Jᵀ V = Σ σ_i/(σ_i² + λ²) v_i u_iᵀ V.
+
+    The θ̇ minimising ‖J θ̇ − V‖² + λ²‖θ̇‖²: bounded by ‖V‖/(2λ) at every configuration (no blow-up at a
+    singularity), → J⁺V as λ → 0. ``damping`` λ ≥ 0 (real, finite; chosen by the caller, e.g. 0.01–0.1 of
+    the typical σ). λ = 0 is exactly :func:`inverse_velocity` (same rank cut-off and warnings).
+
+    Numbers: the SVD form (stable), J (m, n) or (N, m, n), V (m,) or (N, m). SymPy: exact; with λ > 0 the
+    matrix J Jᵀ + λ²I is positive definite, so the result holds for every configuration and J may keep its
+    symbols (small arms: the closed form grows fast); λ = 0 needs a constant J.
+
+    >>> import sympy as sp
+    >>> damped_least_squares(sp.Matrix([[1, 0], [0, 0]]), [1, 1], 1).T    # singular J: the 2nd direction is dropped
+    Matrix([[1/2, 0]])
+    """
+    if is_symbolic(J, V, damping):
+        lam = _damping(damping)
+        M = _exact_J(J)
+        v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
+        if lam == 0:
+            return inverse_velocity(M, v)
+        m, n = M.shape
+        const = not (M.free_symbols or lam.free_symbols)
+        kw = {"iszerofunc": lambda e: proved_zero(e, "a pivot")} if const else {}
+        if m <= n:
+            out = M.T * (M * M.T + lam ** 2 * sp.eye(m)).LUsolve(v, **kw)
+        else:
+            out = (M.T * M + lam ** 2 * sp.eye(n)).LUsolve(M.T * v, **kw)
+        return out.applyfunc(lambda e: sp.radsimp(sp.simplify(e)) if const and not e.has(sp.sin, sp.cos)
+                             else sp.cancel(e))
+    lam = float(_damping(damping))
+    A = _numeric_J(J)
+    v = _numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
+    if lam == 0:
+        return inverse_velocity(A, v)
+    U, s, Vt = np.linalg.svd(A, full_matrices=False)
+    g = s / (s * s + lam * lam)
+    P = np.swapaxes(Vt, -1, -2) @ (g[..., :, None] * np.swapaxes(U, -1, -2))
+    return _apply(P, v, "V")
+
+
+# ----------------------------------------------------------------------------------------------
+# statics and the force ellipsoid
+# ----------------------------------------------------------------------------------------------
+def joint_torques(J: Any, F: Any):
+    """Statics τ = Jᵀ F: the joint torques/forces that hold the wrench F at the end-effector (gravity aside).
+
+    F = [m; f] (moment first, matching twists [ω; v]) expressed like J: the space Jacobian J_s with the
+    space wrench F_s, the body Jacobian J_b with the body wrench F_b, the geometric Jacobian [ω_s; ṗ] with
+    [moment about the tool point, in {s}; force, in {s}]; task rows of J pair with the same rows of F.
+    Power balance: τᵀθ̇ = Fᵀ(J θ̇) = Fᵀ V. Numbers: J (m, n) or (N, m, n), F (m,) or (N, m). SymPy: exact.
+
+    >>> import sympy as sp
+    >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
+    >>> s1, c1, s12, c12 = sp.sin(t1), sp.cos(t1), sp.sin(t1 + t2), sp.cos(t1 + t2)
+    >>> J = sp.Matrix([[-s1 - s12, -s12], [c1 + c12, c12]])   # planar 2R, unit links: rows ṗx, ṗy
+    >>> joint_torques(J, [0, 1]).T                             # hold the force f_y = 1 at the tip
+    Matrix([[cos(theta1) + cos(theta1 + theta2), cos(theta1 + theta2)]])
+    """
+    if is_symbolic(J, F):
+        M = _exact_J(J)
+        f = _exact_vector(F, "F", M.rows, "a wrench (the rows of J)")
+        return M.T * f
+    A = _numeric_J(J)
+    f = _numeric_vectors(F, "F", A.shape[-2], "a wrench (the rows of J)")
+    return _apply(np.swapaxes(A, -1, -2), f, "F")
+
+
+def force_ellipsoid(J: Any, rows: Any = None):
+    """The force ellipsoid {F : ‖Jᵀ F‖ ≤ 1}: (semi-axis lengths 1/σ_i, unit directions u_i as columns).
+
+    Dual to the velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1} (:func:`kinlib.manipulability.velocity_ellipsoid`, lengths
+    σ_i, directions u_i): the same principal directions, reciprocal lengths (Jᵀ u_i = σ_i v_i, so
+    ‖Jᵀ(u_i/σ_i)‖ = 1). Same conventions as velocity_ellipsoid: ``rows`` picks task rows (default: a 6-row J
+    uses "linear", i.e. forces f for the geometric Jacobian), k = min(m, n) axes, columns in the order of
+    the σ_i (descending), so lengths ascend. At a singularity σ_i = 0: the length is ``inf`` (numbers; σ_i ≤
+    max(m, n)·ε·σ_max counts as 0) or ``sp.oo`` (exact): the structure resists that force with no torque.
+    When m > n the ellipsoid is also unbounded along the m − n directions of the left null space of J (not
+    among the k returned, as the velocity ellipsoid's flat directions are not).
+    Numbers: lengths (k,) and directions (m, k); a batch (N, m, n) gives (N, k), (N, m, k). SymPy: exact.
+
+    >>> import sympy as sp
+    >>> force_ellipsoid(sp.Matrix([[2, 0], [0, 0]]))
+    ([1/2, oo], Matrix([
+    [1, 0],
+    [0, 1]]))
+    """
+    if is_symbolic(J):
+        lengths, U = velocity_ellipsoid(J, rows)
+        out = []
+        for s in lengths:
+            zero = proved_zero(s, "a singular value") if not s.free_symbols else sp.simplify(s) == 0
+            out.append(sp.oo if zero else sp.radsimp(1 / s))
+        return out, U
+    A = _numeric_J(J)
+    if rows is None and A.shape[-2] == 6:
+        rows = "linear"
+    if rows is not None:
+        A = task_rows(A, rows)
+    U, s, _ = np.linalg.svd(A, full_matrices=False)
+    m, n = A.shape[-2:]
+    tol = max(m, n) * _EPS * s[..., :1]
+    with np.errstate(divide="ignore"):
+        lengths = np.where(s > tol, 1.0 / np.where(s > tol, s, 1.0), np.inf)
+    return lengths, U
