@@ -10,7 +10,9 @@ LOCAL_WORLD_ALIGNED = the geometric Jacobian [ṗ; ω]) and that a batch equals 
 
 Every figure is the median of repeated ``timeit`` runs. Sections: numeric kinematics (single and
 batched FK, J_s, J_b, geometric J) for the UR5 and the problem set's robots against modern-robotics
-and Pinocchio; symbolic build, display simplification and the UR5's singular set; each notebook's
+and Pinocchio; the first numeric call (code generation) of a 7-joint arm; symbolic build, display
+simplification and the UR5's singular set; exact rank and spans at configurations of 6-joint arms; the
+singular set of a 6×7 J, the numeric singularity search and a symbolic condition number; each notebook's
 execution; one slider move in each explorer; the instructor checker's throughput; ``import kinlib``.
 Missing pieces (Pinocchio, a notebook, a module) are reported as "not available", never skipped
 silently. ``--quick`` (tests) uses a tiny batch and skips notebooks, explorers and the checker.
@@ -52,6 +54,10 @@ T_SINGULAR = 5.0
 T_NOTEBOOK = 10.0
 T_REDRAW = 0.050
 T_IMPORT = 0.6
+T_FIRST_CALL = 2.0       # first numeric call (code generation) of any chain of <= 7 joints
+T_EXACT_RANK = 30.0      # exact rank / column space / left null space at a configuration of a 6-joint arm
+T_SINGULAR_7 = 60.0      # singular set of a 6×7 Jacobian: an answer or a clear "out of reach"
+T_COND_2R = 2.0          # symbolic condition number of a planar 2R
 
 QUANTITIES = [("fk", "FK T(θ)"), ("js", "space Jacobian J_s"), ("jb", "body Jacobian J_b"),
               ("jg", "geometric Jacobian [ω_s; ṗ]")]
@@ -391,6 +397,83 @@ def symbolic_section(args, targets: Targets) -> list[str]:
     return lines + table(["what", "time", "target", "status"], rows)
 
 
+_BAXTER_H = 1.57079632679   # the URDF's own digits: not π/2, so no rotation entry is zero (a dense arm)
+BAXTER_LEFT_ARM = [  # baxter_description: left_arm_mount, then s0 ... w2
+    ("fixed", (0.024645, 0.219645, 0.118588), (0, 0, 0.7854), None),
+    ("revolute", (0.055695, 0, 0.011038), (0, 0, 0), (0, 0, 1)),
+    ("revolute", (0.069, 0, 0.27035), (-_BAXTER_H, 0, 0), (0, 0, 1)),
+    ("revolute", (0.102, 0, 0), (_BAXTER_H, 0, _BAXTER_H), (0, 0, 1)),
+    ("revolute", (0.069, 0, 0.26242), (-_BAXTER_H, -_BAXTER_H, 0), (0, 0, 1)),
+    ("revolute", (0.10359, 0, 0), (_BAXTER_H, 0, _BAXTER_H), (0, 0, 1)),
+    ("revolute", (0.01, 0, 0.2707), (-_BAXTER_H, -_BAXTER_H, 0), (0, 0, 1)),
+    ("revolute", (0.115975, 0, 0), (_BAXTER_H, 0, _BAXTER_H), (0, 0, 1)),
+]
+BAXTER_TOOL = ((0, 0, 0.27175), (0, 0, 0))
+
+
+def first_call_section(args, targets: Targets) -> list[str]:
+    lines = ["## First numeric call of a 7-joint chain (code generation)", "",
+             "A fresh chain built with `robots.from_urdf_joints` from the Baxter left arm's URDF placements "
+             "(SymPy's cache cleared), timed from the first call with floats to its result.", ""]
+    if not hasattr(robots, "from_urdf_joints"):
+        return lines + [NA + " (robots.from_urdf_joints missing)"]
+    q = np.zeros(7)
+
+    def first(methods):
+        sp.core.cache.clear_cache()
+        chain = robots.from_urdf_joints(BAXTER_LEFT_ARM, BAXTER_TOOL, name="baxter_left")
+        t0 = CLOCK()
+        for m in methods:
+            getattr(chain, m)(q)
+        return CLOCK() - t0
+
+    first(["fk"])  # warm-up
+    rows = []
+    for label, methods in (("T(θ)", ["fk"]), ("J_s", ["jacobian_space"]), ("J_b", ["jacobian_body"]),
+                           ("geometric J", ["jacobian_geometric"]),
+                           ("all four", ["fk", "jacobian_space", "jacobian_body", "jacobian_geometric"])):
+        t = statistics.median(first(methods) for _ in range(max(3, min(args.reps, 5))))
+        rows.append([f"Baxter 7R arm from URDF placements: first call of {label}", fmt_t(t), "≤ 2 s",
+                     targets.upper(f"first numeric call, 7-joint arm, {label}", t, T_FIRST_CALL)])
+    return lines + table(["what", "CPU time (median)", "target", "status"], rows)
+
+
+_STANFORD = [[0, 0, 1, 0, 0, 0], [1, 0, 0, 0, 1, 0], [0, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0],
+             [1, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0]]
+
+
+def exact_section(args, targets: Targets) -> list[str]:
+    """Exact rank, column space and left null space at configurations of 6-joint arms (kinlib.exact)."""
+    from kinlib.exact import column_space, left_null_space, rank_at
+    lines = ["## Exact analysis at a configuration (6-joint arms)", "",
+             "`rank_at`, `column_space` and `left_null_space` of the 6×6 J at one configuration: proved exactly "
+             "(or, beyond the exact budget, 60-digit numerics, flagged).", ""]
+    M = sp.eye(4)
+    M[:3, 3] = sp.Matrix([0, sp.Rational(1, 2), 1])
+    stanford = kinlib.SerialChain(M, _STANFORD, name="stanford")
+    R = sp.Rational
+    cases = [("Stanford RRPRRR", stanford, "J_s", (1, 2, 3, 4, 5, 6)),
+             ("Stanford RRPRRR (wrist θ5 = 0)", stanford, "J_s", (1, 2, R(1, 3), 4, 0, 6)),
+             ("UR5 geometric J (elbow θ3 = 0)", robots.ur5(), "J", (R(1, 2), 10, 0, 1, 3, 2)),
+             ("UR5 geometric J", robots.ur5(), "J", (1, 1, 1, 1, 1, 1))]
+    rows = []
+    for label, chain, which, q in cases if not args.quick else cases[:2]:
+        J = chain.jacobian_space() if which == "J_s" else chain.jacobian_geometric()
+        sp.core.cache.clear_cache()
+        t0 = CLOCK()
+        r = rank_at(J, q, chain.thetas)
+        t1 = CLOCK()
+        C = column_space(J, q, chain.thetas)
+        t2 = CLOCK()
+        N = left_null_space(J, q, chain.thetas)
+        t3 = CLOCK()
+        assert C.shape[1] == r and N.shape[1] == 6 - r
+        worst = max(t1 - t0, t2 - t1, t3 - t2)
+        rows.append([f"{label} at θ = {tuple(q)}: rank {r!r}", fmt_t(t1 - t0), fmt_t(t2 - t1), fmt_t(t3 - t2),
+                     "≤ 30 s each", targets.upper(f"exact analysis, {label}", worst, T_EXACT_RANK)])
+    return lines + table(["what", "rank_at", "column_space", "left_null_space", "target", "status"], rows)
+
+
 def notebook_section(args, targets: Targets) -> list[str]:
     lines = ["## Notebooks (executed with nbclient in a temporary copy, kernel start included)", ""]
     expected = ["01_properties_of_jacobians", "02_planar_robot_jacobian", "03_spatial_robot_jacobian",
@@ -536,7 +619,8 @@ def main(argv=None) -> int:
     targets = Targets()
     head = machine()
     sections = []
-    for fn in (numeric_section, symbolic_section, notebook_section, explorer_section, grader_section, import_section):
+    for fn in (numeric_section, first_call_section, symbolic_section, exact_section, notebook_section, explorer_section,
+               grader_section, import_section):
         t0 = time.perf_counter()
         sections.append(fn(args, targets))
         print(f"[bench] {fn.__name__}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)

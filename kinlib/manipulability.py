@@ -14,7 +14,6 @@ batch of Jacobians (N, m, n) gives (N,) results.
 """
 from __future__ import annotations
 
-import itertools
 import numbers
 from typing import Any
 

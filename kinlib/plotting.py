@@ -852,8 +852,12 @@ def draw_chain(chain, q=None, ax=None, *, planar=None, frames=True, axes=True, l
 
 
 def _fmt_expr(e) -> str:
-    s = sp.sstr(sp.nsimplify(e) if not isinstance(e, sp.Basic) else e)
-    return s.replace("**", "^").replace("*", "·")
+    """A label for a number or expression: SymPy as it is, floats to 4 significant digits (never a guessed
+    closed form)."""
+    if not isinstance(e, sp.Basic):
+        x = float(e)
+        return str(int(x)) if x.is_integer() else f"{x:.4g}"
+    return sp.sstr(e).replace("**", "^").replace("*", "·")
 
 
 def _fmt_vec(v) -> str:

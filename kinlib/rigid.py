@@ -211,6 +211,15 @@ def real_array(x, name: str, want: str) -> np.ndarray:
     import numbers
     if isinstance(x, (str, bytes)) or x is None or isinstance(x, (bool, np.bool_, numbers.Number)):
         raise TypeError(f"{name} must be {want}, got {describe(x)}")
+    if isinstance(x, (list, tuple)):     # NumPy would turn [True, 2.0] into [1.0, 2.0]: look at the entries first
+        stack = [x]
+        while stack:
+            for e in stack.pop():
+                if isinstance(e, (list, tuple, np.ndarray)):
+                    stack.append(e)
+                elif isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or e is None \
+                        or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                    raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)} in {describe(x)}")
     try:
         a = np.asarray(x)
     except Exception:
@@ -236,6 +245,8 @@ def proved_zero(e, what: str = "an entry") -> bool:
 
     * nonzero: SymPy's ``evalf(30, strict=True)`` returns a value with 30 correct digits (its error
       tracking raises ``PrecisionExhausted`` rather than return a digit it cannot guarantee) that is not 0;
+    * either way: exact arithmetic in K(tan(g/2)) (:func:`kinlib.exactfield.exact_is_zero`) for sines and
+      cosines of angles r + qπ (r, q rational) and algebraic numbers;
     * zero: a normal form (:func:`kinlib.is_identically_zero`, the sin² + cos² = 1 reduction), the
       minimal polynomial x of an algebraic number, or ``sp.simplify(e) == 0``.
 
@@ -256,6 +267,11 @@ def proved_zero(e, what: str = "an entry") -> bool:
         if v.is_number and (sp.re(v) != 0 or sp.im(v) != 0) and v.is_comparable is not False:
             return False
     except (sp.core.evalf.PrecisionExhausted, TypeError, ValueError):
+        pass
+    try:  # sin/cos of rational angles (+ rational multiples of π), algebraic numbers: exact field arithmetic
+        from .exactfield import exact_is_zero
+        return bool(exact_is_zero(e))
+    except (ImportError, ValueError):
         pass
     from .display import is_identically_zero  # local import: display imports nothing from here
     try:
@@ -331,7 +347,7 @@ def _log3_exact(R: sp.Matrix):
                     w = (R[:, k] + sp.eye(3)[:, k]) / sp.sqrt(2 * d)
                     return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), sp.pi, False
             raise AssertionError("unreachable: a rotation by π has some 1 + r_kk = 2ω̂_k² ≠ 0")  # pragma: no cover
-        theta = sp.acos(c)
+        theta = _acos_exact(c)
         s = sp.sqrt(simp(1 - c ** 2))                                # sin θ > 0 for 0 < θ < π
         w = sp.Matrix([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (2 * s)
         return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), theta, False
@@ -342,6 +358,26 @@ def _log3_exact(R: sp.Matrix):
     s = sp.sqrt(simplify_for_display(1 - c ** 2))
     w = simplify_for_display(sp.Matrix([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / 2) / s
     return w, sp.acos(c), False
+
+
+def _acos_exact(c: sp.Expr) -> sp.Expr:
+    """acos c for a constant c, as a rational multiple of π when it is one (π/12 for (√2 + √6)/4).
+
+    The candidate p/q (q ≤ 360, from the continued fraction of acos(c)/π at 40 digits) is accepted only after
+    cos(pπ/q) − c = 0 is *proved* (:func:`proved_zero`); otherwise acos(c) stays as it is. Exact either way.
+    """
+    import fractions
+    theta = sp.acos(c)
+    if not isinstance(theta, sp.acos):
+        return theta
+    try:
+        x = fractions.Fraction(str(sp.N(theta / sp.pi, 40))).limit_denominator(360)
+        cand = sp.Rational(x.numerator, x.denominator)
+        if 0 < cand < 1 and proved_zero(sp.cos(cand * sp.pi) - c, "cos θ − c"):
+            return cand * sp.pi
+    except (ValueError, TypeError):
+        pass
+    return theta
 
 
 _LOG3_FORMS = ("matrix", "vector", "axis_angle")

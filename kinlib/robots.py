@@ -168,7 +168,8 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
 
     With the home placements T_k = T_{k−1} [[R(rpy_k), xyz_k], [0, 1]] (T_0 = I; joint values 0), a
     revolute joint k has the space screw axis S_k = [ω_k; −ω_k × p_k] with ω_k = R_k â_k and p_k the
-    origin of T_k, a prismatic one S_k = [0; R_k â_k]; M = T_last · tool. (Lynch & Park §4.1.1.)
+    origin of T_k, a prismatic one S_k = [0; R_k â_k]; M = T_last · tool (Lynch & Park §4.1.1). The
+    joint points (for drawing, ``chain.skeleton``) are the joint frames' origins p_k.
 
     Exact numbers: xyz and axis entries are the decimals typed (0.0388353 → 388353/10⁷, via
     ``kinlib._backend.exact_number``). The sine and cosine of a typed rpy angle a are irrational, so a is
@@ -197,10 +198,10 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
     if isinstance(joints, (str, bytes)) or not isinstance(joints, (list, tuple)):
         raise TypeError(f"joints must be a list of (type, xyz, rpy, axis) tuples, got {describe(joints)}")
     R, p = sp.eye(3), sp.zeros(3, 1)
-    screws = []
-    steps = list(enumerate(joints)) + ([(len(joints), ("fixed",) + tuple(tool) + (None,))] if tool is not None else [])
+    screws, points = [], []
     if tool is not None and (not isinstance(tool, (list, tuple)) or len(tool) != 2):
         raise ValueError(f"tool must be (xyz, rpy) or None, got {describe(tool)}")
+    steps = list(enumerate(joints)) + ([(len(joints), ("fixed", tool[0], tool[1], None))] if tool is not None else [])
     for k, joint in steps:
         where = "tool" if k == len(joints) else f"joints[{k}]"
         if not isinstance(joint, (list, tuple)) or len(joint) != 4:
@@ -218,10 +219,12 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
             raise ValueError(f"{where} axis must be a nonzero vector, got {list(a)}")
         w = R * (a if n2 == 1 else a / sp.sqrt(n2))
         screws.append(list(w) + list(-w.cross(p)) if _URDF_KINDS[kind] == "R" else [0, 0, 0] + list(w))
+        points.append(p)
     if not screws:
         raise ValueError(f"joints must hold at least one revolute or prismatic joint, got {describe(joints)}")
     M = sp.Matrix.vstack(sp.Matrix.hstack(R, p), sp.Matrix([[0, 0, 0, 1]]))
-    return SerialChain(M, sp.Matrix(screws).T, name=name, description=description or f"{len(screws)}-joint arm from URDF")
+    return SerialChain(M, sp.Matrix(screws).T, name=name, joint_points=sp.Matrix.hstack(*points),
+                       description=description or f"{len(screws)}-joint arm from URDF joint placements")
 
 
 __all__ += ["from_urdf_joints"]

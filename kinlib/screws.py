@@ -129,7 +129,6 @@ _LOG6_FORMS = ("matrix", "vector", "screw_angle")
 def _log6_exact(T: sp.Matrix):
     """(ω̂, θ_rot, vθ, p) for an exact SymPy transform; θ_rot = 0 exactly when R = I."""
     from ._backend import check_real_finite, exact_number
-    from .display import is_identically_zero
     from .rigid import check_se3, log3, proved_zero
     for e in T:
         check_real_finite(e, "T")

@@ -12,18 +12,24 @@ Jacobian the last three are ṗ). ``singular_configurations`` solves det = 0 in 
 periodic families; ``rank_at``, ``column_space`` and ``left_null_space`` give exact answers *at* a
 configuration (SymPy's ``Matrix.rank()`` on the symbolic J gives only the generic rank and hides the drop).
 
-How the determinant is solved fast: sin θ_i, cos θ_i are replaced by polynomial variables s_i, c_i,
-each entry is reduced modulo s_i² + c_i² − 1 (:class:`kinlib.trigpoly.TrigRing`), the determinant is
-taken by fraction-free elimination in that polynomial ring and factored, and each factor that involves a
-single joint is solved on one period [0, 2π) and written as a family {b + p k : k ∈ ℤ}. Prismatic joint
-variables enter polynomially and are solved over ℝ.
+How the singular set is found exactly: sin θ_i, cos θ_i are replaced by polynomial variables s_i, c_i,
+each entry is reduced modulo s_i² + c_i² − 1 (:class:`kinlib.trigpoly.TrigRing`), and the k×k minors of
+J (k = min(m, n); for square J only det J) are taken by fraction-free elimination in that polynomial
+ring (Σ minors² = det(J Jᵀ) or det(Jᵀ J) by Cauchy–Binet, so rank J < k ⇔ all minors vanish). With G
+their gcd and q_i = minor_i / G, the singular set is {G = 0} ∪ {all q_i = 0}. The factors of G that
+involve a single joint are solved on one period [0, 2π) and written as families {b + p k : k ∈ ℤ}
+(prismatic joint values enter polynomially and are solved over ℝ); the common zeros of the q_i are
+solved joint by joint where their factors allow it, else given as Σ q_i² = 0. Factors that cannot
+vanish are dropped only with a proof (:mod:`kinlib.trigsign`). A time budget bounds the work: past it
+the answer says it is incomplete (``SingularSet.complete``) and names the numeric search
+:func:`kinlib.singular_search.find_singularities`.
 """
 from __future__ import annotations
 
 import itertools
 import numbers
 import time
-from typing import Any, Mapping, Sequence
+from typing import Any, Sequence
 
 import numpy as np
 import sympy as sp
@@ -171,7 +177,12 @@ def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
         raise TypeError(f"e must be a SymPy expression or Matrix, got {describe(e)}")
     angles = angles_in([e], set(thetas) if thetas is not None else None)
     if not angles:
-        return sp.factor(e) if e.free_symbols else sp.nsimplify(sp.radsimp(e)) if e.is_number and not e.has(sp.Float) else e
+        if e.free_symbols:
+            return sp.factor(e)
+        if e.is_number and not e.has(sp.Float):   # exact rewriting only (never nsimplify: it guesses from floats)
+            e = sp.radsimp(e)
+            return sp.trigsimp(e) if e.has(sp.sin, sp.cos) else e
+        return e
     try:
         ring = TrigRing([e], angles, opaque=True)
         p = ring.to_expr(ring.normal_form(e), trig=False)   # in s_i, c_i: factored as a polynomial
@@ -344,19 +355,27 @@ def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float
 
 
 def _cheap_points(g_expr: sp.Expr, joint: sp.Symbol, revolute: bool):
-    """Exact zeros of a single-variable factor on one period where sin and cos are rational (kπ/2), or
-    rational prismatic values; None when the zeros are of another kind."""
+    """Exact zeros of a single-variable factor on one period, as (point, value of sin, value of cos) with
+    rational sin and cos (kπ/2, π − atan(3/4) ...; exact simplification, never a guess), or rational
+    prismatic values as (point, point, None); None when the zeros are of another kind."""
     sol = _solve_single(g_expr, joint, revolute)
     if sol is None:
         return None
     if sol is sp.S.EmptySet:
         return []
     pts = [p for p in sol] if isinstance(sol, sp.FiniteSet) else representatives(sol)
-    if revolute:
-        ok = all(sp.sin(p).is_Rational and sp.cos(p).is_Rational for p in pts)
-    else:
-        ok = all(p.is_Rational for p in pts)
-    return pts if ok else None
+    out = []
+    for p in pts:
+        if revolute:
+            sv, cv = (sp.simplify(sp.expand_trig(f(p))) for f in (sp.sin, sp.cos))
+            if not (sv.is_Rational and cv.is_Rational):
+                return None
+            out.append((p, sv, cv))
+        else:
+            if not p.is_Rational:
+                return None
+            out.append((p, p, None))
+    return out
 
 
 def _solve_system(qs: list, ring, ctx: dict, depth: int = 0):
@@ -388,18 +407,17 @@ def _solve_system(qs: list, ring, ctx: dict, depth: int = 0):
             if pts is None:
                 branches = None
                 break
-            branches += [(j, p) for p in pts]
+            branches += [(j, *p) for p in pts]
         if branches is not None:
             best = branches
             break
     if best is None:
         return None
     by_point: dict = {}
-    for j, p in best:
+    for j, p, sv, cv in best:
         if j in ctx["revolute"]:
             i = ring.angles.index(j)
-            subs = [(ring.gens[i], ring.domain.from_sympy(sp.sin(p))),
-                    (ring.gens[len(ring.angles) + i], ring.domain.from_sympy(sp.cos(p)))]
+            subs = [(ring.gens[i], ring.domain.from_sympy(sv)), (ring.gens[len(ring.angles) + i], ring.domain.from_sympy(cv))]
         else:
             subs = [(ring.gens[2 * len(ring.angles) + ring.variables.index(j)], ring.domain.from_sympy(p))]
         sub = _solve_system([q.subs(subs) for q in qs], ring, ctx, depth + 1)
@@ -567,7 +585,7 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
         # lower-dimensional part: all q_i = 0 together
         total = sum(len(q.terms()) for q in qs)
         S = None
-        if total <= 2000:
+        if sum(len(q.terms()) ** 2 for q in qs) <= 1_000_000:   # Σ q_i² > 0 proved: no common zero
             S = ring.reduce(sum((q * q for q in qs), ring.ring.zero))
         if S is not None and proves_nonzero(ring, S, ctx["kinds"]):
             pass

@@ -29,8 +29,6 @@ False
 """
 from __future__ import annotations
 
-import sympy as sp
-
 __all__ = ["proves_nonzero", "proves_positive", "generator_kinds"]
 
 _MAX_TERMS = 400

@@ -140,27 +140,100 @@ def _warn(rank, s, tol, k: int, stacklevel: int = 3):
 
 
 def _exact_pinv(M: sp.Matrix, name: str = "J"):
-    """(J⁺, rank) for a constant exact J, every zero test a proof (kinlib.rigid.proved_zero)."""
+    """(J⁺, rank) for a constant exact J, every zero test a proof.
+
+    Entries built from sin/cos of angles r + qπ (r, q rational) and algebraic numbers are computed in the field
+    K(t), t = tan(g/2) (:class:`kinlib.exactfield.ExactField`: t is transcendental, so field arithmetic decides
+    every pivot exactly) and written back with t = tan(g/2); other constants by SymPy elimination with
+    :func:`kinlib.rigid.proved_zero` pivot tests (slow beyond small matrices).
+    """
     if M.free_symbols:
         syms = ", ".join(sorted(map(str, M.free_symbols)))
         raise ValueError(f"{name} must be constant for an exact pseudoinverse (its form changes where the rank drops), "
                          f"got entries in {syms}: substitute a configuration first (J.subs({{...}})), or use "
                          f"damped_least_squares with damping > 0, which is exact for every configuration")
-    iz = lambda e: proved_zero(e, f"an entry in the elimination of {name}")
     m, n = M.shape
+    try:
+        from .exactfield import ExactField, NotExact
+    except ImportError:  # pragma: no cover - the exact field is part of kinlib
+        ExactField, NotExact = None, ValueError
+    if ExactField is not None:
+        try:
+            fld = ExactField(list(M))
+            A = fld.field_matrix(M)
+        except NotExact:
+            A = None
+        if A is not None:
+            if fld.K == sp.QQ:   # rational coefficients: field Gauss–Jordan is fastest
+                P, r = _pinv_formula(A, A.rank(), m, n, lambda X: X.inv())
+            else:                # algebraic coefficients (√2 ...): fraction-free, far faster there
+                P, r = _field_pinv(A, m, n)
+            back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
+            return P.to_Matrix().xreplace(back), r
+    iz = lambda e: proved_zero(e, f"an entry in the elimination of {name}")
     if all(iz(e) for e in M):
         return sp.zeros(n, m), 0
     B, C = M.rank_decomposition(iszerofunc=iz)     # M = B C, B: m×r pivot columns, C: r×n (rref rows)
-    r = B.cols
-    if r == m == n:                              # invertible: J⁺ = J⁻¹
-        P = M.inv(method="LU", iszerofunc=iz)
-    elif r == m:                                 # full row rank: J⁺ = Jᵀ (J Jᵀ)⁻¹
-        P = M.T * (M * M.T).inv(method="LU", iszerofunc=iz)
-    elif r == n:                                 # full column rank: J⁺ = (Jᵀ J)⁻¹ Jᵀ
-        P = (M.T * M).inv(method="LU", iszerofunc=iz) * M.T
-    else:                                        # J⁺ = Cᵀ (C Cᵀ)⁻¹ (Bᵀ B)⁻¹ Bᵀ
-        P = C.T * (C * C.T).inv(method="LU", iszerofunc=iz) * (B.T * B).inv(method="LU", iszerofunc=iz) * B.T
+    P, r = _pinv_formula(M, B.cols, m, n, lambda X: X.inv(method="LU", iszerofunc=iz), (B, C))
     return P.applyfunc(tidy), r
+
+
+def _field_pinv(A, m: int, n: int):
+    """J⁺ over the exact field K(t, …) (a DomainMatrix): fraction-free inverses in K[t, …] (inv_den), one
+    cancellation per entry at the end (field Gauss–Jordan with a gcd at every step is far slower)."""
+    R, piv = A.rref()
+    r = len(piv)
+    if r == 0:
+        return A.transpose().mul(A.domain.zero), 0
+
+    def frac(X):                                  # X = N / d, N over the polynomial ring
+        d, N = X.clear_denoms(convert=True)
+        return N, getattr(d, "element", d)
+
+    def inv(X):
+        N, d = frac(X)
+        adj, det = N.inv_den()                    # N⁻¹ = adj / det
+        return adj.mul(d), det
+
+    def mul(*fs):
+        N, d = fs[0]
+        for N2, d2 in fs[1:]:
+            N, d = N * N2, d * d2
+        return N, d
+
+    At = A.transpose()
+    if r == m == n:
+        N, d = inv(A)
+    elif r == m:
+        N, d = mul(frac(At), inv(A * At))
+    elif r == n:
+        N, d = mul(inv(At * A), frac(At))
+    else:                                         # J = B C: B the pivot columns, C the nonzero rref rows
+        B, C = A.extract(list(range(m)), list(piv)), R.extract(list(range(r)), list(range(n)))
+        Ct, Bt = C.transpose(), B.transpose()
+        N, d = mul(frac(Ct), inv(C * Ct), inv(Bt * B), frac(Bt))
+    K = A.domain
+    dd = K.convert_from(d, N.domain)
+    return N.convert_to(K).mul(K.one / dd), r
+
+
+def _pinv_formula(A, r: int, m: int, n: int, inv, BC=None):
+    """J⁺ from the rank r: J⁻¹, Jᵀ(J Jᵀ)⁻¹ (r = m), (Jᵀ J)⁻¹Jᵀ (r = n), else Cᵀ(C Cᵀ)⁻¹(Bᵀ B)⁻¹Bᵀ for J = B C."""
+    T = lambda X: X.transpose() if hasattr(X, "transpose") else X.T
+    if r == 0:
+        return (A.transpose() if hasattr(A, "to_Matrix") else A.T) * 0, 0
+    if r == m == n:
+        return inv(A), r
+    if r == m:
+        return T(A) * inv(A * T(A)), r
+    if r == n:
+        return inv(T(A) * A) * T(A), r
+    if BC is None:                                # rank decomposition from the rref: B = pivot columns of A
+        R, piv = A.rref()
+        B, C = A.extract(list(range(m)), list(piv)), R.extract(list(range(r)), list(range(n)))
+    else:
+        B, C = BC
+    return T(C) * inv(C * T(C)) * inv(T(B) * B) * T(B), r
 
 
 def tidy(e: sp.Expr) -> sp.Expr:
@@ -185,7 +258,10 @@ def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
     singular value was dropped (rank < min(m, n)) or when the kept ones span more than 1e8 (J⁺ amplifies V
     by 1/σ_min); ``full_output=True`` returns (J⁺, PinvReport(rank, singular values, tol)) as well.
     SymPy J: exact, for a constant (evaluated) J only; the rank is decided with proved zero tests; the report
-    holds the exact rank.
+    holds the exact rank. Entries in sin/cos of rational angles (joint values 1, 1/2, ...) are computed in the
+    exact field K(t), t = tan(g/2) (g the angles' common measure, :mod:`kinlib.exactfield`), and come back as
+    rational functions of tan(g/2) (e.g. −2 sin 10/5 as −4 tan 5/(5 + 5 tan² 5)); a UR5 at integer angles
+    takes ≲ 10 s. (SymPy's own ``Matrix.pinv`` is not used: its zero tests can silently fail on such entries.)
 
     >>> import sympy as sp
     >>> pseudoinverse(sp.Matrix([[1, 0], [0, 2], [0, 0]]))
@@ -279,6 +355,9 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
             return inverse_velocity(M, v)
         m, n = M.shape
         const = not (M.free_symbols or lam.free_symbols)
+        fast = _field_dls(M, lam) if const else None
+        if fast is not None:
+            return (fast * v).applyfunc(sp.radsimp)
         kw = {"iszerofunc": lambda e: proved_zero(e, "a pivot")} if const else {}
         if m <= n:
             out = M.T * (M * M.T + lam ** 2 * sp.eye(m)).LUsolve(v, **kw)
@@ -295,6 +374,27 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
     g = s / (s * s + lam * lam)
     P = np.swapaxes(Vt, -1, -2) @ (g[..., :, None] * np.swapaxes(U, -1, -2))
     return _apply(P, v, "V")
+
+
+def _field_dls(M: sp.Matrix, lam: sp.Expr):
+    """Jᵀ(J Jᵀ + λ²I)⁻¹ for a constant J and λ > 0 in the exact field K(tan(g/2)); None when it does not apply."""
+    try:
+        from .exactfield import ExactField
+        fld = ExactField(list(M) + [lam])
+        A = fld.field_matrix(M)
+        l2 = fld.convert(lam ** 2)
+    except (ImportError, ValueError):
+        return None
+    m, n = M.shape
+    K = A.domain
+    At = A.transpose()
+    G = A * At + A.eye(m, K).mul(l2) if m <= n else At * A + A.eye(n, K).mul(l2)
+    d, N = G.clear_denoms(convert=True)          # fraction-free: G⁻¹ = d · adj(N)/det(N)
+    adj, det = N.inv_den()
+    Gi = adj.convert_to(K).mul(K.convert_from(getattr(d, "element", d), N.domain) / K.convert_from(det, N.domain))
+    X = At * Gi if m <= n else Gi * At
+    back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
+    return X.to_Matrix().xreplace(back)
 
 
 # ----------------------------------------------------------------------------------------------
