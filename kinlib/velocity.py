@@ -355,9 +355,9 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
             return inverse_velocity(M, v)
         m, n = M.shape
         const = not (M.free_symbols or lam.free_symbols)
-        fast = _field_dls(M, lam) if const else None
+        fast = _field_dls(M, lam, v) if const else None
         if fast is not None:
-            return (fast * v).applyfunc(sp.radsimp)
+            return fast if not v.free_symbols else (fast * v).applyfunc(sp.radsimp)
         kw = {"iszerofunc": lambda e: proved_zero(e, "a pivot")} if const else {}
         if m <= n:
             out = M.T * (M * M.T + lam ** 2 * sp.eye(m)).LUsolve(v, **kw)
@@ -376,19 +376,26 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
     return _apply(P, v, "V")
 
 
-def _field_dls(M: sp.Matrix, lam: sp.Expr):
-    """Jᵀ(J Jᵀ + λ²I)⁻¹ for a constant J and λ > 0 in the exact field K(tan(g/2)); None when it does not apply."""
+def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
+    """For a constant J and λ > 0, in the exact field K(tan(g/2)): θ̇ = Jᵀ(J Jᵀ + λ²I)⁻¹V when V is constant too
+    (one linear solve), else the matrix Jᵀ(J Jᵀ + λ²I)⁻¹; None when the field does not apply."""
+    const_v = not v.free_symbols
     try:
         from .exactfield import ExactField
-        fld = ExactField(list(M) + [lam])
+        fld = ExactField(list(M) + [lam] + (list(v) if const_v else []))
         A = fld.field_matrix(M)
         l2 = fld.convert(lam ** 2)
+        b = fld.field_matrix(v) if const_v else None
     except (ImportError, ValueError):
         return None
     m, n = M.shape
     K = A.domain
     At = A.transpose()
     G = A * At + A.eye(m, K).mul(l2) if m <= n else At * A + A.eye(n, K).mul(l2)
+    back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
+    if const_v:
+        x = At * G.lu_solve(b) if m <= n else G.lu_solve(At * b)
+        return x.to_Matrix().xreplace(back)
     d, N = G.clear_denoms(convert=True)          # fraction-free: G⁻¹ = d · adj(N)/det(N)
     adj, det = N.inv_den()
     Gi = adj.convert_to(K).mul(K.convert_from(getattr(d, "element", d), N.domain) / K.convert_from(det, N.domain))
