@@ -82,6 +82,10 @@ def _check_thetas(thetas: Any, n: int, name: str = "thetas") -> tuple[sp.Symbol,
                          f"{', '.join(map(str, thetas))}")
     if len(set(thetas)) != n:
         raise ValueError(f"{name} must hold distinct symbols, got {', '.join(map(str, thetas))}")
+    for t in thetas:
+        if t.is_real is not True:
+            raise ValueError(f"{name} must hold real joint symbols: {t} is not declared real (use "
+                             f"sp.Symbol('{t}', real=True)); got {name} = ({', '.join(map(str, thetas))})")
     return thetas
 
 
@@ -115,8 +119,8 @@ def _row_index(r: Any) -> int:
         key = _ALIASES.get(r.lower(), r.lower())
         if key in ROW_NAMES:
             return ROW_NAMES.index(key)
-        raise ValueError(f"rows: unknown row name {r!r}; names are {', '.join(ROW_NAMES)} "
-                         f"(ṗ aliases px, py, pz) or a preset among {', '.join(_PRESETS)}")
+        raise ValueError(f"rows: unknown row name; names are {', '.join(ROW_NAMES)} "
+                         f"(ṗ aliases px, py, pz) or a preset among {', '.join(_PRESETS)}; got {r!r}")
     raise TypeError(f"rows must be row indices or names among {ROW_NAMES}, got {describe(r)}")
 
 
@@ -154,7 +158,8 @@ def task_rows(J: Any, rows: Any):
         raise ValueError(f"row names need a 6-row Jacobian ([ω; v] rows), got J with {m} rows; use indices")
     for i in idx:
         if not -m <= i < m:
-            raise ValueError(f"rows: index {i} is out of range for J with {m} rows")
+            raise ValueError(f"rows: index {i} is out of range for J with {m} rows (indices −{m}…{m - 1}); "
+                             f"got rows = {rows!r}")
     if batch:
         return np.asarray(J, dtype=float)[:, idx, :]
     if isinstance(J, sp.MatrixBase):

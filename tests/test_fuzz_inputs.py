@@ -8,8 +8,7 @@ a symbol that is not declared real, or a wrong shape/length. The call must raise
 the argument; it must never return (no NaN, no value derived from the real part of a complex number).
 
 Every valid call is also made once, so a corruption that is refused is refused for being bad, not because
-the base call was already broken. Cases whose implementation belongs to another part of issue 11 and still
-fails are marked ``xfail(strict=False, reason="owned by <part>, pending")``.
+the base call was already broken.
 """
 from __future__ import annotations
 
@@ -65,7 +64,6 @@ class Case:
     fn: Callable | tuple                          # a callable, or (module, name) looked up at test time
     args: list
     kw: tuple = ()                                # names of the args passed by keyword (in order of args)
-    owner: str | None = None                      # another part of issue 11 owns the implementation
 
 
 def _resolve(fn):
@@ -191,9 +189,6 @@ R_ROT = T_NUM[:3, :3]
 # generic matrices (a twist, a pose T, a Jacobian J, display input) may hold any symbols.
 GENERIC_OK = (X_PLAIN, Z_COMPLEX, BAD_SYM[-1])
 DISPLAY_OK = GENERIC_OK
-OWN_SING = "items 1–2 (exact rank/spans, singular sets)"
-OWN_COND = "item 5 (condition number/isotropy)"
-OWN_VEL = "item 7 (velocity kinematics)"
 
 
 def A(name, value, shapes=(), **kw):
@@ -225,8 +220,8 @@ CASES = [
     Case("unbracket", kinlib.unbracket, [A("X", kinlib.bracket([0.1, 0.2, 0.3, 1, 2, 3]), MAT44, ok=GENERIC_OK)]),
     Case("exp6", kinlib.exp6, [A("S", Z, VEC6), A("theta", 0.7)]),
     Case("exp6 (sym)", kinlib.exp6, [A("S", sp.Matrix(Z), VEC6), A("theta", t1)]),
-    Case("log3", ("kinlib.rigid", "log3"), [A("R", R_ROT, [np.eye(4), np.zeros(3)])], owner=OWN_VEL),
-    Case("log6", ("kinlib.screws", "log6"), [A("T", T_NUM, MAT44)], owner=OWN_VEL),
+    Case("log3", ("kinlib.rigid", "log3"), [A("R", R_ROT, [np.eye(4), np.zeros(3)])]),
+    Case("log6", ("kinlib.screws", "log6"), [A("T", T_NUM, MAT44)]),
     # --- jacobians -------------------------------------------------------------------------------------------
     Case("jacobian_space", kinlib.jacobian_space, [A("Slist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)]),
     Case("jacobian_space (sym)", kinlib.jacobian_space, [A("Slist", S2_SYM, SCREWS), A("thetas", [t1, t2], TH2_SYM)]),
@@ -285,27 +280,24 @@ CASES = [
            ok=DISPLAY_OK)]),
     # --- singularities (owned by items 1–2) ------------------------------------------------------------------
     Case("task_rows", ("kinlib.singularities", "task_rows"), [A("J", J_NUM, [np.zeros((2, 2, 2)), np.zeros(6)], ok=GENERIC_OK),
-          A("rows", ["vx", "vy"], [[], ["vx", "qq"], [7]], whole=[None, "abc", True, 1j, 3.5])],
-         owner=OWN_SING),
+          A("rows", ["vx", "vy"], [[], ["vx", "qq"], [7]], whole=[None, "abc", True, 1j, 3.5])]),
     Case("singular_configurations", ("kinlib.singularities", "singular_configurations"),
          [A("J", J_TRIG, JMAT[:2]), A("thetas", [t1, t2], [[t1], [t1, t2, t3], [t1, t1]], entries=False,
-                                      whole=[None, "ab", 3, [X_PLAIN, t2], [t1, Z_COMPLEX], [1.0, 2.0]])],
-         owner=OWN_SING),
-    Case("rank_at (numeric)", ("kinlib.singularities", "rank_at"), [A("J", J2, JMAT)], owner=OWN_SING),
+                                      whole=[None, "ab", 3, [X_PLAIN, t2], [t1, Z_COMPLEX], [1.0, 2.0]])]),
+    Case("rank_at (numeric)", ("kinlib.singularities", "rank_at"), [A("J", J2, JMAT)]),
     Case("rank_at", ("kinlib.singularities", "rank_at"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5, [1.0]], entries=False)],
-         owner=OWN_SING),
+         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5, [1.0]], entries=False)]),
     Case("rank_at (values)", lambda q: _resolve(("kinlib.singularities", "rank_at"))(J_TRIG, {t1: q[0], t2: q[1]}),
-         [A("subs", [sp.Rational(1, 2), 0], whole=[])], owner=OWN_SING),
+         [A("subs", [sp.Rational(1, 2), 0], whole=[])]),
     Case("column_space", ("kinlib.singularities", "column_space"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)], owner=OWN_SING),
+         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)]),
     Case("left_null_space", ("kinlib.singularities", "left_null_space"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)], owner=OWN_SING),
+         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)]),
     Case("left_null_space (values)",
          lambda q: _resolve(("kinlib.singularities", "left_null_space"))(J_TRIG, {t1: q[0], t2: q[1]}),
-         [A("subs", [3, 0], whole=[])], owner=OWN_SING),
+         [A("subs", [3, 0], whole=[])]),
     Case("evaluate_at", ("kinlib.singularities", "evaluate_at"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)], owner=OWN_SING),
+         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)]),
     # --- manipulability --------------------------------------------------------------------------------------
     Case("manipulability", kinlib.manipulability, [A("J", J2, JMAT, ok=GENERIC_OK)]),
     Case("manipulability (sym)", kinlib.manipulability, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)]),
@@ -314,30 +306,22 @@ CASES = [
     Case("twist_speed_form", kinlib.twist_speed_form, [A("J", J2, JMAT, ok=GENERIC_OK)]),
     Case("twist_speed", ("kinlib.manipulability", "twist_speed"), [A("J", J2, JMAT, ok=GENERIC_OK), A("qdot", [1.0, 2.0], TH2[:2] + TH2[3:], ok=GENERIC_OK)]),
     Case("strongest_joints", ("kinlib.manipulability", "strongest_joints"), [A("row", [1.0, -3.0, 2.0], [[], np.zeros((2, 2, 2))])]),
-    Case("condition_number", kinlib.condition_number, [A("J", J2, JMAT, ok=GENERIC_OK)], owner=OWN_COND),
-    Case("condition_number (sym)", kinlib.condition_number, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)], owner=OWN_COND),
-    Case("isotropy", kinlib.isotropy, [A("J", J2, JMAT, ok=GENERIC_OK)], owner=OWN_COND),
-    Case("isotropy (sym)", kinlib.isotropy, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)], owner=OWN_COND),
+    Case("condition_number", kinlib.condition_number, [A("J", J2, JMAT, ok=GENERIC_OK)]),
+    Case("condition_number (sym)", kinlib.condition_number, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)]),
+    Case("isotropy", kinlib.isotropy, [A("J", J2, JMAT, ok=GENERIC_OK)]),
+    Case("isotropy (sym)", kinlib.isotropy, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)]),
     # --- velocity kinematics (item 7) ------------------------------------------------------------------------
-    Case("pseudoinverse", ("kinlib.velocity", "pseudoinverse"), [A("J", J2, JMAT)], owner=OWN_VEL),
-    Case("pseudoinverse (sym)", ("kinlib.velocity", "pseudoinverse"), [A("J", J2_SYM, JMAT)], owner=OWN_VEL),
-    Case("inverse_velocity", ("kinlib.velocity", "inverse_velocity"), [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:])],
-         owner=OWN_VEL),
+    Case("pseudoinverse", ("kinlib.velocity", "pseudoinverse"), [A("J", J2, JMAT)]),
+    Case("pseudoinverse (sym)", ("kinlib.velocity", "pseudoinverse"), [A("J", J2_SYM, JMAT)]),
+    Case("inverse_velocity", ("kinlib.velocity", "inverse_velocity"), [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:])]),
     Case("damped_least_squares", ("kinlib.velocity", "damped_least_squares"),
-         [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:]), A("damping", 0.1)], owner=OWN_VEL),
-    Case("joint_torques", ("kinlib.velocity", "joint_torques"), [A("J", J2, JMAT), A("F", [1.0, 2.0], TH2[:2] + TH2[3:])],
-         owner=OWN_VEL),
-    Case("force_ellipsoid", ("kinlib.velocity", "force_ellipsoid"), [A("J", J2, JMAT)], owner=OWN_VEL),
+         [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:]), A("damping", 0.1)]),
+    Case("joint_torques", ("kinlib.velocity", "joint_torques"), [A("J", J2, JMAT), A("F", [1.0, 2.0], TH2[:2] + TH2[3:])]),
+    Case("force_ellipsoid", ("kinlib.velocity", "force_ellipsoid"), [A("J", J2, JMAT)]),
 ]
 
 
-def _marks(case):
-    if case.owner:
-        return [pytest.mark.xfail(strict=False, reason=f"owned by {case.owner}, pending")]
-    return []
-
-
-PARAMS = [pytest.param(c, id=c.label, marks=_marks(c)) for c in CASES]
+PARAMS = [pytest.param(c, id=c.label) for c in CASES]
 
 
 @pytest.mark.parametrize("case", [pytest.param(c, id=c.label) for c in CASES])
