@@ -474,6 +474,77 @@ def exact_section(args, targets: Targets) -> list[str]:
     return lines + table(["what", "rank_at", "column_space", "left_null_space", "target", "status"], rows)
 
 
+_SINGULAR7_SCRIPT = r"""
+import json, sys, time, warnings
+import numpy as np, sympy as sp
+from kinlib import SerialChain
+from kinlib.singularities import singular_configurations
+from kinlib.singular_search import find_singularities
+R = sp.Rational
+# a Franka-like 7R arm (Panda's axis layout and DH lengths, in metres, at its zero pose)
+d1, d3, d5, a4, a7 = R(333, 1000), R(316, 1000), R(384, 1000), R(825, 10000), R(88, 1000)
+z3, z5 = d1 + d3, d1 + d3 + d5
+axes = [((0, 0, 1), (0, 0, d1)), ((0, 1, 0), (0, 0, d1)), ((0, 0, 1), (0, 0, z3)), ((0, -1, 0), (a4, 0, z3)),
+        ((0, 0, 1), (0, 0, z5)), ((0, -1, 0), (0, 0, z5)), ((0, 0, -1), (a7, 0, z5))]
+S = [[*sp.Matrix(w), *(-sp.Matrix(w).cross(sp.Matrix(q)))] for w, q in axes]
+arm = SerialChain(sp.Matrix([[1, 0, 0, a7], [0, -1, 0, 0], [0, 0, -1, z5 - R(107, 1000)], [0, 0, 0, 1]]),
+                  sp.Matrix(S).T, name="franka_like")
+J = arm.jacobian_space()
+t = time.thread_time()
+with warnings.catch_warnings():
+    warnings.simplefilter("ignore")
+    res = singular_configurations(J, arm.thetas)
+dt = time.thread_time() - t
+arm.jacobian_geometric(np.zeros(7))          # code generation, not timed below
+t = time.thread_time()
+found = find_singularities(arm)
+ds = time.thread_time() - t
+print(json.dumps({"seconds": dt, "complete": bool(res.complete), "count": len(res),
+                  "ops": [int(sp.count_ops(c)) for c in res if not isinstance(c, dict)],
+                  "search": ds, "points": len(found[0]), "sigma": float(np.max(found[1])) if len(found[1]) else None}))
+"""
+
+
+def analysis_section(args, targets: Targets) -> list[str]:
+    """The 6×7 singular set, the numeric search on the same arm, and a symbolic condition number."""
+    lines = ["## Singular sets of a redundant arm, the numeric search, symbolic conditioning", ""]
+    rows = []
+    try:
+        p = subprocess.run([sys.executable, "-c", _SINGULAR7_SCRIPT], capture_output=True, text=True,
+                           timeout=max(args.singular_timeout, 90), cwd=ROOT)
+        out = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 and p.stdout.strip() else None
+    except subprocess.TimeoutExpired:
+        out, p = None, None
+    if out is None:
+        why = "timed out" if p is None else f"error: {p.stderr.strip()[-200:]}"
+        rows.append(["Franka-like 7R: `singular_configurations` of the 6×7 J_s", why, "≤ 60 s",
+                     targets.upper("6×7 singular set", None, T_SINGULAR_7)])
+        rows.append(["Franka-like 7R: `find_singularities`", why, "—", "—"])
+    else:
+        kind = ("complete" if out["complete"] else "partial (says so)") + f", {out['count']} condition(s)"
+        rows.append([f"Franka-like 7R: `singular_configurations` of the 6×7 J_s ({kind})", fmt_t(out["seconds"]),
+                     "≤ 60 s", targets.upper("6×7 singular set", out["seconds"], T_SINGULAR_7)])
+        rows.append([f"Franka-like 7R: `find_singularities` ({out['points']} configurations, σ_min ≤ "
+                     f"{out['sigma']:.1e})", fmt_t(out["search"]), "—", "reported"])
+    from kinlib.manipulability import condition_number, isotropy
+    L1, L2 = sp.symbols("L1 L2", positive=True)
+    r2 = kinlib.SerialChain(sp.Matrix([[1, 0, 0, L1 + L2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+                            [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0]], name="planar_2r")
+    Jt = kinlib.task_rows(r2.jacobian_geometric(), ["vx", "vy"])
+
+    def cond():
+        sp.core.cache.clear_cache()
+        t0 = CLOCK()
+        k = condition_number(Jt)
+        iso = isotropy(Jt)
+        return CLOCK() - t0, k, iso
+
+    tc, k, _ = min(cond() for _ in range(1 if args.quick else 3))
+    rows.append([f"planar 2R (L1, L2 symbolic): symbolic condition number and isotropy ({sp.count_ops(k)} operations)",
+                 fmt_t(tc), "≤ 2 s", targets.upper("symbolic condition number, planar 2R", tc, T_COND_2R)])
+    return lines + table(["what", "time", "target", "status"], rows) + ["", f"κ(θ) = `{k}`"]
+
+
 def notebook_section(args, targets: Targets) -> list[str]:
     lines = ["## Notebooks (executed with nbclient in a temporary copy, kernel start included)", ""]
     expected = ["01_properties_of_jacobians", "02_planar_robot_jacobian", "03_spatial_robot_jacobian",
@@ -619,8 +690,8 @@ def main(argv=None) -> int:
     targets = Targets()
     head = machine()
     sections = []
-    for fn in (numeric_section, first_call_section, symbolic_section, exact_section, notebook_section, explorer_section,
-               grader_section, import_section):
+    for fn in (numeric_section, first_call_section, symbolic_section, exact_section, analysis_section,
+               notebook_section, explorer_section, grader_section, import_section):
         t0 = time.perf_counter()
         sections.append(fn(args, targets))
         print(f"[bench] {fn.__name__}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)

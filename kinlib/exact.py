@@ -248,7 +248,9 @@ def _fold(e: sp.Expr) -> sp.Expr:
             return simplify_for_display(e)
         except Exception:  # pragma: no cover - display only
             return sp.factor_terms(TR10i(sp.expand(e)))
-    return sp.factor_terms(sp.radsimp(sp.expand(e))) if not e.is_Rational else e
+    if e.is_Rational:
+        return e
+    return sp.expand(sp.radsimp(e)) if e.is_number else sp.factor_terms(sp.radsimp(sp.expand(e)))
 
 
 def _ratio(num: sp.Expr, den: sp.Expr) -> sp.Expr:

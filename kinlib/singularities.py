@@ -29,6 +29,7 @@ from __future__ import annotations
 import itertools
 import numbers
 import time
+import warnings
 from typing import Any, Sequence
 
 import numpy as np
@@ -40,7 +41,7 @@ from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
 from .trigsign import generator_kinds, proves_nonzero
 
 __all__ = [
-    "ROW_NAMES", "task_rows", "singular_configurations", "SingularSet", "representatives", "rank_at", "column_space",
+    "ROW_NAMES", "task_rows", "singular_configurations", "SingularSet", "IncompleteResultWarning", "representatives", "rank_at", "column_space",
     "left_null_space", "evaluate_at", "trig_simplify", "periodic_family", "K",
 ]
 
@@ -269,7 +270,9 @@ class SingularSet(list):
     * ``note`` (str): how the answer was obtained, and for an incomplete one what is missing and the
       numeric alternative (:func:`kinlib.singular_search.find_singularities`).
 
-    It is a plain list otherwise: ``conds == []``, ``conds[0]``, ``len(conds)`` work as before.
+    It is a plain list otherwise: ``conds == []``, ``conds[0]``, ``len(conds)`` work as before, and it prints
+    as a list (so SymPy's notebook printing typesets it); an incomplete answer is announced by an
+    :class:`IncompleteResultWarning` carrying the note when it is made.
     """
 
     def __init__(self, conditions=(), complete: bool = True, note: str = ""):
@@ -277,9 +280,9 @@ class SingularSet(list):
         self.complete = bool(complete)
         self.note = note
 
-    def __repr__(self) -> str:
-        body = super().__repr__()
-        return body if self.complete else f"SingularSet({body}, complete=False, note={self.note!r})"
+
+class IncompleteResultWarning(UserWarning):
+    """A closed-form answer was out of reach: the result is partial (its ``note`` says what is missing)."""
 
 
 class _OutOfTime(Exception):
@@ -549,10 +552,11 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
         return (1 if c.free_symbols & joint_set else 2, 0, str(c))
 
     def out_of_reach(stage: str):
-        return SingularSet(sorted(conditions, key=key), complete=False, note=(
-            f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
-            "(maybe none) are singular, others may be missing. For a numeric search use "
-            "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths."))
+        note = (f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
+                "(maybe none) are singular, others may be missing. For a numeric search use "
+                "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths.")
+        warnings.warn(f"singular_configurations: {note}", IncompleteResultWarning, stacklevel=3)
+        return SingularSet(sorted(conditions, key=key), complete=False, note=note)
 
     k = min(J.shape)
     what = "det J" if J.rows == J.cols else f"the {k}×{k} minors of J"

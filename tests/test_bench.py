@@ -19,7 +19,9 @@ def test_bench_quick_writes_table(tmp_path):
     assert text == p.stdout.rstrip("\n") or text in p.stdout
     for needle in ["# kinlib benchmark", "| CPU |", "| Python |", "| numpy |", "| sympy |", "| date |",
                    "## Targets", "## Numeric kinematics", "| robot | quantity | call | kinlib (best) | modern-robotics",
-                   "## Symbolic", "UR5 J_s built", "## Notebooks", "## Explorers", "## Instructor checker",
+                   "## Symbolic", "UR5 J_s built", "## First numeric call of a 7-joint chain",
+                   "## Exact analysis at a configuration", "## Singular sets of a redundant arm",
+                   "symbolic condition number and isotropy", "## Notebooks", "## Explorers", "## Instructor checker",
                    "import kinlib"]:
         assert needle in text, needle
     # every robot and quantity has a single and a batched row, each with a figure for kinlib

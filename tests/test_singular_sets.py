@@ -18,7 +18,7 @@ from hypothesis import strategies as st
 
 from kinlib import SerialChain, robots
 from kinlib.singular_search import SingularPoints, find_singularities
-from kinlib.singularities import SingularSet, representatives, singular_configurations, task_rows
+from kinlib.singularities import IncompleteResultWarning, SingularSet, representatives, singular_configurations, task_rows
 from kinlib.trigpoly import TrigRing
 from kinlib.trigsign import proves_nonzero
 
@@ -251,10 +251,10 @@ def test_prismatic_sum_of_squares_dropped():
 
 def test_time_budget_gives_a_clear_partial_result():
     r = robots.ur5()
-    conds = singular_configurations(r.jacobian_space(), r.thetas, time_budget=0)
+    with pytest.warns(IncompleteResultWarning, match="find_singularities"):
+        conds = singular_configurations(r.jacobian_space(), r.thetas, time_budget=0)
     assert isinstance(conds, SingularSet) and not conds.complete
     assert "find_singularities" in conds.note and "time_budget" in conds.note
-    assert "complete=False" in repr(conds)
     with pytest.raises(ValueError, match="time_budget"):
         singular_configurations(r.jacobian_space(), r.thetas, time_budget=-1)
 
