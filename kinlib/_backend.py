@@ -16,7 +16,7 @@ import numpy as np
 import sympy as sp
 
 __all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe", "exact_number",
-           "check_real_finite", "exact_floats"]
+           "check_real_finite", "real_array", "exact_floats"]
 
 _ZERO_TOL = 1e-9
 
@@ -293,3 +293,39 @@ def is_zero(e: Any) -> bool:
             pass
     return sp.simplify(e) == 0
 
+
+def real_array(x, name: str, want: str) -> np.ndarray:
+    """``x`` as a float array after refusing str/bytes/None/bool/complex entries and NaN/±inf.
+
+    ``want`` describes the expected value for the error message (e.g. "a 3×3 rotation matrix").
+    Shapes are checked by the caller.
+    """
+    if isinstance(x, (str, bytes)) or x is None or isinstance(x, (bool, np.bool_, numbers.Number)):
+        raise TypeError(f"{name} must be {want}, got {describe(x)}")
+    if isinstance(x, (list, tuple)):     # NumPy would turn [True, 2.0] into [1.0, 2.0]: look at the entries first
+        stack = [x]
+        while stack:
+            for e in stack.pop():
+                if isinstance(e, (list, tuple, np.ndarray)):
+                    stack.append(e)
+                elif isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or e is None \
+                        or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                    raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)} in {describe(x)}")
+    try:
+        a = np.asarray(x)
+    except Exception:
+        raise TypeError(f"{name} must be {want}, got {describe(x)}") from None
+    if a.dtype.kind == "b":
+        raise TypeError(f"{name} must hold real numbers, got booleans ({describe(x)})")
+    if a.dtype.kind == "c":
+        raise TypeError(f"{name} must hold real numbers, got complex numbers ({describe(x)})")
+    if a.dtype.kind not in "iuf":
+        for e in a.reshape(-1):
+            if isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None \
+                    or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)}")
+        a = a.astype(float)
+    a = a.astype(float, copy=False)
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name} must hold finite real numbers, got NaN or ±inf in {describe(x)}")
+    return a

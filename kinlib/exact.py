@@ -39,7 +39,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 from sympy.simplify.fu import TR10i
 
-from ._backend import describe, exact_number, is_symbolic
+from ._backend import describe, exact_number, is_symbolic, real_array
 from .display import simplify_for_display
 from .exactfield import (
     FALLBACK_DIGITS, MAX_MULTIPLE, ExactField, NotExact, decide_zero, exact_is_zero, mp_matrix,
@@ -491,30 +491,11 @@ def _fallback_warning(what: str, why: str):
 # ----------------------------------------------------------------------------------------------
 def _numeric_J(J: Any, name: str = "J") -> np.ndarray:
     """A numeric Jacobian as a finite float array (m, n); bools, strings, complex numbers, NaN/inf refused."""
-    if isinstance(J, (str, bytes)) or J is None or isinstance(J, (numbers.Number, np.generic)):
-        raise TypeError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
-    if isinstance(J, np.ndarray) and J.dtype.kind in "iuf":
-        A = J
-    else:
-        try:
-            obj = np.asarray(J, dtype=object)
-        except Exception:
-            raise TypeError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}") from None
-        for e in obj.flat:
-            if isinstance(e, (bool, np.bool_)):
-                raise TypeError(f"{name} must hold numbers, got the bool {e!r} ({describe(J)})")
-            if isinstance(e, (complex, np.complexfloating)):
-                raise TypeError(f"{name} must hold real numbers, got the complex number {e!r} ({describe(J)})")
-            if not isinstance(e, (numbers.Real, np.integer, np.floating)):
-                raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)}")
-        A = obj
+    A = real_array(J, name, "a matrix (m×n Jacobian)")
     if A.ndim != 2:
         raise ValueError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
-    A = np.asarray(A, dtype=float)
     if 0 in A.shape:
         raise ValueError(f"{name} must have at least one row and one column, got {describe(J)}")
-    if not np.isfinite(A).all():
-        raise ValueError(f"{name} must hold finite numbers, got NaN or inf in {describe(J)}")
     return A
 
 

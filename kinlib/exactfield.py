@@ -319,19 +319,57 @@ def exact_is_zero(e: Any) -> bool:
 
 
 
-def decide_zero(e: sp.Expr) -> bool:
-    """e = 0? A 60-digit value above 1e-30 proves nonzero (SymPy's evalf tracks cancellation); otherwise exactly."""
+def decide_zero(e: Any, what: str = "an entry") -> bool:
+    """Decide e = 0 with a proof, never a guess: the one zero test of kinlib's exact numbers.
+
+    e is a number or an expression in positive parameters (link lengths).
+
+    * nonzero: a value above 10⁻³⁰ at ``FALLBACK_DIGITS + 40`` digits (:func:`mp_value`; with parameters this
+      step is skipped);
+    * either way: exact arithmetic in K(tan(g/2), params) (:class:`ExactField`) for sines and cosines of
+      angles r + qπ (r, q rational), algebraic numbers and parameters;
+    * zero, for other constants: the sin² + cos² = 1 normal form (:func:`kinlib.display.is_identically_zero`),
+      the minimal polynomial x of an algebraic number, or ``sp.simplify(e) == 0``.
+
+    Anything else raises ``ValueError`` (an honest "cannot decide"), never a silent answer.
+
+    >>> decide_zero(sp.sin(3)**2 + sp.cos(3)**2 - 1), decide_zero(sp.sqrt(2)/2 - sp.Rational(7, 10))
+    (True, False)
+    """
+    e = sp.sympify(e)
     if e == 0:
         return True
     if e.is_Rational:
         return False
     if not e.free_symbols:
         import mpmath
-        with mpmath.workdps(FALLBACK_DIGITS + 40):
-            if abs(mp_value(e, {})) > mpmath.mpf(10) ** -30:
-                return False
-    return not ExactField([e]).convert(e)
-
+        try:
+            with mpmath.workdps(FALLBACK_DIGITS + 40):
+                if abs(mp_value(e, {})) > mpmath.mpf(10) ** -30:
+                    return False
+        except (TypeError, ValueError):  # e.g. a complex intermediate: the exact routes below decide
+            pass
+    try:
+        return not ExactField([e]).convert(e)
+    except NotExact:
+        pass
+    from .display import is_identically_zero  # local import: display does not import this module
+    try:
+        if is_identically_zero(e):
+            return True
+    except Exception:  # pragma: no cover - a route that fails is just not a proof
+        pass
+    if not e.free_symbols:
+        x = sp.Dummy("x")
+        try:
+            if sp.minimal_polynomial(e, x) == x:
+                return True
+        except Exception:  # not algebraic (sin 3 ...), or too hard
+            pass
+    if sp.simplify(e) == 0:
+        return True
+    raise ValueError(f"could not decide exactly whether {what} = {e} is zero (its value is below 1e-30 at "
+                     f"{FALLBACK_DIGITS + 40} digits and no exact identity was found); evaluate numerically instead")
 
 
 def mp_value(e: sp.Expr, memo: dict):

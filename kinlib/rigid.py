@@ -13,7 +13,10 @@ import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from ._backend import as_matrix, as_vector, check_real_finite, describe, exact_floats, exact_number, is_symbolic, is_zero
+from ._backend import (
+    as_matrix, as_vector, check_real_finite, describe, exact_floats, exact_number, is_symbolic, is_zero, real_array,
+)
+from .exactfield import decide_zero
 
 __all__ = [
     "skew", "unskew", "exp3", "rp_to_trans", "trans_to_rp", "trans_inv", "adjoint",
@@ -202,95 +205,6 @@ def adjoint(T):
 # The matrix logarithm of SO(3) (issue 11, item 7), and two helpers it shares with
 # kinlib.screws.log6 and kinlib.velocity (public names so those modules may import them).
 # ----------------------------------------------------------------------------------------------
-def real_array(x, name: str, want: str) -> np.ndarray:
-    """``x`` as a float array after refusing str/bytes/None/bool/complex entries and NaN/±inf.
-
-    ``want`` describes the expected value for the error message (e.g. "a 3×3 rotation matrix").
-    Shapes are checked by the caller.
-    """
-    import numbers
-    if isinstance(x, (str, bytes)) or x is None or isinstance(x, (bool, np.bool_, numbers.Number)):
-        raise TypeError(f"{name} must be {want}, got {describe(x)}")
-    if isinstance(x, (list, tuple)):     # NumPy would turn [True, 2.0] into [1.0, 2.0]: look at the entries first
-        stack = [x]
-        while stack:
-            for e in stack.pop():
-                if isinstance(e, (list, tuple, np.ndarray)):
-                    stack.append(e)
-                elif isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or e is None \
-                        or not isinstance(e, (numbers.Real, np.integer, np.floating)):
-                    raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)} in {describe(x)}")
-    try:
-        a = np.asarray(x)
-    except Exception:
-        raise TypeError(f"{name} must be {want}, got {describe(x)}") from None
-    if a.dtype.kind == "b":
-        raise TypeError(f"{name} must hold real numbers, got booleans ({describe(x)})")
-    if a.dtype.kind == "c":
-        raise TypeError(f"{name} must hold real numbers, got complex numbers ({describe(x)})")
-    if a.dtype.kind not in "iuf":
-        for e in a.reshape(-1):
-            if isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None \
-                    or not isinstance(e, (numbers.Real, np.integer, np.floating)):
-                raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)}")
-        a = a.astype(float)
-    a = a.astype(float, copy=False)
-    if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name} must hold finite real numbers, got NaN or ±inf in {describe(x)}")
-    return a
-
-
-def proved_zero(e, what: str = "an entry") -> bool:
-    """Decide e = 0 for a constant SymPy expression (no free symbols) with a proof, never a guess.
-
-    * nonzero: SymPy's ``evalf(30, strict=True)`` returns a value with 30 correct digits (its error
-      tracking raises ``PrecisionExhausted`` rather than return a digit it cannot guarantee) that is not 0;
-    * either way: exact arithmetic in K(tan(g/2)) (:func:`kinlib.exactfield.exact_is_zero`) for sines and
-      cosines of angles r + qπ (r, q rational) and algebraic numbers;
-    * zero: a normal form (:func:`kinlib.is_identically_zero`, the sin² + cos² = 1 reduction), the
-      minimal polynomial x of an algebraic number, or ``sp.simplify(e) == 0``.
-
-    Anything else raises ``ValueError`` (an honest "cannot decide"), never a silent answer.
-
-    >>> proved_zero(sp.sin(3)**2 + sp.cos(3)**2 - 1), proved_zero(sp.sqrt(2)/2 - sp.Rational(7, 10))
-    (True, False)
-    """
-    e = sp.sympify(e)
-    if e == 0:
-        return True
-    if e.free_symbols:
-        raise ValueError(f"proved_zero decides constants only, got {what} = {e} with symbols")
-    try:
-        v = e.evalf(30, strict=True)
-        if v.is_Number and v != 0:
-            return False
-        if v.is_number and (sp.re(v) != 0 or sp.im(v) != 0) and v.is_comparable is not False:
-            return False
-    except (sp.core.evalf.PrecisionExhausted, TypeError, ValueError):
-        pass
-    try:  # sin/cos of rational angles (+ rational multiples of π), algebraic numbers: exact field arithmetic
-        from .exactfield import exact_is_zero
-        return bool(exact_is_zero(e))
-    except (ImportError, ValueError):
-        pass
-    from .display import is_identically_zero  # local import: display imports nothing from here
-    try:
-        if is_identically_zero(e):
-            return True
-    except Exception:  # pragma: no cover - a route that fails is just not a proof
-        pass
-    x = sp.Dummy("x")
-    try:
-        if sp.minimal_polynomial(e, x) == x:
-            return True
-    except Exception:  # not algebraic (sin 3 ...), or too hard
-        pass
-    if sp.simplify(e) == 0:
-        return True
-    raise ValueError(f"could not decide exactly whether {what} = {e} is zero (30 digits cannot tell it "
-                     f"from 0 and no exact identity was found); evaluate numerically (NumPy input) instead")
-
-
 def _log3_numeric(A: np.ndarray):
     """(vector ω̂θ, axis ω̂, angle θ) for a batch (N, 3, 3) of rotation matrices."""
     ax = 0.5 * np.stack([A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0], A[:, 1, 0] - A[:, 0, 1]], axis=-1)
@@ -328,22 +242,22 @@ def _log3_exact(R: sp.Matrix):
         D = R.T * R - sp.eye(3)
         for i in range(3):
             for j in range(i, 3):
-                if not proved_zero(D[i, j], f"(RᵀR − I)[{i}, {j}]"):
+                if not decide_zero(D[i, j], f"(RᵀR − I)[{i}, {j}]"):
                     raise ValueError(f"R must be exactly a rotation matrix (RᵀR = I) for an exact logarithm, got "
                                      f"{R.tolist()} with (RᵀR − I)[{i}, {j}] = {D[i, j]} ≠ 0; "
                                      f"give exact entries (sp.sqrt(2)/2, not 0.7071) or a NumPy array for a numeric log")
-        if not proved_zero(R.det() - 1, "det R − 1"):
+        if not decide_zero(R.det() - 1, "det R − 1"):
             raise ValueError(f"R must be a rotation matrix with det R = 1, got det R = {sp.simplify(R.det())}")
         simp = sp.radsimp
         c = simp(sp.expand((R.trace() - 1) / 2))
-        if proved_zero(c - 1, "cos θ − 1"):
+        if decide_zero(c - 1, "cos θ − 1"):
             return sp.Matrix([0, 0, 1]), sp.S.Zero, True
-        if proved_zero(c + 1, "cos θ + 1"):
+        if decide_zero(c + 1, "cos θ + 1"):
             # θ = π, Modern Robotics' three branches: ω̂ = (r_k + e_k)/√(2(1 + r_kk)) for the first k = 3, 2, 1
             # with 1 + r_kk ≠ 0 (r_k the k-th column of R)
             for k in (2, 1, 0):
                 d = 1 + R[k, k]
-                if not proved_zero(d, f"1 + r{k + 1}{k + 1}"):
+                if not decide_zero(d, f"1 + r{k + 1}{k + 1}"):
                     w = (R[:, k] + sp.eye(3)[:, k]) / sp.sqrt(2 * d)
                     return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), sp.pi, False
             raise AssertionError("unreachable: a rotation by π has some 1 + r_kk = 2ω̂_k² ≠ 0")  # pragma: no cover
@@ -364,7 +278,7 @@ def _acos_exact(c: sp.Expr) -> sp.Expr:
     """acos c for a constant c, as a rational multiple of π when it is one (π/12 for (√2 + √6)/4).
 
     The candidate p/q (q ≤ 360, from the continued fraction of acos(c)/π at 40 digits) is accepted only after
-    cos(pπ/q) − c = 0 is *proved* (:func:`proved_zero`); otherwise acos(c) stays as it is. Exact either way.
+    cos(pπ/q) − c = 0 is *proved* (:func:`decide_zero`); otherwise acos(c) stays as it is. Exact either way.
     """
     import fractions
     theta = sp.acos(c)
@@ -373,7 +287,7 @@ def _acos_exact(c: sp.Expr) -> sp.Expr:
     try:
         x = fractions.Fraction(str(sp.N(theta / sp.pi, 40))).limit_denominator(360)
         cand = sp.Rational(x.numerator, x.denominator)
-        if 0 < cand < 1 and proved_zero(sp.cos(cand * sp.pi) - c, "cos θ − c"):
+        if 0 < cand < 1 and decide_zero(sp.cos(cand * sp.pi) - c, "cos θ − c"):
             return cand * sp.pi
     except (ValueError, TypeError):
         pass

@@ -129,13 +129,14 @@ _LOG6_FORMS = ("matrix", "vector", "screw_angle")
 def _log6_exact(T: sp.Matrix):
     """(ω̂, θ_rot, vθ, p) for an exact SymPy transform; θ_rot = 0 exactly when R = I."""
     from ._backend import check_real_finite, exact_number
-    from .rigid import check_se3, log3, proved_zero
+    from .exactfield import decide_zero
+    from .rigid import check_se3, log3
     for e in T:
         check_real_finite(e, "T")
     if not T.free_symbols:
         T = T.applyfunc(lambda e: exact_number(e, "T"))
         for j, want in enumerate((0, 0, 0, 1)):
-            if not proved_zero(T[3, j] - want, f"T[3, {j}] − {want}"):
+            if not decide_zero(T[3, j] - want, f"T[3, {j}] − {want}"):
                 raise ValueError(f"T must be a homogeneous transform with last row [0, 0, 0, 1], got last row "
                                  f"{list(T[3, :])}")
     else:
@@ -157,11 +158,11 @@ def _log6_exact(T: sp.Matrix):
 
 def _pure_translation_zero(p) -> bool:
     from .display import is_identically_zero
-    from .rigid import proved_zero
+    from .exactfield import decide_zero
     if isinstance(p, sp.MatrixBase):
         if p.free_symbols:
             return is_identically_zero(p)
-        return all(proved_zero(e, "p") for e in p)
+        return all(decide_zero(e, "p") for e in p)
     return not np.any(p)
 
 
@@ -195,7 +196,8 @@ def log6(T, form: str = "matrix"):
     5
     """
     from ._backend import describe
-    from .rigid import log3, real_array
+    from ._backend import real_array
+    from .rigid import log3
     if not isinstance(form, str) or form not in _LOG6_FORMS:
         raise ValueError(f"form must be one of {', '.join(map(repr, _LOG6_FORMS))}, got {describe(form)}")
     if is_symbolic(T):

@@ -28,9 +28,9 @@ from typing import Any, NamedTuple
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_vector, check_real_finite, describe, exact_number, is_symbolic
+from ._backend import as_matrix, as_vector, check_real_finite, describe, exact_number, is_symbolic, real_array
+from .exactfield import decide_zero
 from .manipulability import velocity_ellipsoid
-from .rigid import proved_zero, real_array
 from .singularities import task_rows
 
 __all__ = ["pseudoinverse", "inverse_velocity", "damped_least_squares", "joint_torques", "force_ellipsoid",
@@ -145,7 +145,7 @@ def _exact_pinv(M: sp.Matrix, name: str = "J"):
     Entries built from sin/cos of angles r + qπ (r, q rational) and algebraic numbers are computed in the field
     K(t), t = tan(g/2) (:class:`kinlib.exactfield.ExactField`: t is transcendental, so field arithmetic decides
     every pivot exactly) and written back with t = tan(g/2); other constants by SymPy elimination with
-    :func:`kinlib.rigid.proved_zero` pivot tests (slow beyond small matrices).
+    :func:`kinlib.exactfield.decide_zero` pivot tests (slow beyond small matrices).
     """
     if M.free_symbols:
         syms = ", ".join(sorted(map(str, M.free_symbols)))
@@ -170,7 +170,7 @@ def _exact_pinv(M: sp.Matrix, name: str = "J"):
                 P, r = _field_pinv(A, m, n)
             back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
             return P.to_Matrix().xreplace(back), r
-    iz = lambda e: proved_zero(e, f"an entry in the elimination of {name}")
+    iz = lambda e: decide_zero(e, f"an entry in the elimination of {name}")
     if all(iz(e) for e in M):
         return sp.zeros(n, m), 0
     B, C = M.rank_decomposition(iszerofunc=iz)     # M = B C, B: m×r pivot columns, C: r×n (rref rows)
@@ -358,7 +358,7 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
         fast = _field_dls(M, lam, v) if const else None
         if fast is not None:
             return fast if not v.free_symbols else (fast * v).applyfunc(sp.radsimp)
-        kw = {"iszerofunc": lambda e: proved_zero(e, "a pivot")} if const else {}
+        kw = {"iszerofunc": lambda e: decide_zero(e, "a pivot")} if const else {}
         if m <= n:
             out = M.T * (M * M.T + lam ** 2 * sp.eye(m)).LUsolve(v, **kw)
         else:
@@ -454,7 +454,7 @@ def force_ellipsoid(J: Any, rows: Any = None):
         lengths, U = velocity_ellipsoid(J, rows)
         out = []
         for s in lengths:
-            zero = proved_zero(s, "a singular value") if not s.free_symbols else sp.simplify(s) == 0
+            zero = decide_zero(s, "a singular value") if not s.free_symbols else sp.simplify(s) == 0
             out.append(sp.oo if zero else sp.radsimp(1 / s))
         return out, U
     A = _numeric_J(J)
