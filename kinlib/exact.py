@@ -37,12 +37,11 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 import sympy as sp
 from sympy.polys.matrices import DomainMatrix
-from sympy.simplify.fu import TR10i
 
 from ._backend import describe, exact_number, is_symbolic, real_array
-from .display import simplify_for_display
 from .exactfield import (
-    FALLBACK_DIGITS, MAX_MULTIPLE, ExactField, NotExact, decide_zero, exact_is_zero, mp_matrix,
+    FALLBACK_DIGITS, MAX_MULTIPLE, ExactField, NotExact, decide_zero, exact_is_zero, mp_matrix, readable,
+    readable_fold, readable_ratio,
 )
 from .trigpoly import NotTrigPolynomial, TrigRing
 
@@ -229,47 +228,6 @@ def _ring_det(A: sp.Matrix) -> sp.Expr:
         return sp.expand(A.det(method="bareiss"))
 
 
-def _display(e: sp.Expr) -> sp.Expr:
-    """An exactly equal, readable form of an exact number (or expression in parameters)."""
-    if e == 0 or e.is_Rational:
-        return e
-    num, den = sp.fraction(sp.cancel(sp.together(e))) if not e.has(sp.sin, sp.cos) else sp.fraction(sp.together(e))
-    num, den = _fold(num), _fold(den)
-    if den == 1:
-        return num
-    if den.could_extract_minus_sign():
-        num, den = -num, -den
-    return num / den
-
-
-def _fold(e: sp.Expr) -> sp.Expr:
-    if e.has(sp.sin, sp.cos):
-        try:
-            return simplify_for_display(e)
-        except Exception:  # pragma: no cover - display only
-            return sp.factor_terms(TR10i(sp.expand(e)))
-    if e.is_Rational:
-        return e
-    return sp.expand(sp.radsimp(e)) if e.is_number else sp.factor_terms(sp.radsimp(sp.expand(e)))
-
-
-def _ratio(num: sp.Expr, den: sp.Expr) -> sp.Expr:
-    """num/den for display, with common polynomial factors (in the sines and cosines) cancelled."""
-    if num == 0:
-        return sp.S.Zero
-    try:
-        ring = TrigRing([num, den], opaque=True)
-        if ring.domain.is_EX:
-            raise NotTrigPolynomial(num)
-        pn, pd = ring.normal_form(num), ring.normal_form(den)
-        g = pn.gcd(pd)
-        pn, pd = pn.exquo(g), pd.exquo(g)
-        num, den = ring.to_expr(pn, collect=True), ring.to_expr(pd, collect=True)
-    except (NotTrigPolynomial, Exception):
-        pass
-    return _display(num / den) if den != 1 else _display(num)
-
-
 def _numeric_pivots(X, top) -> tuple:
     """(pivot columns, certain?) of the mpmath matrix X by greedy certified rank tests at 60 digits.
 
@@ -367,7 +325,7 @@ def _canonical_rows(A: sp.Matrix, an: _Analysis) -> sp.Matrix:
                 return minor["d"]
             if an.entry_is_zero(k, j, numerator):
                 continue
-            out[k, j] = _ratio(minor["d"] if "d" in minor else _ring_det(Bk), D)
+            out[k, j] = readable_ratio(minor["d"] if "d" in minor else _ring_det(Bk), D)
     return out
 
 
@@ -434,7 +392,7 @@ def _conditions(A: sp.Matrix, an: _Analysis) -> tuple:
         if pivot_factors is None:
             pivot_factors = facs
         common = facs if common is None else [f for f in common if f in facs]
-    return tuple(_fold(f) for f in (common or pivot_factors or ()))
+    return tuple(readable_fold(f) for f in (common or pivot_factors or ()))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -535,7 +493,7 @@ def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = N
         zero = [decide_zero(e) for e in M]
     except NotExact:
         zero = [e == 0 for e in M]
-    return sp.Matrix(M.rows, M.cols, [sp.S.Zero if z else _display(e) for e, z in zip(M, zero)])
+    return sp.Matrix(M.rows, M.cols, [sp.S.Zero if z else readable(e) for e, z in zip(M, zero)])
 
 
 def _analyse(M: sp.Matrix, what: str):

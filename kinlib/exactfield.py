@@ -27,8 +27,12 @@ import sympy as sp
 from sympy.polys.constructor import construct_domain
 from sympy.polys.fields import field as _field
 from sympy.polys.matrices import DomainMatrix
+from sympy.simplify.fu import TR10i
 
-__all__ = ["ExactField", "NotExact", "exact_is_zero", "decide_zero", "mp_value", "mp_matrix",
+from .trigpoly import NotTrigPolynomial, TrigRing
+
+__all__ = ["ExactField", "NotExact", "exact_is_zero", "decide_zero", "mp_value", "mp_matrix", "readable",
+           "readable_fold", "readable_ratio",
            "MAX_MULTIPLE", "FALLBACK_DIGITS"]
 
 #: the largest |n| with every angle's rational part n·g, above which the exact method is not used
@@ -194,6 +198,17 @@ class ExactField:
 
     def _kconst(self, c):
         return self.ring(self.K.convert(c) if c.is_Rational else self.K.from_sympy(c))
+
+    def to_expr(self, x) -> sp.Expr:
+        """A field element back as a readable SymPy number: t = tan(g/2) written as sin g/(1 + cos g), then
+        one fraction in sin g, cos g with common factors cancelled (an identity, never a guess)."""
+        gens = [self.t] + list(self.extra) + list(self.params)
+        num, den = x.numer.as_expr(*gens), x.denom.as_expr(*gens)
+        if self.g != 0:
+            s, c = sp.sin(self.g), sp.cos(self.g)
+            num, den = sp.fraction(sp.together(sp.expand(num).subs(self.t, s / (1 + c))
+                                               / sp.expand(den).subs(self.t, s / (1 + c))))
+        return readable_ratio(sp.expand(num), sp.expand(den))
 
     def __repr__(self) -> str:
         return f"ExactField(t = tan({self.g}/2), K = {self.K}, parameters {list(self.params)})"
@@ -409,3 +424,49 @@ def mp_matrix(A: sp.Matrix):
     memo: dict = {}
     with mpmath.workdps(FALLBACK_DIGITS + 40):
         return mpmath.matrix([[mp_value(A[i, j], memo) for j in range(A.cols)] for i in range(A.rows)])
+
+
+# ----------------------------------------------------------------------------------------------
+# readable forms of exact numbers (identities only: never a guess)
+# ----------------------------------------------------------------------------------------------
+def readable(e: sp.Expr) -> sp.Expr:
+    """An exactly equal, readable form of an exact number (or expression in parameters)."""
+    if e == 0 or e.is_Rational:
+        return e
+    num, den = sp.fraction(sp.cancel(sp.together(e))) if not e.has(sp.sin, sp.cos) else sp.fraction(sp.together(e))
+    num, den = readable_fold(num), readable_fold(den)
+    if den == 1:
+        return num
+    if den.could_extract_minus_sign():
+        num, den = -num, -den
+    return num / den
+
+
+def readable_fold(e: sp.Expr) -> sp.Expr:
+    """e (a polynomial in sines, cosines, constants and parameters) reduced by sin² + cos² = 1 and folded."""
+    from .display import simplify_for_display  # local import: display imports nothing from here
+    if e.has(sp.sin, sp.cos):
+        try:
+            return simplify_for_display(e)
+        except Exception:  # pragma: no cover - display only
+            return sp.factor_terms(TR10i(sp.expand(e)))
+    if e.is_Rational:
+        return e
+    return sp.expand(sp.radsimp(e)) if e.is_number else sp.factor_terms(sp.radsimp(sp.expand(e)))
+
+
+def readable_ratio(num: sp.Expr, den: sp.Expr) -> sp.Expr:
+    """num/den for display, with common polynomial factors (in the sines and cosines) cancelled."""
+    if num == 0:
+        return sp.S.Zero
+    try:
+        ring = TrigRing([num, den], opaque=True)
+        if ring.domain.is_EX:
+            raise NotTrigPolynomial(num)
+        pn, pd = ring.normal_form(num), ring.normal_form(den)
+        g = pn.gcd(pd)
+        pn, pd = pn.exquo(g), pd.exquo(g)
+        num, den = ring.to_expr(pn, collect=True), ring.to_expr(pd, collect=True)
+    except (NotTrigPolynomial, Exception):
+        pass
+    return readable(num / den) if den != 1 else readable(num)

@@ -168,8 +168,7 @@ def _exact_pinv(M: sp.Matrix, name: str = "J"):
                 P, r = _pinv_formula(A, A.rank(), m, n, lambda X: X.inv())
             else:                # algebraic coefficients (√2 ...): fraction-free, far faster there
                 P, r = _field_pinv(A, m, n)
-            back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
-            return P.to_Matrix().xreplace(back), r
+            return _back(fld, P), r
     iz = lambda e: decide_zero(e, f"an entry in the elimination of {name}")
     if all(iz(e) for e in M):
         return sp.zeros(n, m), 0
@@ -259,8 +258,8 @@ def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
     by 1/σ_min); ``full_output=True`` returns (J⁺, PinvReport(rank, singular values, tol)) as well.
     SymPy J: exact, for a constant (evaluated) J only; the rank is decided with proved zero tests; the report
     holds the exact rank. Entries in sin/cos of rational angles (joint values 1, 1/2, ...) are computed in the
-    exact field K(t), t = tan(g/2) (g the angles' common measure, :mod:`kinlib.exactfield`), and come back as
-    rational functions of tan(g/2) (e.g. −2 sin 10/5 as −4 tan 5/(5 + 5 tan² 5)); a UR5 at integer angles
+    exact field K(t), t = tan(g/2) (g the angles' common measure, :mod:`kinlib.exactfield`), and come back
+    written with sin g and cos g (e.g. −2 sin 10/5); a UR5 at integer angles
     takes ≲ 10 s. (SymPy's own ``Matrix.pinv`` is not used: its zero tests can silently fail on such entries.)
 
     >>> import sympy as sp
@@ -392,16 +391,22 @@ def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
     K = A.domain
     At = A.transpose()
     G = A * At + A.eye(m, K).mul(l2) if m <= n else At * A + A.eye(n, K).mul(l2)
-    back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
     if const_v:
         x = At * G.lu_solve(b) if m <= n else G.lu_solve(At * b)
-        return x.to_Matrix().xreplace(back)
+        return _back(fld, x)
     d, N = G.clear_denoms(convert=True)          # fraction-free: G⁻¹ = d · adj(N)/det(N)
     adj, det = N.inv_den()
     Gi = adj.convert_to(K).mul(K.convert_from(getattr(d, "element", d), N.domain) / K.convert_from(det, N.domain))
     X = At * Gi if m <= n else Gi * At
-    back = {fld.t: sp.tan(fld.g / 2)} if fld.g != 0 else {}
-    return X.to_Matrix().xreplace(back)
+    return _back(fld, X)
+
+
+def _back(fld, X) -> sp.Matrix:
+    """A matrix over the exact field written back readably in the configuration's sines and cosines."""
+    rows, cols = X.shape
+    L = X.to_list()
+    return sp.Matrix(rows, cols, [fld.to_expr(fld.F(L[i][j])) if L[i][j] else sp.S.Zero
+                                  for i in range(rows) for j in range(cols)])
 
 
 # ----------------------------------------------------------------------------------------------

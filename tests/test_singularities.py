@@ -237,11 +237,11 @@ def test_bad_input_singular_configurations():
     assert singular_configurations(J.subs(sp.Symbol("L", positive=True), x), r.thetas, params=[x]) == \
         singular_configurations(J, r.thetas) + [x]
     with pytest.raises(ValueError, match="identically zero"):
-        singular_configurations(sp.Matrix([[sp.sin(x), sp.sin(x)], [sp.cos(x), sp.cos(x)]]), [x, sp.Symbol("y")])
+        singular_configurations(sp.Matrix([[sp.sin(x), sp.sin(x)], [sp.cos(x), sp.cos(x)]]), [x, sp.Symbol("y", real=True)])
     with pytest.raises(ValueError, match="polynomial in sin"):
         singular_configurations(sp.Matrix([[sp.sin(x / 2)]]), [x])
     with pytest.raises(ValueError, match=r"polynomial in sin.*entry x\*sin\(x\)"):
-        singular_configurations(sp.Matrix([[1, 0], [x * sp.sin(x), sp.cos(x)]]), [x, sp.Symbol("y")])
+        singular_configurations(sp.Matrix([[1, 0], [x * sp.sin(x), sp.cos(x)]]), [x, sp.Symbol("y", real=True)])
 
 
 # ------------------------------------------------------------------------------------------
