@@ -15,7 +15,18 @@ from .jacobians import (
     space_to_body, space_to_geometric,
 )
 from .chains import SerialChain, fk_body, fk_space
-from .singularities import column_space, left_null_space, rank_at, singular_configurations, task_rows
+from .singularities import (
+    IncompleteResultWarning, SingularSet, column_space, evaluate_at, left_null_space, rank_at,
+    singular_configurations, task_rows,
+)
+from .exact import ConditionalResultWarning, NumericFallbackWarning, Rank
+from .singular_search import SingularPoints, find_singularities
+from .rigid import log3
+from .screws import log6
+from .velocity import (
+    PinvReport, SingularityWarning, damped_least_squares, force_ellipsoid, inverse_velocity, joint_torques,
+    pseudoinverse,
+)
 from .manipulability import (
     condition_number, isotropy, manipulability, twist_speed_form, velocity_ellipsoid,
 )
@@ -31,25 +42,10 @@ __all__ = [
     "jacobian_space", "jacobian_body", "geometric_jacobian", "space_to_body", "body_to_space",
     "body_to_geometric", "geometric_to_body", "space_to_geometric", "geometric_to_space",
     "linear_first", "angular_first", "position_jacobian", "robots",
-    "task_rows", "singular_configurations", "rank_at", "column_space", "left_null_space",
+    "task_rows", "singular_configurations", "SingularSet", "IncompleteResultWarning", "find_singularities",
+    "SingularPoints", "rank_at", "column_space", "left_null_space", "evaluate_at", "Rank", "NumericFallbackWarning",
+    "ConditionalResultWarning", "log3", "log6", "pseudoinverse", "inverse_velocity", "damped_least_squares",
+    "joint_torques", "force_ellipsoid", "PinvReport", "SingularityWarning",
     "manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
     "simplify_for_display", "is_identically_zero",
 ]
-
-# --- issue 11, item 7: matrix logarithms and the velocity kinematics after the Jacobian -------------
-from .rigid import log3
-from .screws import log6
-from .velocity import (
-    PinvReport, SingularityWarning, damped_least_squares, force_ellipsoid, inverse_velocity, joint_torques,
-    pseudoinverse,
-)
-
-__all__ += [
-    "log3", "log6", "pseudoinverse", "inverse_velocity", "damped_least_squares", "joint_torques",
-    "force_ellipsoid", "PinvReport", "SingularityWarning",
-]
-
-# --- issue 11, items 2 and 5: numeric singularity search; the singular-set answer type --------------
-from .singular_search import SingularPoints, find_singularities  # noqa: E402
-from .singularities import SingularSet  # noqa: E402
-__all__ += ["find_singularities", "SingularPoints", "SingularSet"]
