@@ -16,7 +16,8 @@ import numpy as np
 import sympy as sp
 
 __all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe", "exact_number",
-           "check_real_finite", "real_array", "exact_floats"]
+           "check_real_finite", "real_array", "exact_floats",
+           "joint_symbols"]
 
 _ZERO_TOL = 1e-9
 
@@ -329,3 +330,33 @@ def real_array(x, name: str, want: str) -> np.ndarray:
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name} must hold finite real numbers, got NaN or ±inf in {describe(x)}")
     return a
+
+
+def joint_symbols(thetas: Any, n: int | None = None, name: str = "thetas", per: str = "one per joint") -> tuple:
+    """The joint variables: ``n`` (any number when None) distinct SymPy symbols declared real.
+
+    A single Symbol or a SymPy column is accepted as a sequence. Refused with a message naming ``name``:
+    strings, non-symbols, the wrong count, repeats, symbols without ``real=True`` (joint values are real).
+    """
+    if isinstance(thetas, sp.Symbol):
+        thetas = (thetas,)
+    if isinstance(thetas, sp.MatrixBase):
+        thetas = list(thetas)
+    count = f"{n} " if n is not None else ""
+    if isinstance(thetas, (str, bytes)) or not isinstance(thetas, (list, tuple, np.ndarray)):
+        raise TypeError(f"{name} must be a sequence of {count}SymPy symbols ({per}), got {describe(thetas)}")
+    thetas = tuple(thetas)
+    if not all(isinstance(t, sp.Symbol) for t in thetas):
+        raise TypeError(f"{name} must be a sequence of {count}SymPy symbols ({per}), got {describe(list(thetas))}: "
+                        f"{', '.join(map(repr, thetas))[:120]}")
+    if n is not None and len(thetas) != n:
+        raise ValueError(f"{name} must be {count}SymPy symbols ({per}), got {describe(list(thetas))}: "
+                         f"{', '.join(map(repr, thetas))[:120]}")
+    if len(set(thetas)) != len(thetas):
+        raise ValueError(f"{name} must hold distinct symbols, got {', '.join(map(str, thetas))}")
+    for i, t in enumerate(thetas):
+        if t.is_real is not True:
+            raise ValueError(f"{name}[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)): joint values "
+                             f"are real, got the symbol {t} with no real assumption (declared real) in "
+                             f"{name} = ({', '.join(map(str, thetas))})")
+    return thetas

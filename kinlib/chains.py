@@ -11,7 +11,9 @@ from typing import Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_screw_list, as_thetas, as_vector, describe, exact_number, is_symbolic
+from ._backend import (
+    as_matrix, as_screw_list, as_thetas, as_vector, describe, exact_number, is_symbolic, joint_symbols,
+)
 from .codegen import CompiledMatrix
 from .jacobians import _prepare, jacobian_body as _jacobian_body, jacobian_space as _jacobian_space
 from .rigid import adjoint, check_se3, cross, skew, trans_inv
@@ -50,27 +52,6 @@ _F8 = np.dtype(float)
 
 def _joint_symbols(n: int):
     return sp.symbols(f"theta1:{n + 1}", real=True)
-
-
-def _check_joint_symbols(thetas, n: int) -> tuple:
-    """n distinct SymPy symbols declared real (joint angles and slides are real numbers)."""
-    if isinstance(thetas, sp.Symbol):
-        thetas = [thetas]
-    if isinstance(thetas, sp.MatrixBase):
-        thetas = list(thetas)
-    if isinstance(thetas, (str, bytes)) or not isinstance(thetas, (list, tuple)):
-        raise TypeError(f"thetas must be {n} SymPy symbols (one per screw axis), got {describe(thetas)}")
-    thetas = tuple(thetas)
-    if len(thetas) != n or not all(isinstance(t, sp.Symbol) for t in thetas):
-        raise ValueError(f"thetas must be {n} SymPy symbols (one per screw axis), got {describe(list(thetas))}: "
-                         f"{', '.join(map(repr, thetas))[:120]}")
-    if len(set(thetas)) != n:
-        raise ValueError(f"thetas must be {n} distinct symbols, got {', '.join(map(str, thetas))}")
-    for i, t in enumerate(thetas):
-        if t.is_real is not True:
-            raise ValueError(f"thetas[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)): joint values "
-                             f"are real, got the symbol {t} with no real assumption")
-    return thetas
 
 
 class SerialChain:
@@ -117,7 +98,7 @@ class SerialChain:
         n = S.shape[1]
         if thetas is None:
             thetas = _joint_symbols(n)
-        thetas = _check_joint_symbols(thetas, n)
+        thetas = joint_symbols(thetas, n, per="one per screw axis")
         _, _, kinds, _ = _prepare(S, list(thetas), "screws")
         self.name = name
         self.description = description

@@ -30,7 +30,6 @@ computed from a singular value decomposition in mpmath with ``FALLBACK_DIGITS`` 
 from __future__ import annotations
 
 import itertools
-import numbers
 import warnings
 from typing import Any, Mapping, Sequence
 
@@ -38,7 +37,7 @@ import numpy as np
 import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
-from ._backend import describe, exact_number, is_symbolic, real_array
+from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
 from .exactfield import (
     FALLBACK_DIGITS, MAX_MULTIPLE, ExactField, NotExact, decide_zero, exact_is_zero, mp_matrix, readable,
     readable_fold, readable_ratio,
@@ -103,47 +102,13 @@ def _make_rank(v, exact, unless, note):
 # input: J and the configuration
 # ----------------------------------------------------------------------------------------------
 def _jacobian(J: Any, name: str = "J") -> sp.Matrix:
-    if isinstance(J, sp.MatrixBase):
-        M = sp.Matrix(J)
-    elif isinstance(J, (list, tuple, np.ndarray)):
-        try:
-            M = sp.Matrix(np.asarray(J, dtype=object).tolist())
-        except Exception:
-            raise TypeError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}") from None
-        if np.asarray(J, dtype=object).ndim != 2:
-            raise ValueError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
-    else:
+    """J as an exact SymPy Matrix (numbers made exact, I/nan/oo refused: ``_backend.as_matrix``), not empty."""
+    if not isinstance(J, (sp.MatrixBase, list, tuple, np.ndarray)):
         raise TypeError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
+    M = as_matrix(J, name, None, True)
     if M.rows == 0 or M.cols == 0:
         raise ValueError(f"{name} must have at least one row and one column, got {describe(J)}")
-    out = []
-    for e in M:
-        if isinstance(e, (bool, np.bool_)) or not isinstance(e, (sp.Expr, numbers.Number, np.number)):
-            raise TypeError(f"{name} must hold numbers or SymPy expressions, got an entry {describe(e)}")
-        out.append(exact_number(e, f"an entry of {name}") if not isinstance(e, sp.Expr) else e)
-    M = sp.Matrix(M.rows, M.cols, out)
-    for e in M:
-        if e.has(sp.I, sp.nan, sp.zoo, sp.oo, -sp.oo):
-            raise ValueError(f"{name} must hold real, finite entries, got the entry {e}")
     return M
-
-
-def _joint_symbols(thetas: Any, name: str = "thetas") -> tuple:
-    if isinstance(thetas, sp.Symbol):
-        thetas = (thetas,)
-    if isinstance(thetas, sp.MatrixBase):
-        thetas = list(thetas)
-    if isinstance(thetas, (str, bytes)) or not isinstance(thetas, (Sequence, np.ndarray)):
-        raise TypeError(f"{name} must be a sequence of SymPy symbols (the joint variables), got {describe(thetas)}")
-    thetas = tuple(thetas)
-    for t in thetas:
-        if not isinstance(t, sp.Symbol):
-            raise TypeError(f"{name} must hold SymPy symbols (the joint variables), got {describe(t)}")
-        if t.is_real is not True:
-            raise ValueError(f"{name}: the joint symbol {t} must be declared real (sp.Symbol('{t}', real=True))")
-    if len(set(thetas)) != len(thetas):
-        raise ValueError(f"{name} must hold distinct symbols, got {', '.join(map(str, thetas))}")
-    return thetas
 
 
 def _table(subs: Any, thetas: Any) -> tuple:
@@ -157,7 +122,7 @@ def _table(subs: Any, thetas: Any) -> tuple:
         if thetas is None:
             raise ValueError(f"subs is a sequence of joint values (got {describe(subs)}): give thetas= (the joint "
                              "symbols, in order) too, or a mapping {joint symbol: value}")
-        thetas = _joint_symbols(thetas)
+        thetas = joint_symbols(thetas)
         if len(vals) != len(thetas):
             raise ValueError(f"subs must hold {len(thetas)} joint values (one per joint "
                              f"{', '.join(map(str, thetas))}), got {len(vals)}")

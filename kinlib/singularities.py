@@ -35,7 +35,7 @@ from typing import Any, Sequence
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, describe, is_symbolic
+from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols
 from .display import _exact_zero
 from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
 from .trigsign import generator_kinds, proves_nonzero
@@ -66,28 +66,6 @@ def _jacobian(J: Any, name: str = "J", symbolic: bool | None = None):
     if isinstance(J, np.ndarray) and J.ndim != 2:
         raise ValueError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
     return as_matrix(J, name, None, symbolic)
-
-
-def _check_thetas(thetas: Any, n: int, name: str = "thetas") -> tuple[sp.Symbol, ...]:
-    if isinstance(thetas, sp.Symbol):
-        thetas = (thetas,)
-    if isinstance(thetas, sp.MatrixBase):
-        thetas = list(thetas)
-    if isinstance(thetas, (str, bytes)) or not isinstance(thetas, Sequence):
-        raise TypeError(f"{name} must be a sequence of {n} SymPy symbols (one per column of J), got {describe(thetas)}")
-    thetas = tuple(thetas)
-    if not all(isinstance(t, sp.Symbol) for t in thetas):
-        raise TypeError(f"{name} must hold SymPy symbols (the joint variables), got {describe(list(thetas))}")
-    if len(thetas) != n:
-        raise ValueError(f"{name} must hold {n} joint symbols (one per column of J), got {len(thetas)}: "
-                         f"{', '.join(map(str, thetas))}")
-    if len(set(thetas)) != n:
-        raise ValueError(f"{name} must hold distinct symbols, got {', '.join(map(str, thetas))}")
-    for t in thetas:
-        if t.is_real is not True:
-            raise ValueError(f"{name} must hold real joint symbols: {t} is not declared real (use "
-                             f"sp.Symbol('{t}', real=True)); got {name} = ({', '.join(map(str, thetas))})")
-    return thetas
 
 
 def _check_params(J: sp.Matrix, thetas, params) -> tuple[sp.Symbol, ...]:
@@ -214,11 +192,13 @@ def _det(M: sp.Matrix) -> sp.Expr:
 def periodic_family(points: Sequence) -> sp.Set:
     """{b + p k : k ∈ ℤ}: the angles ≡ one of ``points`` (exact, one period [0, 2π)) modulo 2π, written with
     period π when the points come in pairs π apart (sin θ = 0 → {kπ}); bases in (−π/2, π/2] or (−π, π]."""
-    points = [sp.sympify(p) for p in points]
+    if isinstance(points, (str, bytes)) or not isinstance(points, (Sequence, set, frozenset, sp.FiniteSet)):
+        raise TypeError(f"points must be a sequence of real numbers, got {describe(points)}")
+    points = [exact_number(p, "points") for p in points]     # a float means the decimal typed, never a guess
     if not points or not all(p.is_number and p.is_real for p in points):
         raise ValueError(f"points must be real numbers, got {points}")
     points = [p - _TWO_PI * sp.floor(p / _TWO_PI) for p in points]
-    pts = sorted(set(sp.nsimplify(p) if isinstance(p, sp.Float) else p for p in points), key=lambda x: float(x))
+    pts = sorted(set(points), key=lambda x: float(x))
     modpi = all(any(sp.simplify((p + sp.pi) % _TWO_PI - q) == 0 for q in pts) for p in pts)
     if modpi:
         period = sp.pi
@@ -509,7 +489,7 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
     if not is_symbolic(J):
         raise TypeError(f"J must be a symbolic Jacobian (a SymPy Matrix in the joint symbols), got {describe(J)}")
     J = _jacobian(J, "J", True)
-    thetas = _check_thetas(thetas, J.cols)
+    thetas = joint_symbols(thetas, J.cols, per="one per column of J")
     _check_params(J, thetas, params)
     if J.rows == 0 or J.cols == 0:
         raise ValueError(f"J must have at least one row and one column, got {describe(J)}")

@@ -19,7 +19,6 @@ import pytest
 import sympy as sp
 from hypothesis import given, settings, strategies as st
 
-import kinlib
 from kinlib import robots
 from kinlib.robots import from_urdf_joints
 from kinlib.tape import Tape, TapeValue

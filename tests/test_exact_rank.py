@@ -6,8 +6,6 @@ configurations are rationals, integers, rational multiples of π, mixtures, and 
 """
 from __future__ import annotations
 
-import itertools
-import warnings
 
 import mpmath
 import pytest

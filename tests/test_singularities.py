@@ -222,7 +222,7 @@ def test_bad_input_singular_configurations():
         singular_configurations(np.eye(3), r.thetas)
     with pytest.raises(TypeError, match="J must be a matrix"):
         singular_configurations(sp.Symbol("x"), r.thetas)
-    with pytest.raises(ValueError, match="3 joint symbols"):
+    with pytest.raises(ValueError, match="3 SymPy symbols"):
         singular_configurations(J, r.thetas[:2])
     with pytest.raises(TypeError, match="SymPy symbols"):
         singular_configurations(J, ["theta1", "theta2", "theta3"])
