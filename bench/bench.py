@@ -17,6 +17,7 @@ execution; one slider move in each explorer; the instructor checker's throughput
 Missing pieces (Pinocchio, a notebook, a module) are reported as "not available", never skipped
 silently. ``--quick`` (tests) uses a tiny batch and skips notebooks, explorers and the checker.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -45,22 +46,26 @@ import kinlib  # noqa: E402
 from kinlib import robots  # noqa: E402
 
 # --- targets (issue 7) -------------------------------------------------------------------------
-T_SINGLE = 3e-6          # one numeric UR5 Jacobian / FK
-T_SPEEDUP_MR = 80.0      # J_s: at least 80x modern-robotics
-T_BATCH = 200e-9         # per configuration, batch of 100,000
+T_SINGLE = 3e-6  # one numeric UR5 Jacobian / FK
+T_SPEEDUP_MR = 80.0  # J_s: at least 80x modern-robotics
+T_BATCH = 200e-9  # per configuration, batch of 100,000
 T_SYM_BUILD = 0.1
 T_DISPLAY = 3.0
 T_SINGULAR = 5.0
 T_NOTEBOOK = 10.0
 T_REDRAW = 0.050
 T_IMPORT = 0.6
-T_FIRST_CALL = 2.0       # first numeric call (code generation) of any chain of <= 7 joints
-T_EXACT_RANK = 30.0      # exact rank / column space / left null space at a configuration of a 6-joint arm
-T_SINGULAR_7 = 60.0      # singular set of a 6×7 Jacobian: an answer or a clear "out of reach"
-T_COND_2R = 2.0          # symbolic condition number of a planar 2R
+T_FIRST_CALL = 2.0  # first numeric call (code generation) of any chain of <= 7 joints
+T_EXACT_RANK = 30.0  # exact rank / column space / left null space at a configuration of a 6-joint arm
+T_SINGULAR_7 = 60.0  # singular set of a 6×7 Jacobian: an answer or a clear "out of reach"
+T_COND_2R = 2.0  # symbolic condition number of a planar 2R
 
-QUANTITIES = [("fk", "FK T(θ)"), ("js", "space Jacobian J_s"), ("jb", "body Jacobian J_b"),
-              ("jg", "geometric Jacobian [ω_s; ṗ]")]
+QUANTITIES = [
+    ("fk", "FK T(θ)"),
+    ("js", "space Jacobian J_s"),
+    ("jb", "body Jacobian J_b"),
+    ("jg", "geometric Jacobian [ω_s; ṗ]"),
+]
 METHOD = {"fk": "fk", "js": "jacobian_space", "jb": "jacobian_body", "jg": "jacobian_geometric"}
 
 NA = "not available"
@@ -150,6 +155,7 @@ def once(fn, reps: int, best: bool = False):
 # --- machine ---------------------------------------------------------------------------------------
 def _version(dist: str) -> str:
     from importlib import metadata
+
     try:
         return metadata.version(dist)
     except metadata.PackageNotFoundError:
@@ -166,19 +172,33 @@ def machine() -> list[str]:
     except OSError:
         pass
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg()) if hasattr(os, "getloadavg") else NA
-    rows = [["CPU", cpu], ["cores", str(os.cpu_count())], ["load average at start (1, 5, 15 min)", load],
-            ["OS", platform.platform()], ["Python", platform.python_version()],
-            ["numpy", np.__version__], ["sympy", sp.__version__], ["kinlib", kinlib.__version__],
-            ["modern-robotics", _version("modern_robotics")], ["pin (Pinocchio)", _version("pin")],
-            ["date", datetime.datetime.now().astimezone().isoformat(timespec="seconds")]]
+    rows = [
+        ["CPU", cpu],
+        ["cores", str(os.cpu_count())],
+        ["load average at start (1, 5, 15 min)", load],
+        ["OS", platform.platform()],
+        ["Python", platform.python_version()],
+        ["numpy", np.__version__],
+        ["sympy", sp.__version__],
+        ["kinlib", kinlib.__version__],
+        ["modern-robotics", _version("modern_robotics")],
+        ["pin (Pinocchio)", _version("pin")],
+        ["date", datetime.datetime.now().astimezone().isoformat(timespec="seconds")],
+    ]
     return table(["machine", ""], rows)
 
 
 # --- reference implementations -------------------------------------------------------------------
 def numeric_robots() -> list:
     """The UR5 (book's lengths) and the problem set's robots with numeric lengths."""
-    return [robots.ur5(), robots.planar_offset_3r(1), robots.spatial_rppr(1, 1), robots.cart_pole(1, 1),
-            robots.planar_3r(1, 1, 1), robots.planar_rpp(1)]
+    return [
+        robots.ur5(),
+        robots.planar_offset_3r(1),
+        robots.spatial_rppr(1, 1),
+        robots.cart_pole(1, 1),
+        robots.planar_3r(1, 1, 1),
+        robots.planar_rpp(1),
+    ]
 
 
 class MR:
@@ -186,6 +206,7 @@ class MR:
 
     def __init__(self, chain):
         import modern_robotics as mr
+
         self.mr = mr
         self.M = np.array(chain.M, dtype=float)
         self.S = np.array(chain.screws, dtype=float)
@@ -200,8 +221,12 @@ class MR:
 
     def fn(self, what):
         mr = self.mr
-        return {"fk": lambda q: mr.FKinSpace(self.M, self.S, q), "js": lambda q: mr.JacobianSpace(self.S, q),
-                "jb": lambda q: mr.JacobianBody(self.B, q), "jg": self.geometric}[what]
+        return {
+            "fk": lambda q: mr.FKinSpace(self.M, self.S, q),
+            "js": lambda q: mr.JacobianSpace(self.S, q),
+            "jb": lambda q: mr.JacobianBody(self.B, q),
+            "jg": self.geometric,
+        }[what]
 
 
 class Pin:
@@ -209,6 +234,7 @@ class Pin:
 
     def __init__(self, chain):
         import pinocchio as pin
+
         self.pin = pin
         S = np.array(chain.screws, dtype=float)
         pts = np.array(chain.joint_points, dtype=float)
@@ -226,20 +252,26 @@ class Pin:
                 joint = pin.JointModelPrismaticUnaligned(v)
             parent = model.addJoint(parent, joint, pin.SE3(np.eye(3), p - prev), f"joint{i + 1}")
             prev = p
-        self.fid = model.addFrame(pin.Frame("tool", parent, pin.SE3(M[:3, :3], M[:3, 3] - prev),
-                                            pin.FrameType.OP_FRAME))
+        self.fid = model.addFrame(
+            pin.Frame("tool", parent, pin.SE3(M[:3, :3], M[:3, 3] - prev), pin.FrameType.OP_FRAME)
+        )
         self.model, self.data = model, model.createData()
 
     def raw(self, what):
         """The timed call (Pinocchio's own conventions, no reordering)."""
         pin, m, d, f = self.pin, self.model, self.data, self.fid
         if what == "fk":
+
             def fk(q):
                 pin.framesForwardKinematics(m, d, q)
                 return d.oMf[f].homogeneous
+
             return fk
-        ref = {"js": pin.ReferenceFrame.WORLD, "jb": pin.ReferenceFrame.LOCAL,
-               "jg": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED}[what]
+        ref = {
+            "js": pin.ReferenceFrame.WORLD,
+            "jb": pin.ReferenceFrame.LOCAL,
+            "jg": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+        }[what]
         return lambda q: pin.computeFrameJacobian(m, d, q, f, ref)
 
     def book(self, what):
@@ -261,19 +293,24 @@ def _loop(f, Q, shape):
 def numeric_section(args, targets: Targets) -> list[str]:
     try:
         import pinocchio  # noqa: F401
+
         have_pin = True
         pin_note = f"Pinocchio {_version('pin')}: a Python loop over `computeFrameJacobian` for a batch."
     except ImportError:
         have_pin = False
-        pin_note = "**Pinocchio (`pin`) is not installed: its columns say \"not available\"** (`make bench` installs it)."
+        pin_note = '**Pinocchio (`pin`) is not installed: its columns say "not available"** (`make bench` installs it).'
     rng = np.random.default_rng(2024)
-    lines = ["## Numeric kinematics (float arrays, fast path)", "",
-             f"kinlib: `SerialChain` methods with q a float array of shape (n,), or (N, n) for a batch of "
-             f"N = {args.batch:,}; kinlib's column gives the median (the fastest run in parentheses: the machine "
-             f"may be shared, the median is what the targets are checked against). modern-robotics 1.1.1: `FKinSpace`, `JacobianSpace`, `JacobianBody` (geometric: "
-             f"blockdiag(R, R)·J_b), a Python loop for a batch. {pin_note} Times per configuration; "
-             f"× = how many times faster kinlib is. Checked first: kinlib = modern-robotics = Pinocchio "
-             f"(np.allclose, 20 random configurations, and batch = single calls).", ""]
+    lines = [
+        "## Numeric kinematics (float arrays, fast path)",
+        "",
+        f"kinlib: `SerialChain` methods with q a float array of shape (n,), or (N, n) for a batch of "
+        f"N = {args.batch:,}; kinlib's column gives the median (the fastest run in parentheses: the machine "
+        f"may be shared, the median is what the targets are checked against). modern-robotics 1.1.1: `FKinSpace`, `JacobianSpace`, `JacobianBody` (geometric: "
+        f"blockdiag(R, R)·J_b), a Python loop for a batch. {pin_note} Times per configuration; "
+        f"× = how many times faster kinlib is. Checked first: kinlib = modern-robotics = Pinocchio "
+        f"(np.allclose, 20 random configurations, and batch = single calls).",
+        "",
+    ]
     rows = []
     for chain in numeric_robots():
         n = chain.n
@@ -293,36 +330,78 @@ def numeric_section(args, targets: Targets) -> list[str]:
                 assert np.allclose(single, ref, atol=1e-9), f"{chain.name} {what}: kinlib != modern-robotics at {qk}"
                 assert np.allclose(batch[k], single, atol=1e-12), f"{chain.name} {what}: batch != single at {qk}"
                 if pinr is not None:
-                    assert np.allclose(single, pinr.book(what)(qk), atol=1e-9), \
+                    assert np.allclose(single, pinr.book(what)(qk), atol=1e-9), (
                         f"{chain.name} {what}: kinlib != Pinocchio at {qk}"
+                    )
             shape = batch.shape[1:]
             t_k, t_k_best = per_call(lambda: kin(q), args.reps, best=True)
             t_m = per_call(lambda: mrr.fn(what)(q), max(3, args.reps // 2))
             t_p = per_call(lambda: pinr.raw(what)(q), args.reps) if pinr else None
             kin(Q)  # compile/warm
             tb_k, tb_k_best = (t / args.batch for t in once(lambda: kin(Q), max(3, args.reps // 2), best=True))
-            Qm = Q[:args.mr_batch]
+            Qm = Q[: args.mr_batch]
             tb_m = once(lambda: _loop(mrr.fn(what), Qm, shape), 3) / len(Qm)
-            Qp = Q[:args.pin_batch]
+            Qp = Q[: args.pin_batch]
             tb_p = once(lambda: _loop(pinr.raw(what), Qp, shape), 3) / len(Qp) if pinr else None
             name = f"{chain.name} (n={n})"
             s_single = s_batch = "—"
             if is_ur5:
                 s_single = targets.upper(f"UR5 {label}, one configuration", t_k, T_SINGLE)
                 if what == "js":
-                    s_single = f"{s_single}; ≥ 80× mr: " + targets.lower("UR5 J_s speed-up over modern-robotics",
-                                                                         t_m / t_k, T_SPEEDUP_MR)
+                    s_single = f"{s_single}; ≥ 80× mr: " + targets.lower(
+                        "UR5 J_s speed-up over modern-robotics", t_m / t_k, T_SPEEDUP_MR
+                    )
                 s_batch = targets.upper(f"UR5 {label}, batched, per configuration", tb_k, T_BATCH)
             tgt_s = ("≤ 3 µs, ≥ 80× mr" if what == "js" else "≤ 3 µs") if is_ur5 else "—"
             tgt_b = "≤ 200 ns" if is_ur5 else "—"
-            rows.append([name, label, "single", f"{fmt_t(t_k)} ({fmt_t(t_k_best)})", fmt_t(t_m), fmt_x(t_m / t_k),
-                         fmt_t(t_p) if pinr else NA, fmt_x(t_p / t_k) if pinr else NA, tgt_s, s_single])
-            rows.append([name, label, f"batch {args.batch:,}", f"{fmt_t(tb_k)} ({fmt_t(tb_k_best)})", fmt_t(tb_m), fmt_x(tb_m / tb_k),
-                         fmt_t(tb_p) if pinr else NA, fmt_x(tb_p / tb_k) if pinr else NA, tgt_b, s_batch])
-    lines += table(["robot", "quantity", "call", "kinlib (best)", "modern-robotics", "× vs mr", "Pinocchio",
-                    "× vs pin", "target", "status"], rows)
-    lines += ["", f"Batched reference loops ran over the first {args.mr_batch:,} (modern-robotics) and "
-                  f"{args.pin_batch:,} (Pinocchio) configurations of the same batch."]
+            rows.append(
+                [
+                    name,
+                    label,
+                    "single",
+                    f"{fmt_t(t_k)} ({fmt_t(t_k_best)})",
+                    fmt_t(t_m),
+                    fmt_x(t_m / t_k),
+                    fmt_t(t_p) if pinr else NA,
+                    fmt_x(t_p / t_k) if pinr else NA,
+                    tgt_s,
+                    s_single,
+                ]
+            )
+            rows.append(
+                [
+                    name,
+                    label,
+                    f"batch {args.batch:,}",
+                    f"{fmt_t(tb_k)} ({fmt_t(tb_k_best)})",
+                    fmt_t(tb_m),
+                    fmt_x(tb_m / tb_k),
+                    fmt_t(tb_p) if pinr else NA,
+                    fmt_x(tb_p / tb_k) if pinr else NA,
+                    tgt_b,
+                    s_batch,
+                ]
+            )
+    lines += table(
+        [
+            "robot",
+            "quantity",
+            "call",
+            "kinlib (best)",
+            "modern-robotics",
+            "× vs mr",
+            "Pinocchio",
+            "× vs pin",
+            "target",
+            "status",
+        ],
+        rows,
+    )
+    lines += [
+        "",
+        f"Batched reference loops ran over the first {args.mr_batch:,} (modern-robotics) and "
+        f"{args.pin_batch:,} (Pinocchio) configurations of the same batch.",
+    ]
     return lines
 
 
@@ -346,6 +425,7 @@ print(json.dumps({"seconds": dt, "result": str(res), "count": len(res)}))
 def symbolic_section(args, targets: Targets) -> list[str]:
     lines = ["## Symbolic (exact SymPy)", ""]
     rows = []
+
     # build: a fresh chain each time, with SymPy's cache cleared (nothing remembered)
     def build():
         sp.core.cache.clear_cache()
@@ -356,8 +436,14 @@ def symbolic_section(args, targets: Targets) -> list[str]:
 
     build()  # warm-up: imports inside SymPy
     tb = statistics.median(build()[0] for _ in range(max(3, args.reps)))
-    rows.append(["UR5 J_s built (fresh chain, SymPy cache cleared)", fmt_t(tb), "≤ 0.1 s",
-                 targets.upper("UR5 symbolic J_s build", tb, T_SYM_BUILD)])
+    rows.append(
+        [
+            "UR5 J_s built (fresh chain, SymPy cache cleared)",
+            fmt_t(tb),
+            "≤ 0.1 s",
+            targets.upper("UR5 symbolic J_s build", tb, T_SYM_BUILD),
+        ]
+    )
     try:
         from kinlib.display import simplify_for_display
     except ImportError:
@@ -372,32 +458,69 @@ def symbolic_section(args, targets: Targets) -> list[str]:
         td = statistics.median(times)
         qv = {t: 0.1 * (i + 1) for i, t in enumerate(robots.ur5().thetas)}
         assert np.allclose(np.array(D.subs(qv).evalf(), float), np.array(J.subs(qv).evalf(), float), atol=1e-12)
-        rows.append(["UR5 J_s shown simplified (`kinlib.display.simplify_for_display`)", fmt_t(td), "≤ 3 s",
-                     targets.upper("UR5 J_s display simplification", td, T_DISPLAY)])
+        rows.append(
+            [
+                "UR5 J_s shown simplified (`kinlib.display.simplify_for_display`)",
+                fmt_t(td),
+                "≤ 3 s",
+                targets.upper("UR5 J_s display simplification", td, T_DISPLAY),
+            ]
+        )
     else:
-        rows.append(["UR5 J_s shown simplified", NA, "≤ 3 s", targets.upper("UR5 J_s display simplification", None, T_DISPLAY)])
+        rows.append(
+            ["UR5 J_s shown simplified", NA, "≤ 3 s", targets.upper("UR5 J_s display simplification", None, T_DISPLAY)]
+        )
     # singular set, in a subprocess with a time limit
     try:
-        p = subprocess.run([sys.executable, "-c", _SINGULAR_SCRIPT], capture_output=True, text=True,
-                           timeout=args.singular_timeout, cwd=ROOT)
+        p = subprocess.run(
+            [sys.executable, "-c", _SINGULAR_SCRIPT],
+            capture_output=True,
+            text=True,
+            timeout=args.singular_timeout,
+            cwd=ROOT,
+        )
         out = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 and p.stdout.strip() else None
         if out is None:
-            rows.append(["UR5 singular set (`singular_configurations(J_s, θ)`)", f"error: {p.stderr.strip()[-200:]}",
-                         "≤ 5 s", targets.upper("UR5 singular set", None, T_SINGULAR)])
+            rows.append(
+                [
+                    "UR5 singular set (`singular_configurations(J_s, θ)`)",
+                    f"error: {p.stderr.strip()[-200:]}",
+                    "≤ 5 s",
+                    targets.upper("UR5 singular set", None, T_SINGULAR),
+                ]
+            )
         elif out.get("missing"):
-            rows.append(["UR5 singular set", NA + " (kinlib.singularities missing)", "≤ 5 s",
-                         targets.upper("UR5 singular set", None, T_SINGULAR)])
+            rows.append(
+                [
+                    "UR5 singular set",
+                    NA + " (kinlib.singularities missing)",
+                    "≤ 5 s",
+                    targets.upper("UR5 singular set", None, T_SINGULAR),
+                ]
+            )
         else:
-            rows.append([f"UR5 singular set (`singular_configurations(J_s, θ)`: {out['count']} conditions)",
-                         fmt_t(out["seconds"]), "≤ 5 s", targets.upper("UR5 singular set", out["seconds"], T_SINGULAR)])
+            rows.append(
+                [
+                    f"UR5 singular set (`singular_configurations(J_s, θ)`: {out['count']} conditions)",
+                    fmt_t(out["seconds"]),
+                    "≤ 5 s",
+                    targets.upper("UR5 singular set", out["seconds"], T_SINGULAR),
+                ]
+            )
             lines += [f"UR5 singular set found: `{out['result']}`", ""]
     except subprocess.TimeoutExpired:
-        rows.append(["UR5 singular set", f"> {args.singular_timeout:.0f} s (stopped)", "≤ 5 s",
-                     targets.upper("UR5 singular set", float(args.singular_timeout), T_SINGULAR)])
+        rows.append(
+            [
+                "UR5 singular set",
+                f"> {args.singular_timeout:.0f} s (stopped)",
+                "≤ 5 s",
+                targets.upper("UR5 singular set", float(args.singular_timeout), T_SINGULAR),
+            ]
+        )
     return lines + table(["what", "time", "target", "status"], rows)
 
 
-_BAXTER_H = 1.57079632679   # the URDF's own digits: not π/2, so no rotation entry is zero (a dense arm)
+_BAXTER_H = 1.57079632679  # the URDF's own digits: not π/2, so no rotation entry is zero (a dense arm)
 BAXTER_LEFT_ARM = [  # baxter_description: left_arm_mount, then s0 ... w2
     ("fixed", (0.024645, 0.219645, 0.118588), (0, 0, 0.7854), None),
     ("revolute", (0.055695, 0, 0.011038), (0, 0, 0), (0, 0, 1)),
@@ -412,9 +535,13 @@ BAXTER_TOOL = ((0, 0, 0.27175), (0, 0, 0))
 
 
 def first_call_section(args, targets: Targets) -> list[str]:
-    lines = ["## First numeric call of a 7-joint chain (code generation)", "",
-             "A fresh chain built with `robots.from_urdf_joints` from the Baxter left arm's URDF placements "
-             "(SymPy's cache cleared), timed from the first call with floats to its result.", ""]
+    lines = [
+        "## First numeric call of a 7-joint chain (code generation)",
+        "",
+        "A fresh chain built with `robots.from_urdf_joints` from the Baxter left arm's URDF placements "
+        "(SymPy's cache cleared), timed from the first call with floats to its result.",
+        "",
+    ]
     if not hasattr(robots, "from_urdf_joints"):
         return lines + [NA + " (robots.from_urdf_joints missing)"]
     q = np.zeros(7)
@@ -429,33 +556,56 @@ def first_call_section(args, targets: Targets) -> list[str]:
 
     first(["fk"])  # warm-up
     rows = []
-    for label, methods in (("T(θ)", ["fk"]), ("J_s", ["jacobian_space"]), ("J_b", ["jacobian_body"]),
-                           ("geometric J", ["jacobian_geometric"]),
-                           ("all four", ["fk", "jacobian_space", "jacobian_body", "jacobian_geometric"])):
+    for label, methods in (
+        ("T(θ)", ["fk"]),
+        ("J_s", ["jacobian_space"]),
+        ("J_b", ["jacobian_body"]),
+        ("geometric J", ["jacobian_geometric"]),
+        ("all four", ["fk", "jacobian_space", "jacobian_body", "jacobian_geometric"]),
+    ):
         t = statistics.median(first(methods) for _ in range(max(3, min(args.reps, 5))))
-        rows.append([f"Baxter 7R arm from URDF placements: first call of {label}", fmt_t(t), "≤ 2 s",
-                     targets.upper(f"first numeric call, 7-joint arm, {label}", t, T_FIRST_CALL)])
+        rows.append(
+            [
+                f"Baxter 7R arm from URDF placements: first call of {label}",
+                fmt_t(t),
+                "≤ 2 s",
+                targets.upper(f"first numeric call, 7-joint arm, {label}", t, T_FIRST_CALL),
+            ]
+        )
     return lines + table(["what", "CPU time (median)", "target", "status"], rows)
 
 
-_STANFORD = [[0, 0, 1, 0, 0, 0], [1, 0, 0, 0, 1, 0], [0, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0],
-             [1, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0]]
+_STANFORD = [
+    [0, 0, 1, 0, 0, 0],
+    [1, 0, 0, 0, 1, 0],
+    [0, 0, 0, 0, 1, 0],
+    [0, 1, 0, -1, 0, 0],
+    [1, 0, 0, 0, 1, 0],
+    [0, 1, 0, -1, 0, 0],
+]
 
 
 def exact_section(args, targets: Targets) -> list[str]:
     """Exact rank, column space and left null space at configurations of 6-joint arms (kinlib.exact)."""
     from kinlib.exact import column_space, left_null_space, rank_at
-    lines = ["## Exact analysis at a configuration (6-joint arms)", "",
-             "`rank_at`, `column_space` and `left_null_space` of the 6×6 J at one configuration: proved exactly "
-             "(or, beyond the exact budget, 60-digit numerics, flagged).", ""]
+
+    lines = [
+        "## Exact analysis at a configuration (6-joint arms)",
+        "",
+        "`rank_at`, `column_space` and `left_null_space` of the 6×6 J at one configuration: proved exactly "
+        "(or, beyond the exact budget, 60-digit numerics, flagged).",
+        "",
+    ]
     M = sp.eye(4)
     M[:3, 3] = sp.Matrix([0, sp.Rational(1, 2), 1])
     stanford = kinlib.SerialChain(M, _STANFORD, name="stanford")
     R = sp.Rational
-    cases = [("Stanford RRPRRR", stanford, "J_s", (1, 2, 3, 4, 5, 6)),
-             ("Stanford RRPRRR (wrist θ5 = 0)", stanford, "J_s", (1, 2, R(1, 3), 4, 0, 6)),
-             ("UR5 geometric J (elbow θ3 = 0)", robots.ur5(), "J", (R(1, 2), 10, 0, 1, 3, 2)),
-             ("UR5 geometric J", robots.ur5(), "J", (1, 1, 1, 1, 1, 1))]
+    cases = [
+        ("Stanford RRPRRR", stanford, "J_s", (1, 2, 3, 4, 5, 6)),
+        ("Stanford RRPRRR (wrist θ5 = 0)", stanford, "J_s", (1, 2, R(1, 3), 4, 0, 6)),
+        ("UR5 geometric J (elbow θ3 = 0)", robots.ur5(), "J", (R(1, 2), 10, 0, 1, 3, 2)),
+        ("UR5 geometric J", robots.ur5(), "J", (1, 1, 1, 1, 1, 1)),
+    ]
     rows = []
     for label, chain, which, q in cases if not args.quick else cases[:2]:
         J = chain.jacobian_space() if which == "J_s" else chain.jacobian_geometric()
@@ -469,8 +619,16 @@ def exact_section(args, targets: Targets) -> list[str]:
         t3 = CLOCK()
         assert C.shape[1] == r and N.shape[1] == 6 - r
         worst = max(t1 - t0, t2 - t1, t3 - t2)
-        rows.append([f"{label} at θ = {tuple(q)}: rank {r!r}", fmt_t(t1 - t0), fmt_t(t2 - t1), fmt_t(t3 - t2),
-                     "≤ 30 s each", targets.upper(f"exact analysis, {label}", worst, T_EXACT_RANK)])
+        rows.append(
+            [
+                f"{label} at θ = {tuple(q)}: rank {r!r}",
+                fmt_t(t1 - t0),
+                fmt_t(t2 - t1),
+                fmt_t(t3 - t2),
+                "≤ 30 s each",
+                targets.upper(f"exact analysis, {label}", worst, T_EXACT_RANK),
+            ]
+        )
     return lines + table(["what", "rank_at", "column_space", "left_null_space", "target", "status"], rows)
 
 
@@ -510,26 +668,53 @@ def analysis_section(args, targets: Targets) -> list[str]:
     lines = ["## Singular sets of a redundant arm, the numeric search, symbolic conditioning", ""]
     rows = []
     try:
-        p = subprocess.run([sys.executable, "-c", _SINGULAR7_SCRIPT], capture_output=True, text=True,
-                           timeout=max(args.singular_timeout, 90), cwd=ROOT)
+        p = subprocess.run(
+            [sys.executable, "-c", _SINGULAR7_SCRIPT],
+            capture_output=True,
+            text=True,
+            timeout=max(args.singular_timeout, 90),
+            cwd=ROOT,
+        )
         out = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 and p.stdout.strip() else None
     except subprocess.TimeoutExpired:
         out, p = None, None
     if out is None:
         why = "timed out" if p is None else f"error: {p.stderr.strip()[-200:]}"
-        rows.append(["Franka-like 7R: `singular_configurations` of the 6×7 J_s", why, "≤ 60 s",
-                     targets.upper("6×7 singular set", None, T_SINGULAR_7)])
+        rows.append(
+            [
+                "Franka-like 7R: `singular_configurations` of the 6×7 J_s",
+                why,
+                "≤ 60 s",
+                targets.upper("6×7 singular set", None, T_SINGULAR_7),
+            ]
+        )
         rows.append(["Franka-like 7R: `find_singularities`", why, "—", "—"])
     else:
         kind = ("complete" if out["complete"] else "partial (says so)") + f", {out['count']} condition(s)"
-        rows.append([f"Franka-like 7R: `singular_configurations` of the 6×7 J_s ({kind})", fmt_t(out["seconds"]),
-                     "≤ 60 s", targets.upper("6×7 singular set", out["seconds"], T_SINGULAR_7)])
-        rows.append([f"Franka-like 7R: `find_singularities` ({out['points']} configurations, σ_min ≤ "
-                     f"{out['sigma']:.1e})", fmt_t(out["search"]), "—", "reported"])
+        rows.append(
+            [
+                f"Franka-like 7R: `singular_configurations` of the 6×7 J_s ({kind})",
+                fmt_t(out["seconds"]),
+                "≤ 60 s",
+                targets.upper("6×7 singular set", out["seconds"], T_SINGULAR_7),
+            ]
+        )
+        rows.append(
+            [
+                f"Franka-like 7R: `find_singularities` ({out['points']} configurations, σ_min ≤ {out['sigma']:.1e})",
+                fmt_t(out["search"]),
+                "—",
+                "reported",
+            ]
+        )
     from kinlib.manipulability import condition_number, isotropy
+
     L1, L2 = sp.symbols("L1 L2", positive=True)
-    r2 = kinlib.SerialChain(sp.Matrix([[1, 0, 0, L1 + L2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
-                            [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0]], name="planar_2r")
+    r2 = kinlib.SerialChain(
+        sp.Matrix([[1, 0, 0, L1 + L2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+        [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0]],
+        name="planar_2r",
+    )
     Jt = kinlib.task_rows(r2.jacobian_geometric(), ["vx", "vy"])
 
     def cond():
@@ -540,15 +725,27 @@ def analysis_section(args, targets: Targets) -> list[str]:
         return CLOCK() - t0, k, iso
 
     tc, k, _ = min(cond() for _ in range(1 if args.quick else 3))
-    rows.append([f"planar 2R (L1, L2 symbolic): symbolic condition number and isotropy ({sp.count_ops(k)} operations)",
-                 fmt_t(tc), "≤ 2 s", targets.upper("symbolic condition number, planar 2R", tc, T_COND_2R)])
+    rows.append(
+        [
+            f"planar 2R (L1, L2 symbolic): symbolic condition number and isotropy ({sp.count_ops(k)} operations)",
+            fmt_t(tc),
+            "≤ 2 s",
+            targets.upper("symbolic condition number, planar 2R", tc, T_COND_2R),
+        ]
+    )
     return lines + table(["what", "time", "target", "status"], rows) + ["", f"κ(θ) = `{k}`"]
 
 
 def notebook_section(args, targets: Targets) -> list[str]:
     lines = ["## Notebooks (executed with nbclient in a temporary copy, kernel start included)", ""]
-    expected = ["01_properties_of_jacobians", "02_planar_robot_jacobian", "03_spatial_robot_jacobian",
-                "04_interpreting_the_jacobian", "05_singularities_planar", "06_singularities_spatial"]
+    expected = [
+        "01_properties_of_jacobians",
+        "02_planar_robot_jacobian",
+        "03_spatial_robot_jacobian",
+        "04_interpreting_the_jacobian",
+        "05_singularities_planar",
+        "06_singularities_spatial",
+    ]
     present = {p.stem: p for p in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))}
     names = expected + [s for s in present if s not in expected]
     rows = []
@@ -556,6 +753,7 @@ def notebook_section(args, targets: Targets) -> list[str]:
         return lines + ["skipped (--quick)"]
     import nbformat
     from nbclient import NotebookClient
+
     with tempfile.TemporaryDirectory() as tmp:
         work = Path(tmp) / "notebooks"
         shutil.copytree(ROOT / "notebooks", work)
@@ -565,8 +763,7 @@ def notebook_section(args, targets: Targets) -> list[str]:
                 continue
             path = work / present[stem].name
             nb = nbformat.read(path, as_version=4)
-            client = NotebookClient(nb, timeout=120, kernel_name="python3",
-                                    resources={"metadata": {"path": str(work)}})
+            client = NotebookClient(nb, timeout=120, kernel_name="python3", resources={"metadata": {"path": str(work)}})
             t0 = time.perf_counter()
             try:
                 client.execute()
@@ -603,6 +800,7 @@ def explorer_section(args, targets: Targets) -> list[str]:
             def move():
                 k[0] ^= 1
                 ex.update(qs[k[0]])
+
             t = once(move, max(5, args.reps))
             rows.append([chain.name, fmt_t(t), "≤ 50 ms", targets.upper(f"explorer redraw {chain.name}", t, T_REDRAW)])
         except Exception as exc:
@@ -612,11 +810,11 @@ def explorer_section(args, targets: Targets) -> list[str]:
 
 
 def grader_section(args, targets: Targets) -> list[str]:
-    lines = ["## Instructor checker (`python -m kinlib.grade`)", ""]
+    lines = ["## Instructor checker (`kinlib grade`)", ""]
     if args.quick:
         return lines + ["skipped (--quick)"]
-    if not (ROOT / "kinlib" / "grade.py").exists():
-        return lines + [f"{NA} (kinlib.grade missing)"]
+    if not (ROOT / "kinlib" / "course" / "grade.py").exists():
+        return lines + [f"{NA} (kinlib.course.grade missing)"]
     sols = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
     if not sols:
         return lines + [f"{NA} (no solution notebook to grade)"]
@@ -630,16 +828,37 @@ def grader_section(args, targets: Targets) -> list[str]:
         shutil.copy(sol, warm / "student_0.ipynb")
         for i in range(copies):
             shutil.copy(sol, subs / f"student_{i + 1}.ipynb")
-        base = [sys.executable, "-m", "kinlib.grade", "--notebooks", str(ROOT / "notebooks"),
-                "--cache", str(tmp / "cache"), "--jobs", "2", "--quiet"]
+        base = [
+            sys.executable,
+            "-m",
+            "kinlib.course",
+            "grade",
+            "--notebooks",
+            str(ROOT / "notebooks"),
+            "--cache",
+            str(tmp / "cache"),
+            "--jobs",
+            "2",
+            "--quiet",
+        ]
         try:
             t0 = time.perf_counter()
-            p0 = subprocess.run(base + [str(warm), "--out", str(tmp / "out0")], capture_output=True, text=True,
-                                timeout=args.grade_timeout, cwd=ROOT)
+            p0 = subprocess.run(
+                base + [str(warm), "--out", str(tmp / "out0")],
+                capture_output=True,
+                text=True,
+                timeout=args.grade_timeout,
+                cwd=ROOT,
+            )
             t_first = time.perf_counter() - t0
             t0 = time.perf_counter()
-            p = subprocess.run(base + [str(subs), "--out", str(tmp / "out")], capture_output=True, text=True,
-                               timeout=args.grade_timeout, cwd=ROOT)
+            p = subprocess.run(
+                base + [str(subs), "--out", str(tmp / "out")],
+                capture_output=True,
+                text=True,
+                timeout=args.grade_timeout,
+                cwd=ROOT,
+            )
             dt = time.perf_counter() - t0
         except subprocess.TimeoutExpired:
             return lines + [f"did not finish in {args.grade_timeout:.0f} s"]
@@ -648,9 +867,14 @@ def grader_section(args, targets: Targets) -> list[str]:
             return lines + [f"error (exit {p0.returncode}/{p.returncode}): `{err}`"]
         csv = (tmp / "out" / "grades.csv").read_text().splitlines()[1:] if (tmp / "out" / "grades.csv").exists() else []
         passed = sum(1 for r in csv if ",pass," in r)
-        rows = [[f"1 copy of {sol.name}, reference answers not yet cached", fmt_t(t_first), "—"],
-                [f"{copies} copies, --jobs 2, reference cached", fmt_t(dt),
-                 f"{60 * copies / dt:.1f} submissions/min ({fmt_t(dt / copies)} each); {passed}/{len(csv)} parts pass"]]
+        rows = [
+            [f"1 copy of {sol.name}, reference answers not yet cached", fmt_t(t_first), "—"],
+            [
+                f"{copies} copies, --jobs 2, reference cached",
+                fmt_t(dt),
+                f"{60 * copies / dt:.1f} submissions/min ({fmt_t(dt / copies)} each); {passed}/{len(csv)} parts pass",
+            ],
+        ]
     return lines + table(["batch", "wall time", "throughput"], rows)
 
 
@@ -664,13 +888,16 @@ def import_section(args, targets: Targets) -> list[str]:
     cpu = statistics.median(t[1] for t in times)  # CPU time of the whole process up to the end of the import
     return ["## `import kinlib` (fresh interpreter, median of several)", ""] + table(
         ["what", "wall time", "CPU time (interpreter start included)", "target", "status (CPU time)"],
-        [["import kinlib", fmt_t(wall), fmt_t(cpu), "≤ 0.6 s", targets.upper("import kinlib", cpu, T_IMPORT)]])
+        [["import kinlib", fmt_t(wall), fmt_t(cpu), "≤ 0.6 s", targets.upper("import kinlib", cpu, T_IMPORT)]],
+    )
 
 
 # --- main ------------------------------------------------------------------------------------------
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", type=Path, default=ROOT / "build" / "bench.md", help="markdown report (default build/bench.md)")
+    ap.add_argument(
+        "--out", type=Path, default=ROOT / "build" / "bench.md", help="markdown report (default build/bench.md)"
+    )
     ap.add_argument("--reps", type=int, default=7, help="timeit repetitions (median taken; default 7)")
     ap.add_argument("--batch", type=int, default=100_000, help="configurations in a batch (default 100000)")
     ap.add_argument("--mr-batch", type=int, default=200, help="configurations in modern-robotics' batch loop")
@@ -690,8 +917,17 @@ def main(argv=None) -> int:
     targets = Targets()
     head = machine()
     sections = []
-    for fn in (numeric_section, first_call_section, symbolic_section, exact_section, analysis_section,
-               notebook_section, explorer_section, grader_section, import_section):
+    for fn in (
+        numeric_section,
+        first_call_section,
+        symbolic_section,
+        exact_section,
+        analysis_section,
+        notebook_section,
+        explorer_section,
+        grader_section,
+        import_section,
+    ):
         t0 = time.perf_counter()
         sections.append(fn(args, targets))
         print(f"[bench] {fn.__name__}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)
@@ -701,11 +937,22 @@ def main(argv=None) -> int:
     if missed:
         summary += ["", "Missed or not measured:", ""] + [f"- {w}: {m}" for w, _, m in missed]
     total = time.perf_counter() - t_start
-    doc = ["# kinlib benchmark", "", f"`python bench/bench.py` ({'--quick, ' if args.quick else ''}"
-           f"medians of {args.reps} timeit runs; whole run {total:.0f} s). In-process figures are this "
-           f"thread's CPU time (`time.thread_time`: on a shared machine, what the code costs, while wall time "
-           f"also counts the time other processes hold the core); notebook executions and the checker are "
-           f"wall time (they run kernels in other processes).", ""] + head + [""] + summary + [""]
+    doc = (
+        [
+            "# kinlib benchmark",
+            "",
+            f"`python bench/bench.py` ({'--quick, ' if args.quick else ''}"
+            f"medians of {args.reps} timeit runs; whole run {total:.0f} s). In-process figures are this "
+            f"thread's CPU time (`time.thread_time`: on a shared machine, what the code costs, while wall time "
+            f"also counts the time other processes hold the core); notebook executions and the checker are "
+            f"wall time (they run kernels in other processes).",
+            "",
+        ]
+        + head
+        + [""]
+        + summary
+        + [""]
+    )
     for s in sections:
         doc += s + [""]
     text = "\n".join(doc)

@@ -5,47 +5,80 @@ A SymPy argument gives an exact SymPy Matrix; plain numbers give NumPy float arr
 
 Jacobians: ``jacobian_space`` (V_s = J_s θ̇), ``jacobian_body`` (V_b = J_b θ̇) and
 ``geometric_jacobian`` ([ω_s; ṗ] = J θ̇, J = blockdiag(R, R) J_b), the problem set's "geometric Jacobian".
-Plotting and widgets live in ``kinlib.plotting`` and ``kinlib.widgets`` (imported on demand).
+Yoshikawa's measure is ``kinlib.manipulability.manipulability`` (``kinlib.manipulability`` is the module of
+all the measures). Plotting and widgets live in ``kinlib.plotting`` and ``kinlib.widgets``, the course tooling
+(handouts, self-checks, grading) in ``kinlib.course``; ``import kinlib`` loads none of them.
+
+>>> import kinlib
+>>> J = kinlib.robots.planar_2r(1, 1).jacobian_geometric([0, 0])   # [ω_s; ṗ], 6×2
+>>> J[4].tolist()                                                      # ṗ_y = 2 θ̇1 + θ̇2
+[2.0, 1.0]
 """
-from .rigid import adjoint, check_se3, check_so3, exp3, rp_to_trans, skew, trans_inv, trans_to_rp, unskew
-from .screws import bracket, exp6, screw_axis, screw_prismatic, screw_revolute, unbracket
-from .jacobians import (
-    angular_first, body_to_geometric, body_to_space, geometric_jacobian, geometric_to_body,
-    geometric_to_space, jacobian_body, jacobian_space, linear_first, position_jacobian,
-    space_to_body, space_to_geometric,
-)
+
+from . import manipulability, robots, taskspace
 from .chains import SerialChain, fk_body, fk_space
-from .singularities import (
-    IncompleteResultWarning, SingularSet, column_space, evaluate_at, left_null_space, rank_at,
-    singular_configurations, task_rows,
-)
+from .display import is_identically_zero, simplify_for_display
 from .exact import ConditionalResultWarning, NumericFallbackWarning, Rank
+from .jacobians import (
+    angular_first,
+    body_to_geometric,
+    body_to_space,
+    geometric_jacobian,
+    geometric_to_body,
+    geometric_to_space,
+    jacobian_body,
+    jacobian_space,
+    linear_first,
+    position_jacobian,
+    space_to_body,
+    space_to_geometric,
+)
+from .manipulability import condition_number, isotropy, twist_speed_form, velocity_ellipsoid
+from .rigid import adjoint, check_se3, check_so3, exp3, log3, rp_to_trans, skew, trans_inv, trans_to_rp, unskew
+from .screws import bracket, exp6, log6, screw_axis, screw_prismatic, screw_revolute, unbracket
 from .singular_search import SingularPoints, find_singularities
-from .rigid import log3
-from .screws import log6
+from .singularities import (
+    IncompleteResultWarning,
+    SingularSet,
+    column_space,
+    evaluate_at,
+    left_null_space,
+    rank_at,
+    singular_configurations,
+    task_rows,
+)
 from .velocity import (
-    PinvReport, SingularityWarning, damped_least_squares, force_ellipsoid, inverse_velocity, joint_torques,
+    PinvReport,
+    SingularityWarning,
+    damped_least_squares,
+    force_ellipsoid,
+    inverse_velocity,
+    joint_torques,
     pseudoinverse,
 )
-from .manipulability import (
-    condition_number, isotropy, manipulability, twist_speed_form, velocity_ellipsoid,
-)
-from .display import is_identically_zero, simplify_for_display
-from . import robots
 
 __version__ = "0.1.0"
 
+# grouped as in the textbook
+# fmt: off
 __all__ = [
-    "skew", "unskew", "exp3", "rp_to_trans", "trans_to_rp", "trans_inv", "adjoint", "check_so3", "check_se3",
-    "screw_revolute", "screw_prismatic", "screw_axis", "bracket", "unbracket", "exp6",
-    "fk_space", "fk_body", "SerialChain",
-    "jacobian_space", "jacobian_body", "geometric_jacobian", "space_to_body", "body_to_space",
-    "body_to_geometric", "geometric_to_body", "space_to_geometric", "geometric_to_space",
-    "linear_first", "angular_first", "position_jacobian", "robots",
-    "task_rows", "singular_configurations", "SingularSet", "IncompleteResultWarning", "find_singularities",
-    "SingularPoints", "rank_at", "column_space", "left_null_space", "evaluate_at", "Rank", "NumericFallbackWarning",
-    "ConditionalResultWarning", "log3", "log6", "pseudoinverse", "inverse_velocity", "damped_least_squares",
-    "joint_torques", "force_ellipsoid", "PinvReport", "SingularityWarning",
+    # rigid motions, screws and the product of exponentials (Modern Robotics, chapters 3-4)
+    "skew", "unskew", "exp3", "log3", "rp_to_trans", "trans_to_rp", "trans_inv", "adjoint", "check_so3", "check_se3",
+    "screw_revolute", "screw_prismatic", "screw_axis", "bracket", "unbracket", "exp6", "log6",
+    "fk_space", "fk_body", "SerialChain", "robots",
+    # Jacobians (chapter 5): space, body and the problem set's geometric J = blockdiag(R, R) J_b
+    "jacobian_space", "jacobian_body", "geometric_jacobian", "space_to_body", "body_to_space", "body_to_geometric",
+    "geometric_to_body", "space_to_geometric", "geometric_to_space", "linear_first", "angular_first",
+    "position_jacobian",
+    # task spaces, singularities, exact answers at a configuration
+    "taskspace", "task_rows", "singular_configurations", "SingularSet", "IncompleteResultWarning",
+    "find_singularities", "SingularPoints", "rank_at", "column_space", "left_null_space", "evaluate_at", "Rank",
+    "NumericFallbackWarning", "ConditionalResultWarning",
+    # manipulability and velocity kinematics, statics
     "manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
+    "pseudoinverse", "inverse_velocity", "damped_least_squares", "joint_torques", "force_ellipsoid", "PinvReport",
+    "SingularityWarning",
+    # exact display
     "simplify_for_display", "is_identically_zero",
 ]
+# fmt: on

@@ -7,19 +7,34 @@ arrays) select the numeric backend: results are NumPy float arrays.
 Every check raises ``ValueError``/``TypeError`` naming the argument, the expected shape or
 property, and what was given.
 """
+
 from __future__ import annotations
 
+import math
 import numbers
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
-__all__ = ["is_symbolic", "as_matrix", "as_vector", "as_screw_list", "as_thetas", "describe", "exact_number",
-           "check_real_finite", "real_array", "exact_floats",
-           "joint_symbols"]
-
-_ZERO_TOL = 1e-9
+__all__ = [
+    "is_symbolic",
+    "as_matrix",
+    "as_vector",
+    "as_screw_list",
+    "as_thetas",
+    "describe",
+    "exact_number",
+    "check_real_finite",
+    "real_array",
+    "exact_floats",
+    "joint_symbols",
+    "as_scalar",
+    "as_jacobian",
+    "numeric_jacobian",
+    "numeric_vectors",
+    "exact_jacobian",
+]
 
 
 def describe(x: Any) -> str:
@@ -52,6 +67,7 @@ def exact_number(x: Any, name: str) -> sp.Expr:
     """
     import decimal
     import fractions
+
     if isinstance(x, (bool, np.bool_)):
         raise TypeError(f"{name} must be a real number, got the bool {x!r}")
     if isinstance(x, (str, bytes)) or x is None:
@@ -99,15 +115,19 @@ def check_real_finite(e: sp.Expr, name: str, symbols: bool = True) -> sp.Expr:
         if isinstance(e, _NOT_FINITE_TYPES):
             raise ValueError(f"{name} must be real and finite, got {e}")
         if symbols and e.is_Symbol and e.is_real is not True:
-            raise ValueError(f"{name} must be real: the symbol {e} is not declared real "
-                             f"(use sp.Symbol({str(e)!r}, real=True) or positive=True), got {e}")
+            raise ValueError(
+                f"{name} must be real: the symbol {e} is not declared real "
+                f"(use sp.Symbol({str(e)!r}, real=True) or positive=True), got {e}"
+            )
         return e
-    if e.atoms(*_NOT_FINITE_TYPES):   # one traversal: I, nan, oo, -oo, zoo anywhere
+    if e.atoms(*_NOT_FINITE_TYPES):  # one traversal: I, nan, oo, -oo, zoo anywhere
         raise ValueError(f"{name} must be real and finite, got {str(e)[:200]}")
     bad = sorted((s for s in e.free_symbols if s.is_real is not True), key=str) if symbols else []
     if bad:
-        raise ValueError(f"{name} must be real: the symbol(s) {', '.join(map(str, bad))} are not declared real "
-                         f"(use sp.Symbol(..., real=True) or positive=True), got {str(e)[:200]}")
+        raise ValueError(
+            f"{name} must be real: the symbol(s) {', '.join(map(str, bad))} are not declared real "
+            f"(use sp.Symbol(..., real=True) or positive=True), got {str(e)[:200]}"
+        )
     if e.is_number and e.is_real is False:
         raise ValueError(f"{name} must be real, got {str(e)[:200]}")
     return e
@@ -173,8 +193,13 @@ def _check_scalar(e: Any, name: str, symbolic: bool, real_symbols: bool = False)
     raise TypeError(f"{name} must hold real numbers, got {describe(e)}")
 
 
-def as_matrix(x: Any, name: str, shape: tuple[int | None, int | None] | None = None,
-              symbolic: bool | None = None, real_symbols: bool = False):
+def as_matrix(
+    x: Any,
+    name: str,
+    shape: tuple[int | None, int | None] | None = None,
+    symbolic: bool | None = None,
+    real_symbols: bool = False,
+):
     """``x`` as a 2-D SymPy Matrix (symbolic) or float array (numeric), shape-checked.
 
     ``shape`` entries of ``None`` accept any size along that axis.
@@ -205,8 +230,7 @@ def as_matrix(x: Any, name: str, shape: tuple[int | None, int | None] | None = N
     return np.array(rows, dtype=float).reshape(got_shape)
 
 
-def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None,
-              real_symbols: bool = False):
+def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None, real_symbols: bool = False):
     """``x`` as a column: SymPy Matrix (k×1) when symbolic, 1-D float array otherwise.
 
     Accepts a flat sequence, a 1-D array, or a column/row matrix.
@@ -281,20 +305,6 @@ def _fmt_shape(shape) -> str:
     return "(" + ", ".join("n" if s is None else str(s) for s in shape) + ")"
 
 
-def is_zero(e: Any) -> bool:
-    """Exact zero test for a SymPy expression (simplifies only when needed)."""
-    if e == 0:
-        return True
-    if not isinstance(e, sp.Basic) or not e.free_symbols:
-        # exact numbers: zero to 25 digits; numbers carrying Floats (from float input): zero to float precision
-        tol = 1e-9 if isinstance(e, sp.Basic) and e.has(sp.Float) else 1e-25
-        try:
-            return abs(complex(sp.N(e, 30))) < tol
-        except (TypeError, ValueError):
-            pass
-    return sp.simplify(e) == 0
-
-
 def real_array(x, name: str, want: str) -> np.ndarray:
     """``x`` as a float array after refusing str/bytes/None/bool/complex entries and NaN/±inf.
 
@@ -303,14 +313,17 @@ def real_array(x, name: str, want: str) -> np.ndarray:
     """
     if isinstance(x, (str, bytes)) or x is None or isinstance(x, (bool, np.bool_, numbers.Number)):
         raise TypeError(f"{name} must be {want}, got {describe(x)}")
-    if isinstance(x, (list, tuple)):     # NumPy would turn [True, 2.0] into [1.0, 2.0]: look at the entries first
+    if isinstance(x, (list, tuple)):  # NumPy would turn [True, 2.0] into [1.0, 2.0]: look at the entries first
         stack = [x]
         while stack:
             for e in stack.pop():
                 if isinstance(e, (list, tuple, np.ndarray)):
                     stack.append(e)
-                elif isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or e is None \
-                        or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                elif (
+                    isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating))
+                    or e is None
+                    or not isinstance(e, (numbers.Real, np.integer, np.floating))
+                ):
                     raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)} in {describe(x)}")
     try:
         a = np.asarray(x)
@@ -322,8 +335,11 @@ def real_array(x, name: str, want: str) -> np.ndarray:
         raise TypeError(f"{name} must hold real numbers, got complex numbers ({describe(x)})")
     if a.dtype.kind not in "iuf":
         for e in a.reshape(-1):
-            if isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None \
-                    or not isinstance(e, (numbers.Real, np.integer, np.floating)):
+            if (
+                isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating))
+                or e is None
+                or not isinstance(e, (numbers.Real, np.integer, np.floating))
+            ):
                 raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)}")
         a = a.astype(float)
     a = a.astype(float, copy=False)
@@ -347,16 +363,73 @@ def joint_symbols(thetas: Any, n: int | None = None, name: str = "thetas", per: 
         raise TypeError(f"{name} must be a sequence of {count}SymPy symbols ({per}), got {describe(thetas)}")
     thetas = tuple(thetas)
     if not all(isinstance(t, sp.Symbol) for t in thetas):
-        raise TypeError(f"{name} must be a sequence of {count}SymPy symbols ({per}), got {describe(list(thetas))}: "
-                        f"{', '.join(map(repr, thetas))[:120]}")
+        raise TypeError(
+            f"{name} must be a sequence of {count}SymPy symbols ({per}), got {describe(list(thetas))}: "
+            f"{', '.join(map(repr, thetas))[:120]}"
+        )
     if n is not None and len(thetas) != n:
-        raise ValueError(f"{name} must be {count}SymPy symbols ({per}), got {describe(list(thetas))}: "
-                         f"{', '.join(map(repr, thetas))[:120]}")
+        raise ValueError(
+            f"{name} must be {count}SymPy symbols ({per}), got {describe(list(thetas))}: "
+            f"{', '.join(map(repr, thetas))[:120]}"
+        )
     if len(set(thetas)) != len(thetas):
         raise ValueError(f"{name} must hold distinct symbols, got {', '.join(map(str, thetas))}")
     for i, t in enumerate(thetas):
         if t.is_real is not True:
-            raise ValueError(f"{name}[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)): joint values "
-                             f"are real, got the symbol {t} with no real assumption (declared real) in "
-                             f"{name} = ({', '.join(map(str, thetas))})")
+            raise ValueError(
+                f"{name}[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)): joint values "
+                f"are real, got the symbol {t} with no real assumption (declared real) in "
+                f"{name} = ({', '.join(map(str, thetas))})"
+            )
     return thetas
+
+
+def as_scalar(x, name: str, symbolic: bool):
+    """A joint value / pitch: exact (symbolic; 0.1 → 1/10) or a finite float; anything else refused."""
+    if symbolic:
+        if isinstance(x, sp.Basic) and not isinstance(x, sp.Float):
+            if not isinstance(x, sp.Expr):
+                raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
+            return check_real_finite(exact_floats(x, name), name)
+        return exact_number(x, name)
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (numbers.Real, np.integer, np.floating)):
+        if isinstance(x, (complex, np.complexfloating)):
+            raise TypeError(f"{name} must be a real number, got the complex number {x!r}")
+        raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
+    x = float(x)
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be a finite real number, got {x!r}")
+    return x
+
+
+def as_jacobian(J: Any, name: str = "J", symbolic: bool | None = None):
+    """J as a 2-D SymPy Matrix (symbolic) or float array; a clear error for anything else."""
+    if not isinstance(J, (sp.MatrixBase, np.ndarray, list, tuple)):
+        raise TypeError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
+    if isinstance(J, np.ndarray) and J.ndim != 2:
+        raise ValueError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
+    return as_matrix(J, name, None, symbolic)
+
+
+def numeric_jacobian(J: Any, name: str = "J") -> np.ndarray:
+    """J as floats, shape (m, n) or a batch (N, m, n), m, n ≥ 1; refuses non-real entries and NaN/±inf."""
+    A = real_array(J, name, "a Jacobian (m, n) or a batch (N, m, n) of real numbers")
+    if A.ndim not in (2, 3) or 0 in A.shape:
+        raise ValueError(f"{name} must be a Jacobian (m, n) or a batch (N, m, n) with m, n ≥ 1, got {describe(J)}")
+    return A
+
+
+def numeric_vectors(x: Any, name: str, m: int, what: str) -> np.ndarray:
+    """x as floats, one vector (m,) or a batch (N, m), matching a Jacobian; ``what`` names it in errors."""
+    a = real_array(x, name, f"{what} of length {m} (or a batch (N, {m}))")
+    if a.ndim not in (1, 2) or a.shape[-1] != m:
+        raise ValueError(f"{name} must be {what} of length {m} (or a batch (N, {m})) to match J, got {describe(x)}")
+    return a
+
+
+def exact_jacobian(J: Any, name: str = "J") -> sp.Matrix:
+    """J as a SymPy Matrix with at least one row and one column; floats become the decimals typed."""
+    M = as_matrix(J, name, None, True)
+    if M.rows == 0 or M.cols == 0:
+        raise ValueError(f"{name} must have at least one row and one column, got {describe(M)}")
+    return M.applyfunc(lambda e: exact_number(e, name))  # Floats → the decimal typed; refuses I, nan, oo

@@ -3,48 +3,33 @@
 Space form:  T(θ) = e^{[S1]θ1} e^{[S2]θ2} ⋯ e^{[Sn]θn} M
 Body form:   T(θ) = M e^{[B1]θ1} ⋯ e^{[Bn]θn},  with B_i = Ad_{M⁻¹} S_i.
 """
+
 from __future__ import annotations
 
 import numbers
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import sympy as sp
 
 from ._backend import (
-    as_matrix, as_screw_list, as_thetas, as_vector, describe, exact_number, is_symbolic, joint_symbols,
+    as_matrix,
+    as_screw_list,
+    as_thetas,
+    as_vector,
+    describe,
+    exact_number,
+    is_symbolic,
+    joint_symbols,
 )
 from .codegen import CompiledMatrix
-from .jacobians import _prepare, jacobian_body as _jacobian_body, jacobian_space as _jacobian_space
+from .jacobians import jacobian_body as _jacobian_body
+from .jacobians import jacobian_space as _jacobian_space
+from .poe import checked_screw_list, fk_body, fk_space
 from .rigid import adjoint, check_se3, cross, skew, trans_inv
-from .screws import _exp6
 from .tape import Tape
 
 __all__ = ["fk_space", "fk_body", "SerialChain"]
-
-
-def fk_space(M, Slist, thetas):
-    """T(θ) = e^{[S1]θ1} ⋯ e^{[Sn]θn} M: the end-effector pose from the space screw axes."""
-    symbolic = is_symbolic(M, Slist, thetas)
-    M = check_se3(as_matrix(M, "M", None, symbolic, real_symbols=True), "M")
-    S, th, kinds, _ = _prepare(Slist, thetas, "Slist", symbolic)
-    T = sp.eye(4) if symbolic else np.eye(4)
-    for i in range(S.shape[1]):
-        E = _exp6(S[:, i], th[i], kinds[i], symbolic)
-        T = T * E if symbolic else T @ E
-    return T * M if symbolic else T @ M
-
-
-def fk_body(M, Blist, thetas):
-    """T(θ) = M e^{[B1]θ1} ⋯ e^{[Bn]θn}: the end-effector pose from the body screw axes."""
-    symbolic = is_symbolic(M, Blist, thetas)
-    M = check_se3(as_matrix(M, "M", None, symbolic, real_symbols=True), "M")
-    B, th, kinds, _ = _prepare(Blist, thetas, "Blist", symbolic)
-    T = M
-    for i in range(B.shape[1]):
-        E = _exp6(B[:, i], th[i], kinds[i], symbolic)
-        T = T * E if symbolic else T @ E
-    return T
 
 
 _F8 = np.dtype(float)
@@ -86,8 +71,16 @@ class SerialChain:
     2.0
     """
 
-    def __init__(self, M, screws, *, name: str = "chain", thetas: Sequence[sp.Symbol] | None = None,
-                 joint_points=None, description: str = ""):
+    def __init__(
+        self,
+        M,
+        screws,
+        *,
+        name: str = "chain",
+        thetas: Sequence[sp.Symbol] | None = None,
+        joint_points=None,
+        description: str = "",
+    ):
         for arg, value in (("name", name), ("description", description)):
             if not isinstance(value, str):
                 raise TypeError(f"{arg} must be a string, got {describe(value)}")
@@ -99,14 +92,14 @@ class SerialChain:
         if thetas is None:
             thetas = _joint_symbols(n)
         thetas = joint_symbols(thetas, n, per="one per screw axis")
-        _, _, kinds, _ = _prepare(S, list(thetas), "screws")
+        _, _, kinds, _ = checked_screw_list(S, list(thetas), "screws")
         self.name = name
         self.description = description
         self.M = M
         self.screws = S
         self.thetas = thetas
         self.n = n
-        self._vec_shape = (n,)         # the shape of one configuration (the fast path compares it)
+        self._vec_shape = (n,)  # the shape of one configuration (the fast path compares it)
         self.joint_types = "".join(kinds)
         if joint_points is None:
             pts = []
@@ -117,22 +110,31 @@ class SerialChain:
         else:
             jp = joint_points
             if isinstance(jp, (list, tuple)) and len(jp) == n and all(np.size(p) == 3 for p in jp):
-                jp = sp.Matrix.hstack(*[as_vector(p, f"joint_points[{i}]", 3, True, real_symbols=True)
-                                        for i, p in enumerate(jp)])
+                jp = sp.Matrix.hstack(
+                    *[as_vector(p, f"joint_points[{i}]", 3, True, real_symbols=True) for i, p in enumerate(jp)]
+                )
             joint_points = as_matrix(jp, "joint_points", (3, n), True, real_symbols=True)
         self.joint_points = joint_points
         syms = set().union(M.free_symbols, S.free_symbols, joint_points.free_symbols)
         self.params = tuple(sorted(syms - set(thetas), key=str))
         self._sym: dict[str, sp.Matrix] = {}
         self._num: dict[str, CompiledMatrix] = {}
+        self._numeric_cache: dict[tuple, SerialChain] = {}
 
     # --- the book's objects ------------------------------------------------------------------
     @property
     def body_screws(self) -> sp.Matrix:
-        """B_i = Ad_{M⁻¹} S_i (6×n, one per column)."""
+        """B_i = Ad_{M⁻¹} S_i (6×n, one per column).
+
+        >>> from kinlib.robots import planar_2r
+        >>> planar_2r().body_screws.T   # the joint axes seen from the tool frame at home
+        Matrix([
+        [0, 0, 1, 0, L1 + L2, 0],
+        [0, 0, 1, 0,      L2, 0]])
+        """
         return adjoint(trans_inv(self.M)) * self.screws
 
-    def subs(self, values: Mapping | None = None, **by_name) -> "SerialChain":
+    def subs(self, values: Mapping | None = None, **by_name) -> SerialChain:
         """A copy with parameters replaced: ``chain.subs(L=1)`` or ``chain.subs({L: 1})``.
 
         Values become exact as typed (``kinlib._backend.exact_number``: 0.1 → 1/10, 2.0 → 2) or are
@@ -151,8 +153,76 @@ class SerialChain:
             if key is None:
                 raise ValueError(f"{self.name} has no parameter {k!r}; its parameters are {sorted(names)}")
             table[key] = exact_number(v, str(key))
-        return SerialChain(self.M.subs(table), self.screws.subs(table), name=self.name, thetas=self.thetas,
-                           joint_points=self.joint_points.subs(table), description=self.description)
+        return SerialChain(
+            self.M.subs(table),
+            self.screws.subs(table),
+            name=self.name,
+            thetas=self.thetas,
+            joint_points=self.joint_points.subs(table),
+            description=self.description,
+        )
+
+    def numeric(self, params: Mapping | None = None) -> SerialChain:
+        """The chain with numbers for all its parameters (link lengths), ready to draw or evaluate fast.
+
+        ``params`` maps parameters (symbols or their names) to numbers, as :meth:`subs`; the chain itself when
+        it has no parameters left. A ValueError names the parameters still symbolic. Results are cached on the
+        chain (so repeated calls with the same numbers, e.g. from a slider, return the same chain).
+
+        >>> from kinlib import robots
+        >>> robots.planar_2r().numeric({"L1": 1, "L2": 0.5}).M[0, 3]
+        3/2
+        >>> robots.planar_2r().numeric({"L1": 1})
+        Traceback (most recent call last):
+        ...
+        ValueError: planar_2r still has the symbolic parameter(s) L2: give numbers for them, e.g. params={'L2': 1}
+        """
+        if params is not None and not isinstance(params, Mapping):
+            raise TypeError(f"params must be a dict of parameter values like {{'L': 1}}, got {describe(params)}")
+        chain = self
+        if params:
+            key = tuple(sorted((str(k), repr(v)) for k, v in params.items()))
+            chain = self._numeric_cache.get(key)
+            if chain is None:
+                for k, v in params.items():
+                    if isinstance(v, sp.Basic) and v.free_symbols:
+                        raise ValueError(f"params[{str(k)!r}] must be a number, got {describe(v)}")
+                chain = self.subs(params)
+                self._numeric_cache[key] = chain
+        if chain.params:
+            left = ", ".join(map(str, chain.params))
+            raise ValueError(
+                f"{self.name} still has the symbolic parameter(s) {left}: give numbers for them, "
+                f"e.g. params={{{str(chain.params[0])!r}: 1}}"
+            )
+        return chain
+
+    def joint_index(self, joint, name: str = "joint") -> int:
+        """0-based index of a joint given as its number 1…n (θ1…θn), its symbol, or its symbol's name.
+
+        >>> from kinlib import robots
+        >>> r = robots.planar_2r()
+        >>> r.joint_index(2), r.joint_index(r.thetas[0]), r.joint_index("theta2")
+        (1, 0, 1)
+        """
+        if isinstance(joint, sp.Symbol):
+            if joint in self.thetas:
+                return self.thetas.index(joint)
+            raise ValueError(f"{name}: {joint} is not a joint of {self.name} (joints {self.thetas}); got {joint}")
+        if isinstance(joint, str):
+            for i, t in enumerate(self.thetas):
+                if str(t) == joint:
+                    return i
+            raise ValueError(
+                f"{name}: not a joint of {self.name} (joints {tuple(map(str, self.thetas))}); got {joint!r}"
+            )
+        if isinstance(joint, (numbers.Integral, np.integer)) and not isinstance(joint, (bool, np.bool_)):
+            if 1 <= joint <= self.n:
+                return int(joint) - 1
+            raise ValueError(
+                f"{name} must be a joint number 1..{self.n} (as in θ1..θ{self.n}) for {self.name}, got {joint}"
+            )
+        raise TypeError(f"{name} must be a joint number 1..{self.n}, a joint symbol or its name, got {describe(joint)}")
 
     def __repr__(self) -> str:
         params = ", ".join(map(str, self.params)) or "none"
@@ -168,7 +238,9 @@ class SerialChain:
                 e = _jacobian_space(self.screws, th)
             elif what == "jb":
                 e = _jacobian_body(self.body_screws, th)
-            elif what == "jg":  # = space_to_geometric(J_s, T) without re-checking T (its SE(3) check costs seconds on big T)
+            elif (
+                what == "jg"
+            ):  # = space_to_geometric(J_s, T) without re-checking T (its SE(3) check costs seconds on big T)
                 js, p = self._expr("js"), self._expr("fk")[:3, 3]
                 e = sp.Matrix.vstack(js[:3, :], js[3:, :] - skew(p) * js[:3, :])
             elif what in ("fk_num", "js_num", "jb_num", "jg_num"):
@@ -211,20 +283,23 @@ class SerialChain:
             if c is not None:
                 if q.shape == self._vec_shape:
                     v = q.tolist()
-                    t = sum(v)         # nan/inf anywhere makes t − t nan (≈ 80 ns; np.isfinite(q).all() ≈ 1 µs);
-                    if t - t == 0.0:   # the rare finite q whose sum overflows just takes the checked path below
+                    t = sum(v)  # nan/inf anywhere makes t − t nan (≈ 80 ns; np.isfinite(q).all() ≈ 1 µs);
+                    if t - t == 0.0:  # the rare finite q whose sum overflows just takes the checked path below
                         return c._single(v)
                 elif q.ndim == 2 and q.shape[1] == self.n and np.isfinite(q).all():
                     return c(q)
         elif type(q) is list or type(q) is tuple:  # plain floats (and small ints): no array needed
             c = self._num.get(what)
-            if c is not None and len(q) == self.n and \
-                    all(isinstance(v, float) and v - v == 0.0 or type(v) is int and -2**53 <= v <= 2**53 for v in q):
-                return c._single(q)    # floats incl. np.float64; v - v == 0.0 is False for nan and ±inf
+            if (
+                c is not None
+                and len(q) == self.n
+                and all(isinstance(v, float) and v - v == 0.0 or type(v) is int and -(2**53) <= v <= 2**53 for v in q)
+            ):
+                return c._single(q)  # floats incl. np.float64; v - v == 0.0 is False for nan and ±inf
         if q is None:
             return self._expr(what)
         if is_symbolic(q):
-            expr = self._expr(what)    # numbers need only the generated code, not the whole symbolic matrix
+            expr = self._expr(what)  # numbers need only the generated code, not the whole symbolic matrix
             qs = q if not isinstance(q, sp.MatrixBase) else list(q)
             if isinstance(qs, (sp.Basic,)) and self.n == 1:
                 qs = [qs]
@@ -232,9 +307,12 @@ class SerialChain:
                 raise ValueError(f"q must hold {self.n} joint values for {self.name}, got {describe(q)}")
             # exact values (0.5 -> 1/2); I, nan, oo, strings, bools, non-real symbols refused
             vals = list(as_thetas(qs, self.n, "q", True))
-            return expr.xreplace(dict(zip(self.thetas, vals))) if all(v.is_Atom for v in vals) \
+            return (
+                expr.xreplace(dict(zip(self.thetas, vals)))
+                if all(v.is_Atom for v in vals)
                 else expr.subs(dict(zip(self.thetas, vals)), simultaneous=True)
-        q = self._joint_values(q)      # checked before any code generation (a bad q is named first)
+            )
+        q = self._joint_values(q)  # checked before any code generation (a bad q is named first)
         return self._compiled(what)(q)
 
     def _joint_values(self, q):
@@ -242,7 +320,7 @@ class SerialChain:
         n = self.n
         want = f"{n} real joint values (or an (N, {n}) batch)"
         if type(q) in (list, tuple) and len(q) == n and all(isinstance(v, float) for v in q):
-            arr = np.array(q, dtype=float)     # the common case: plain floats
+            arr = np.array(q, dtype=float)  # the common case: plain floats
         elif isinstance(q, np.ndarray) and q.dtype.kind in "fiu":
             arr = q.astype(float, copy=False)
         elif isinstance(q, (list, tuple, np.ndarray)):
@@ -251,21 +329,26 @@ class SerialChain:
                 raise ValueError(f"q must have shape ({n},) or (N, {n}) for this {n}-joint chain, got {describe(q)}")
             for idx in np.ndindex(obj.shape):
                 e = obj[idx]
-                if isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or \
-                        not isinstance(e, (numbers.Real, np.integer, np.floating)):
+                if isinstance(e, (bool, np.bool_, str, bytes, complex, np.complexfloating)) or not isinstance(
+                    e, (numbers.Real, np.integer, np.floating)
+                ):
                     raise TypeError(f"q must hold {want}, got {describe(q)} whose entry {list(idx)} is {describe(e)}")
             try:
                 arr = np.array(obj.tolist(), dtype=float)
             except OverflowError:
-                raise ValueError(f"q must hold {want}, got {describe(q)} with an integer too large for a float") from None
+                raise ValueError(
+                    f"q must hold {want}, got {describe(q)} with an integer too large for a float"
+                ) from None
         else:
             raise TypeError(f"q must hold {want}, got {describe(q)}")
         if arr.ndim not in (1, 2) or arr.shape[-1] != n:
             raise ValueError(f"q must have shape ({n},) or (N, {n}) for this {n}-joint chain, got {describe(q)}")
         if not np.isfinite(arr).all():
             bad = np.argwhere(~np.isfinite(arr))[0]
-            raise ValueError(f"q must hold {n} finite real joint values, got {describe(q)} whose entry "
-                             f"{bad.tolist()} is {float(arr[tuple(bad)])!r}")
+            raise ValueError(
+                f"q must hold {n} finite real joint values, got {describe(q)} whose entry "
+                f"{bad.tolist()} is {float(arr[tuple(bad)])!r}"
+            )
         return arr
 
     def _compiled(self, what: str) -> CompiledMatrix:
@@ -281,7 +364,8 @@ class SerialChain:
             if self.params:
                 raise ValueError(
                     f"{self.name} has symbolic parameters {', '.join(map(str, self.params))}: give them numbers "
-                    f"first, e.g. chain.subs({str(self.params[0])}=1), or pass SymPy joint values for an exact result")
+                    f"first, e.g. chain.subs({str(self.params[0])}=1), or pass SymPy joint values for an exact result"
+                )
             tp = Tape(self.n)
             rows = _poe_rows(self, what, _float_constant, lambda i: (tp.sin(i), tp.cos(i), tp.q(i)))
             self._num[what] = tp.compile(rows, self.thetas, f"{self.name}.{what}")
@@ -289,23 +373,74 @@ class SerialChain:
 
     # --- kinematics ------------------------------------------------------------------------------
     def fk(self, q=None):
-        """T(θ) = e^{[S1]θ1} ⋯ e^{[Sn]θn} M (4×4; (N, 4, 4) for a batch)."""
+        """T(θ) = e^{[S1]θ1} ⋯ e^{[Sn]θn} M (4×4; (N, 4, 4) for a batch).
+
+        >>> import numpy as np, sympy as sp
+        >>> from kinlib.robots import planar_2r
+        >>> planar_2r().fk([0, sp.pi / 2])   # SymPy values: exact; the elbow bent a right angle, tool at (L1, L2)
+        Matrix([
+        [0, -1, 0, L1],
+        [1,  0, 0, L2],
+        [0,  0, 1,  0],
+        [0,  0, 0,  1]])
+        >>> planar_2r(1, 1).fk(np.zeros((5, 2))).shape   # numbers: a batch of 5 configurations, floats
+        (5, 4, 4)
+        """
         return self._eval("fk", q)
 
     def jacobian_space(self, q=None):
-        """Space Jacobian J_s(θ), rows [ω; v] (6×n; (N, 6, n) for a batch): V_s = J_s θ̇."""
+        """Space Jacobian J_s(θ), rows [ω; v] (6×n; (N, 6, n) for a batch): V_s = J_s θ̇.
+
+        >>> from kinlib.robots import planar_2r
+        >>> planar_2r().jacobian_space().T   # q omitted: exact in θ1, θ2 (J_s never depends on the last joint)
+        Matrix([
+        [0, 0, 1,              0,               0, 0],
+        [0, 0, 1, L1*sin(theta1), -L1*cos(theta1), 0]])
+        """
         return self._eval("js", q)
 
     def jacobian_body(self, q=None):
-        """Body Jacobian J_b(θ) = Ad_{T⁻¹} J_s, rows [ω; v]: V_b = J_b θ̇."""
+        """Body Jacobian J_b(θ) = Ad_{T⁻¹} J_s, rows [ω; v]: V_b = J_b θ̇.
+
+        >>> import sympy as sp
+        >>> from kinlib.rigid import adjoint, trans_inv
+        >>> from kinlib.robots import planar_3r
+        >>> r, q = planar_3r(), [0, sp.pi / 2, 0]
+        >>> r.jacobian_body(q)[[2, 3, 4], :]   # rows ω_z, v_x, v_y in the tool frame
+        Matrix([
+        [      1,       1,  1],
+        [     L1,       0,  0],
+        [L2 + L3, L2 + L3, L3]])
+        >>> r.jacobian_body(q) == adjoint(trans_inv(r.fk(q))) * r.jacobian_space(q)
+        True
+        """
         return self._eval("jb", q)
 
     def jacobian_geometric(self, q=None):
-        """Geometric Jacobian J(θ) = blockdiag(R, R) J_b, rows [ω_s; ṗ]: angular velocity and tool-origin velocity in {s}."""
+        """Geometric Jacobian J(θ) = blockdiag(R, R) J_b, rows [ω_s; ṗ]: angular velocity and tool-origin
+        velocity in {s}.
+
+        >>> import numpy as np
+        >>> from kinlib.robots import planar_2r
+        >>> J = planar_2r(1, 1).jacobian_geometric([0.0, np.pi / 2])
+        >>> (J[[3, 4]].round(3) + 0.0).tolist()   # rows ṗ_x, ṗ_y
+        [[-1.0, -1.0], [1.0, 0.0]]
+        >>> round(float(np.linalg.det(J[[3, 4]])), 3)   # L1 L2 sin θ2
+        1.0
+        """
         return self._eval("jg", q)
 
     def skeleton(self, q=None):
-        """Points to draw the chain (3×(n+2)): base origin, each joint point, tool origin; (N, 3, n+2) for a batch."""
+        """Points to draw the chain (3×(n+2)): base origin, each joint point, tool origin; (N, 3, n+2) for a batch.
+
+        >>> import sympy as sp
+        >>> from kinlib.robots import planar_2r
+        >>> planar_2r().skeleton([0, sp.pi / 2])   # columns: base origin, joint 1, joint 2, tool origin
+        Matrix([
+        [0, 0, L1, L1],
+        [0, 0,  0, L2],
+        [0, 0,  0,  0]])
+        """
         return self._eval("skeleton", q)
 
 
@@ -351,8 +486,15 @@ def _exp_constants(S, kind: str, num):
     K0 = [[_I3[i][j] + W2[i][j] for j in range(3)] for i in range(3)]
     d, b = _mv(W2, v), _mv(W, v)
     a = _vadd(v, d)
-    return ("R", [[num(x) for x in row] for row in K0], [[num(x) for x in row] for row in W],
-            [[num(-x) for x in row] for row in W2], [num(x) for x in a], [num(x) for x in b], [num(x) for x in d])
+    return (
+        "R",
+        [[num(x) for x in row] for row in K0],
+        [[num(x) for x in row] for row in W],
+        [[num(-x) for x in row] for row in W2],
+        [num(x) for x in a],
+        [num(x) for x in b],
+        [num(x) for x in d],
+    )
 
 
 def _exp_apply(C, s, c, th, sign: int = 1):

@@ -27,12 +27,13 @@ float literals, ``c - a*b`` rather than ``-a*b + c``, ``(x*x)`` rather than ``x*
 numbers agree with the expression to rounding.
 ``CompiledMatrix.source`` holds the generated code.
 """
+
 from __future__ import annotations
 
 import math
 import re
 import struct
-from typing import Sequence
+from collections.abc import Sequence
 
 import numpy as np
 import sympy as sp
@@ -41,11 +42,20 @@ from sympy.printing.pycode import PythonCodePrinter
 
 from ._backend import describe
 
-__all__ = ["CompiledMatrix", "compile_matrix"]
+__all__ = ["CompiledMatrix"]
 
 _MATH = {name: getattr(math, name) for name in ("sin", "cos", "tan", "sqrt", "exp", "log", "atan2", "pi", "e")}
-_NUMPY = {"sin": np.sin, "cos": np.cos, "tan": np.tan, "sqrt": np.sqrt, "exp": np.exp, "log": np.log,
-          "atan2": np.arctan2, "pi": math.pi, "e": math.e}
+_NUMPY = {
+    "sin": np.sin,
+    "cos": np.cos,
+    "tan": np.tan,
+    "sqrt": np.sqrt,
+    "exp": np.exp,
+    "log": np.log,
+    "atan2": np.arctan2,
+    "pi": math.pi,
+    "e": math.e,
+}
 
 #: configurations per block in the batched code: the live temporaries of a block stay in cache
 BLOCK = 8192
@@ -159,8 +169,10 @@ def _half_angle(repl, reduced):
     named = {e: s for s, e in repl if e in calls}  # a temporary that is just sin(a) keeps its name
     sub, trig = {}, {}
     for k, a in enumerate(args):
-        pair = [named.get(sp.sin(a), sp.Symbol(f"_sin{k}")) if sp.sin(a) in calls else None,
-                named.get(sp.cos(a), sp.Symbol(f"_cos{k}")) if sp.cos(a) in calls else None]
+        pair = [
+            named.get(sp.sin(a), sp.Symbol(f"_sin{k}")) if sp.sin(a) in calls else None,
+            named.get(sp.cos(a), sp.Symbol(f"_cos{k}")) if sp.cos(a) in calls else None,
+        ]
         for f, sym in zip((sp.sin, sp.cos), pair):
             if sym is not None:
                 sub[f(a)] = sym
@@ -229,8 +241,12 @@ class _BatchEmitter:
         a, sin_s, cos_s = self.trig[s]
         h, r = self._alloc(), self._alloc()
         self._emit(a * sp.Rational(1, 2), h)
-        self.lines += [f"tan({h}, out={h})", f"_mul({h}, {h}, out={r})", f"_add({r}, 1.0, out={r})",
-                       f"_div(2.0, {r}, out={r})"]
+        self.lines += [
+            f"tan({h}, out={h})",
+            f"_mul({h}, {h}, out={r})",
+            f"_add({r}, 1.0, out={r})",
+            f"_div(2.0, {r}, out={r})",
+        ]
         for sym, row, line in ((sin_s, h, f"_mul({h}, {r}, out={h})"), (cos_s, r, f"_sub({r}, 1.0, out={r})")):
             if sym is None:
                 self._release(row)
@@ -370,8 +386,11 @@ class _BatchEmitter:
                 self.lines.append(f"{dest}[...] = {self.name[e]}")
                 neg = e in self.negated
         else:  # anything else: the NumPy expression as printed, assigned into dest
-            txt = self.pr.doprint(e.xreplace({s: (-1 if s in self.negated else 1) * sp.Symbol(n)
-                                              for s, n in self.name.items() if s.is_Symbol}))
+            txt = self.pr.doprint(
+                e.xreplace(
+                    {s: (-1 if s in self.negated else 1) * sp.Symbol(n) for s, n in self.name.items() if s.is_Symbol}
+                )
+            )
             self.lines.append(f"{dest}[...] = {txt}")
         for b in scratch:
             self._release(b)
@@ -417,7 +436,7 @@ class _BatchEmitter:
                 k = next((i for i in range(start, len(self.lines)) if pat.search(self.lines[i])), None)
                 if k is not None and self.lines[k].endswith(f"out={buf})") and pat.subn("", self.lines[k])[1] == 1:
                     self.lines[k] = f"{s} = {self.lines[k]}"
-                    self.lines[k + 1:] = [pat.sub(str(s), ln) for ln in self.lines[k + 1:]]
+                    self.lines[k + 1 :] = [pat.sub(str(s), ln) for ln in self.lines[k + 1 :]]
                 else:
                     self.lines[start:] = [pat.sub(str(s), ln) for ln in self.lines[start:]]
                     self.lines.insert(start, f"{s} = {buf}")
@@ -451,6 +470,14 @@ class CompiledMatrix:
     The code for one configuration is generated at once; the batched code on the first batched
     call (or when ``source`` is read). :meth:`from_pieces` starts from common subexpressions that
     are already known (e.g. from a :class:`kinlib.tape.Tape`).
+
+    >>> import sympy as sp
+    >>> x, y = sp.symbols("x y", real=True)
+    >>> c = CompiledMatrix(sp.Matrix([[sp.cos(x), x * y]]), [x, y])
+    >>> c([0.5, 2.0]).round(6).tolist()   # one configuration: a (1, 2) array
+    [[0.877583, 1.0]]
+    >>> c(np.array([[0.5, 2.0], [0.0, 3.0], [1.0, 1.0]])).shape   # a batch of three
+    (3, 1, 2)
     """
 
     def __init__(self, expr: sp.MatrixBase, args: Sequence[sp.Symbol], name: str = "matrix"):
@@ -467,8 +494,9 @@ class CompiledMatrix:
         self._setup(repl, reduced, args, expr.shape, name)
 
     @classmethod
-    def from_pieces(cls, repl, reduced, args: Sequence[sp.Symbol], shape: tuple[int, int],
-                    name: str = "matrix") -> "CompiledMatrix":
+    def from_pieces(
+        cls, repl, reduced, args: Sequence[sp.Symbol], shape: tuple[int, int], name: str = "matrix"
+    ) -> CompiledMatrix:
         """Compile from cse-style pieces: ``repl`` a list of (temporary symbol ``_xK``, expression), each
         using only earlier temporaries and the joint symbols ``_q0 … _q{n−1}`` (for ``args``), and
         ``reduced`` the rows·cols entries (row-major) in those symbols.
@@ -502,8 +530,10 @@ class CompiledMatrix:
         known = set(local) | {s for s, _ in repl}
         extra = set().union(*(e.free_symbols for _, e in repl), *(e.free_symbols for e in reduced)) - known
         if extra:
-            raise ValueError(f"cannot generate numeric code for {name}: it still has the free symbols "
-                             f"{sorted(map(str, extra))} besides the joint variables; give them values first")
+            raise ValueError(
+                f"cannot generate numeric code for {name}: it still has the free symbols "
+                f"{sorted(map(str, extra))} besides the joint variables; give them values first"
+            )
         self._repl, self._reduced = repl, reduced
         pr = _Printer()
         r, c = self.shape
@@ -545,8 +575,10 @@ class CompiledMatrix:
             brepl, bred, trig = _half_angle(repl, reduced)
             em = _BatchEmitter(_Printer(), trig)
             body = em.emit_block(brepl, [(f"out[{k // c}, {k % c}, _s:_e]", bred[k]) for k in varying])
-            batch += [f"    _B = min(N, {BLOCK})",
-                      f"    _buf = _empty(({max(em.nbuf, 1)}, _B))  # scratch rows, reused block after block"]
+            batch += [
+                f"    _B = min(N, {BLOCK})",
+                f"    _buf = _empty(({max(em.nbuf, 1)}, _B))  # scratch rows, reused block after block",
+            ]
             batch += [f"    for _s in range(0, N, {BLOCK}):", f"        _e = min(_s + {BLOCK}, N)"]
             if em.nbuf:
                 batch.append(f"        {', '.join(f'_t{i}' for i in range(em.nbuf))}, = _buf[:, :_e - _s]")
@@ -582,17 +614,14 @@ class CompiledMatrix:
         try:
             arr = np.asarray(q, dtype=float)
         except (TypeError, ValueError):
-            raise TypeError(f"q must hold {self.n} real joint values (or an (N, {self.n}) batch), "
-                            f"got {describe(q)}: {repr(q)[:80]}") from None
+            raise TypeError(
+                f"q must hold {self.n} real joint values (or an (N, {self.n}) batch), got {describe(q)}: {repr(q)[:80]}"
+            ) from None
         if arr.ndim == 1 and arr.shape[0] == self.n:
             return self._single(arr.tolist())
         if arr.ndim == 2 and arr.shape[1] == self.n:
             out = self._batch(arr)
             return out.transpose(2, 0, 1)
-        raise ValueError(f"q must have shape ({self.n},) or (N, {self.n}) for this {self.n}-joint chain, "
-                         f"got {describe(q)}")
-
-
-def compile_matrix(expr: sp.MatrixBase, args: Sequence[sp.Symbol], name: str = "matrix") -> CompiledMatrix:
-    """Compile a SymPy matrix in the symbols ``args`` to fast NumPy code (see :class:`CompiledMatrix`)."""
-    return CompiledMatrix(expr, args, name)
+        raise ValueError(
+            f"q must have shape ({self.n},) or (N, {self.n}) for this {self.n}-joint chain, got {describe(q)}"
+        )

@@ -19,6 +19,7 @@ The result is exactly equal to the input (each step is an identity). On the UR5'
 takes a fraction of a second, where ``sp.simplify`` of each entry takes minutes and ``trigsimp`` 10–15 s.
 Numeric code is generated from the *unsimplified* expression (see :mod:`kinlib.codegen`).
 """
+
 from __future__ import annotations
 
 import numbers
@@ -29,16 +30,17 @@ import sympy as sp
 from sympy.simplify.fu import TR10i
 
 from ._backend import check_real_finite, describe
+from .exactfield import decide_zero
 from .trigpoly import NotTrigPolynomial, TrigRing, single_angle_form
 
-__all__ = ["simplify_for_display", "is_identically_zero"]
+__all__ = ["simplify_for_display", "is_identically_zero", "readable", "readable_fold", "readable_ratio"]
 
 
 def _display_entry(e: sp.Expr, phase_shifts: bool = False) -> sp.Expr:
     if not e.atoms(sp.sin, sp.cos):
         return sp.factor_terms(sp.expand(e)) if e.free_symbols else e
     try:
-        ring = TrigRing([e], opaque=True)   # every sin/cos argument is an angle; √L, 1/L ... as they are
+        ring = TrigRing([e], opaque=True)  # every sin/cos argument is an angle; √L, 1/L ... as they are
         reduced = ring.to_expr(ring.normal_form(e), collect=True)
     except NotTrigPolynomial:  # e.g. trig functions inside a square root: leave the entry as it is
         return sp.factor_terms(TR10i(sp.expand(single_angle_form(e))))
@@ -76,6 +78,16 @@ def simplify_for_display(M: Any, phase_shifts: bool = False):
     (cos θ2 cos θ3 − sin θ2 sin θ3 → cos(θ2 + θ3)) and common factors. ``phase_shifts=True`` also writes
     a cos x − a sin x as √2 a cos(x + π/4), the form of the printed solutions (problem set, eqs. 17–20).
     For display only: the numeric fast path evaluates the unsimplified expression.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> simplify_for_display(planar_2r().fk()[:2, 3])   # the 2R arm's p(θ), folded from products of sines and cosines
+    Matrix([
+    [L1*cos(theta1) + L2*cos(theta1 + theta2)],
+    [L1*sin(theta1) + L2*sin(theta1 + theta2)]])
+    >>> t = sp.Symbol("theta1", real=True)
+    >>> simplify_for_display(sp.cos(t) - sp.sin(t)), simplify_for_display(sp.cos(t) - sp.sin(t), phase_shifts=True)
+    (-sin(theta1) + cos(theta1), sqrt(2)*cos(theta1 + pi/4))
     """
     if not isinstance(phase_shifts, (bool, np.bool_)):
         raise TypeError(f"phase_shifts must be True or False, got {describe(phase_shifts)}")
@@ -98,34 +110,11 @@ def _finite(e: Any, name: str) -> sp.Expr:
 # ----------------------------------------------------------------------------------------------
 # exact zero test
 # ----------------------------------------------------------------------------------------------
-def _normal_form_is_zero(e: sp.Expr) -> bool:
-    ring = TrigRing([e])                    # exact mode: NotTrigPolynomial unless a polynomial in sin/cos
-    if ring.domain.is_EX:                   # constants SymPy cannot do exact arithmetic with
-        raise NotTrigPolynomial(e)
-    return not ring.normal_form(e)
-
-
-def _exact_zero(e: sp.Expr) -> bool | None:
-    """Whether e ≡ 0, decided exactly when e (or its numerator) is a polynomial in sines, cosines and
-    symbols; None when e is of another form (√L, exp, ...)."""
-    if e == 0:
-        return True
-    try:
-        return _normal_form_is_zero(e)
-    except NotTrigPolynomial:
-        pass
-    num = sp.fraction(sp.together(e))[0]   # a rational function is 0 exactly where its numerator is
-    try:
-        return _normal_form_is_zero(num)
-    except NotTrigPolynomial:
-        return None
-
-
 def _entry_is_zero(e: sp.Expr) -> bool:
-    exact = _exact_zero(e)
-    if exact is not None:
-        return exact
-    return sp.expand(sp.expand_trig(e).rewrite(sp.exp)) == 0
+    try:
+        return decide_zero(e)
+    except ValueError:  # documented: False may mean "not shown" for forms outside the exact routes
+        return False
 
 
 def _entries(M: Any, name: str) -> list:
@@ -138,10 +127,14 @@ def _entries(M: Any, name: str) -> list:
     if isinstance(M, (sp.Expr, numbers.Number)):
         return [_finite(sp.sympify(M), name)]
     if isinstance(M, (list, tuple, np.ndarray)):
-        if any(isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None
-               for e in np.asarray(M, dtype=object).flat):
-            raise TypeError(f"{name} must hold real SymPy expressions or numbers, got {describe(M)} with a "
-                            f"string, bool, None or complex entry")
+        if any(
+            isinstance(e, (str, bytes, bool, np.bool_, complex, np.complexfloating)) or e is None
+            for e in np.asarray(M, dtype=object).flat
+        ):
+            raise TypeError(
+                f"{name} must hold real SymPy expressions or numbers, got {describe(M)} with a "
+                f"string, bool, None or complex entry"
+            )
         try:
             flat = list(sp.Matrix(M))
         except Exception as err:
@@ -168,9 +161,79 @@ def is_identically_zero(M: Any) -> bool:
     difference of two of them) the answer is True if and only if the entry is identically zero
     (θ_i(t) and θ̇_i count as independent variables, as they are at any one instant).
     Floats count at their exact binary values. Rational functions are tested through their numerator.
-    Other forms (square roots of symbols, exponentials, half angles θ/2) fall back to writing sin and cos
-    with exponentials and expanding: there True is still a proof, but False may mean "not shown".
+    Entries without symbols (sin 3, √2 …) and entries in positive lengths only are decided in the exact field
+    of :mod:`kinlib.exactfield`. Each entry goes through :func:`kinlib.exactfield.decide_zero`, kinlib's one
+    zero test; where it cannot decide (square roots of symbols, exponentials, half angles θ/2 that the
+    exponential rewrite does not settle) the answer is False, meaning "not shown".
 
     Much faster than ``sp.simplify(e) == 0``: no trigsimp, and no SymPy ``expand`` of large products.
+
+    >>> import sympy as sp
+    >>> t = sp.Symbol("theta")
+    >>> is_identically_zero(sp.Matrix([sp.sin(t)**2 + sp.cos(t)**2 - 1, sp.sin(2*t) - 2*sp.sin(t)*sp.cos(t)]))
+    True
+    >>> is_identically_zero(sp.sin(t) - sp.cos(t))
+    False
     """
     return all(_entry_is_zero(e) for e in _entries(M, "M"))
+
+
+# ----------------------------------------------------------------------------------------------
+# readable forms of exact numbers (identities only: never a guess)
+# ----------------------------------------------------------------------------------------------
+def readable(e: sp.Expr) -> sp.Expr:
+    """An exactly equal, readable form of an exact number (or expression in parameters).
+
+    >>> import sympy as sp
+    >>> readable((sp.sqrt(2) + 2) / sp.sqrt(2)), readable(sp.sin(3) / -sp.cos(3))
+    (1 + sqrt(2), -sin(3)/cos(3))
+    """
+    if e == 0 or e.is_Rational:
+        return e
+    num, den = sp.fraction(sp.cancel(sp.together(e))) if not e.has(sp.sin, sp.cos) else sp.fraction(sp.together(e))
+    num, den = readable_fold(num), readable_fold(den)
+    if den == 1:
+        return num
+    if den.could_extract_minus_sign():
+        num, den = -num, -den
+    return num / den
+
+
+def readable_fold(e: sp.Expr) -> sp.Expr:
+    """e (a polynomial in sines, cosines, constants and parameters) reduced by sin² + cos² = 1 and folded.
+
+    >>> import sympy as sp
+    >>> readable_fold(sp.cos(1) * sp.cos(2) - sp.sin(1) * sp.sin(2)), readable_fold((sp.sqrt(2) + 1) ** 2)
+    (cos(3), 2*sqrt(2) + 3)
+    """
+    if e.has(sp.sin, sp.cos):
+        try:
+            return simplify_for_display(e)
+        except Exception:  # pragma: no cover - display only
+            return sp.factor_terms(TR10i(sp.expand(e)))
+    if e.is_Rational:
+        return e
+    return sp.expand(sp.radsimp(e)) if e.is_number else sp.factor_terms(sp.radsimp(sp.expand(e)))
+
+
+def readable_ratio(num: sp.Expr, den: sp.Expr) -> sp.Expr:
+    """num/den for display, with common polynomial factors (in the sines and cosines) cancelled.
+
+    >>> import sympy as sp
+    >>> t = sp.Symbol("theta1", real=True)
+    >>> readable_ratio(sp.sin(2 * t), sp.sin(t)), readable_ratio(sp.sin(3) * sp.cos(3), sp.cos(3) ** 2)
+    (2*cos(theta1), sin(3)/cos(3))
+    """
+    if num == 0:
+        return sp.S.Zero
+    try:
+        ring = TrigRing([num, den], opaque=True)
+        if ring.domain.is_EX:
+            raise NotTrigPolynomial(num)
+        pn, pd = ring.normal_form(num), ring.normal_form(den)
+        g = pn.gcd(pd)
+        pn, pd = pn.exquo(g), pd.exquo(g)
+        num, den = ring.to_expr(pn, collect=True), ring.to_expr(pd, collect=True)
+    except (NotTrigPolynomial, Exception):
+        pass
+    return readable(num / den) if den != 1 else readable(num)

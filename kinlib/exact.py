@@ -27,25 +27,62 @@ computed from a singular value decomposition in mpmath with ``FALLBACK_DIGITS`` 
 (``Rank.exact`` is False and ``Rank.note`` states the precision; the bases come with a
 :class:`NumericFallbackWarning`).
 """
+
 from __future__ import annotations
 
 import itertools
 import warnings
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
+from .display import readable, readable_fold, readable_ratio
 from .exactfield import (
-    FALLBACK_DIGITS, MAX_MULTIPLE, ExactField, NotExact, decide_zero, exact_is_zero, mp_matrix, readable,
-    readable_fold, readable_ratio,
+    FALLBACK_DIGITS,
+    MAX_MULTIPLE,
+    ExactField,
+    NotExact,
+    decide_zero,
+    exact_is_zero,
+    mp_matrix,
 )
 from .trigpoly import NotTrigPolynomial, TrigRing
 
-__all__ = ["Rank", "NumericFallbackWarning", "ConditionalResultWarning", "evaluate_at", "rank_at",
-           "column_space", "left_null_space", "exact_is_zero", "MAX_MULTIPLE", "FALLBACK_DIGITS"]
+__all__ = [
+    "Rank",
+    "NumericFallbackWarning",
+    "ConditionalResultWarning",
+    "evaluate_at",
+    "rank_at",
+    "column_space",
+    "left_null_space",
+    "exact_is_zero",
+    "exact_det",
+    "MAX_MULTIPLE",
+    "FALLBACK_DIGITS",
+]
+
+
+def exact_det(M: sp.Matrix) -> sp.Expr:
+    """det M, exactly: fraction-free elimination over the polynomial domain of M's entries (DomainMatrix), or
+    SymPy's Bareiss elimination when the entries hold constants outside that domain (√2, sin 3 …).
+
+    >>> L, t = sp.symbols("L theta")
+    >>> exact_det(sp.Matrix([[L, sp.sin(t)], [sp.cos(t), L]]))
+    L**2 - sin(theta)*cos(theta)
+    """
+    try:
+        dM = DomainMatrix.from_Matrix(M)
+        if dM.domain.is_EX:  # algebraic constants such as √2: plain fraction-free elimination
+            raise ValueError
+        return dM.domain.to_sympy(dM.det())
+    except Exception:
+        return sp.expand(M.det(method="bareiss"))
+
 
 #: the relative size (10^-40 σ_max) below which the numeric fallback counts a singular value as zero
 FALLBACK_ZERO_DIGITS = 40
@@ -55,11 +92,33 @@ EXACT_BUDGET = 100
 
 
 class NumericFallbackWarning(UserWarning):
-    """A result was computed numerically (mpmath, 60 digits) because an exact decision was out of reach."""
+    """A result was computed numerically (mpmath, 60 digits) because an exact decision was out of reach.
+
+    >>> import warnings, sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r = planar_2r(1, 2)
+    >>> J = r.jacobian_geometric()[[3, 4], :]   # rows ṗ_x, ṗ_y
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     B = column_space(J, [sp.sqrt(2), 0], r.thetas)   # θ2 = 0: a rank drop; θ1 = √2: no exact field
+    >>> [w.category.__name__ for w in caught], B.shape
+    (['NumericFallbackWarning'], (2, 1))
+    """
 
 
 class ConditionalResultWarning(UserWarning):
-    """A result with symbolic parameters holds only where a stated expression in them is nonzero."""
+    """A result with symbolic parameters holds only where a stated expression in them is nonzero.
+
+    >>> import warnings, sympy as sp
+    >>> L1, L2 = sp.symbols("L1 L2", positive=True)
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     B = column_space(sp.Matrix([[L1, L2], [1, 1]]))   # det = L1 − L2
+    >>> caught[0].category.__name__, B.shape
+    ('ConditionalResultWarning', (2, 2))
+    >>> print(caught[0].message)
+    column_space holds for the parameters where L1 - L2 ≠ 0
+    """
 
 
 class Rank(int):
@@ -67,9 +126,26 @@ class Rank(int):
 
     * ``exact``: True when proved by exact arithmetic; False for the 60-digit numeric fallback.
     * ``unless``: expressions in the positive parameters (link lengths); the rank is this value for every
-      positive value of the parameters at which none of them vanishes (and smaller where one does). Empty
-      when the rank holds for all positive values.
+      positive value of the parameters at which none of them vanishes. Where one vanishes the rank *may* be
+      smaller: the factors come from one nonzero minor, a sufficient condition, not always a necessary one
+      (for [[L1 − L2, 0], [0, 1], [L1 − 2 L2, 0]] the rank is 2 even at L1 = L2). Empty when the rank holds
+      for all positive values.
     * ``note``: how it was decided, in words.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r = planar_2r(1, 2)
+    >>> J = r.jacobian_geometric()[[3, 4], :]   # rows ṗ_x, ṗ_y; det = L1 L2 sin θ2
+    >>> R = rank_at(J, [1, 0], r.thetas)   # stretched out (θ2 = 0): proved
+    >>> R, R.exact, R.unless, R.note
+    (1, True, (), 'exact elimination in K(tan(g/2), parameters)')
+    >>> R = rank_at(J, [sp.sqrt(2), 0], r.thetas)   # θ1 = √2 is outside the exact method
+    >>> R, R.exact
+    (1 (numeric, 60 digits), False)
+    >>> L1, L2 = sp.symbols("L1 L2", positive=True)
+    >>> R = rank_at(sp.Matrix([[L1, L2], [1, 1]]))
+    >>> R, R.unless, R + 0   # an int: 2 for all positive L1, L2 with L1 ≠ L2
+    (2 (assuming L1 - L2 ≠ 0), (L1 - L2,), 2)
     """
 
     exact: bool
@@ -116,16 +192,22 @@ def _table(subs: Any, thetas: Any) -> tuple:
     if isinstance(subs, Mapping):
         table = dict(subs)
     elif isinstance(subs, (str, bytes)) or not isinstance(subs, (Sequence, np.ndarray, sp.MatrixBase)):
-        raise TypeError(f"subs must be a mapping {{joint symbol: value}} or a sequence of joint values, got {describe(subs)}")
+        raise TypeError(
+            f"subs must be a mapping {{joint symbol: value}} or a sequence of joint values, got {describe(subs)}"
+        )
     else:
         vals = list(subs) if not isinstance(subs, np.ndarray) else subs.reshape(-1).tolist()
         if thetas is None:
-            raise ValueError(f"subs is a sequence of joint values (got {describe(subs)}): give thetas= (the joint "
-                             "symbols, in order) too, or a mapping {joint symbol: value}")
+            raise ValueError(
+                f"subs is a sequence of joint values (got {describe(subs)}): give thetas= (the joint "
+                "symbols, in order) too, or a mapping {joint symbol: value}"
+            )
         thetas = joint_symbols(thetas)
         if len(vals) != len(thetas):
-            raise ValueError(f"subs must hold {len(thetas)} joint values (one per joint "
-                             f"{', '.join(map(str, thetas))}), got {len(vals)}")
+            raise ValueError(
+                f"subs must hold {len(thetas)} joint values (one per joint "
+                f"{', '.join(map(str, thetas))}), got {len(vals)}"
+            )
         table = dict(zip(thetas, vals))
     clean, numeric = {}, False
     for k, v in table.items():
@@ -147,8 +229,10 @@ def _evaluated(J: Any, subs: Any, thetas: Any) -> tuple:
     if not isinstance(J, (sp.MatrixBase, list, tuple, np.ndarray)):
         raise TypeError(f"J must be a matrix (m×n Jacobian), got {describe(J)}")
     if subs is not None and not is_symbolic(J):
-        raise TypeError(f"subs only applies to a symbolic J (SymPy expressions in the joint symbols); got a "
-                        f"numeric J ({describe(J)}): call without subs")
+        raise TypeError(
+            f"subs only applies to a symbolic J (SymPy expressions in the joint symbols); got a "
+            f"numeric J ({describe(J)}): call without subs"
+        )
     M = _jacobian(J)
     numeric = False
     if subs is not None:
@@ -156,16 +240,20 @@ def _evaluated(J: Any, subs: Any, thetas: Any) -> tuple:
         M = M.xreplace(table)
     left = sorted((s for s in M.free_symbols if not s.is_positive), key=str)
     if left:
-        raise ValueError(f"J must be taken at a configuration: it still depends on {', '.join(map(str, left))} (got "
-                         f"{describe(J)}{' and subs ' + sp.sstr(subs) if subs is not None else ', no subs'}); give a "
-                         "value for every joint in subs (only positive parameters such as link lengths may stay symbolic)")
-    for e in M:   # the values may have brought in I, oo, nan (checked cheaply: entries can be large trees)
+        raise ValueError(
+            f"J must be taken at a configuration: it still depends on {', '.join(map(str, left))} (got "
+            f"{describe(J)}{' and subs ' + sp.sstr(subs) if subs is not None else ', no subs'}); give a "
+            "value for every joint in subs (only positive parameters such as link lengths may stay symbolic)"
+        )
+    for e in M:  # the values may have brought in I, oo, nan (checked cheaply: entries can be large trees)
         if e.has(sp.I, sp.nan, sp.zoo, sp.oo, -sp.oo):
             raise ValueError(f"J at the configuration must be real and finite, got the entry {e}")
     if numeric and M.free_symbols:
-        raise ValueError(f"float joint values select the numeric backend, which needs numbers for the parameters "
-                         f"{', '.join(map(str, sorted(M.free_symbols, key=str)))} (substitute them, or give exact "
-                         "joint values such as sp.Rational(1, 2) or sp.pi/4)")
+        raise ValueError(
+            f"float joint values select the numeric backend, which needs numbers for the parameters "
+            f"{', '.join(map(str, sorted(M.free_symbols, key=str)))} (substitute them, or give exact "
+            "joint values such as sp.Rational(1, 2) or sp.pi/4)"
+        )
     return M, numeric
 
 
@@ -186,8 +274,9 @@ def _ring_det(A: sp.Matrix) -> sp.Expr:
         ring = TrigRing(list(A), opaque=True)
         if ring.domain.is_EX:
             raise NotTrigPolynomial(A)
-        dA = DomainMatrix([[ring.normal_form(A[i, j]) for j in range(A.cols)] for i in range(A.rows)],
-                          A.shape, ring.ring.to_domain())
+        dA = DomainMatrix(
+            [[ring.normal_form(A[i, j]) for j in range(A.cols)] for i in range(A.rows)], A.shape, ring.ring.to_domain()
+        )
         return ring.to_expr(ring.reduce(dA.det()), collect=True)
     except NotTrigPolynomial:
         return sp.expand(A.det(method="bareiss"))
@@ -200,6 +289,7 @@ def _numeric_pivots(X, top) -> tuple:
     (certified: the entries and the SVD are accurate to ~10⁻⁵⁵·σ_max, and σ moves by at most that much).
     A column that does not join is a "zero" decision, certain only once the pivots already span every row."""
     import mpmath
+
     m, n = X.rows, X.cols
     piv: list = []
     with mpmath.workdps(FALLBACK_DIGITS):
@@ -233,6 +323,7 @@ class _Analysis:
         if not A.free_symbols:
             X = mp_matrix(A)
             import mpmath
+
             with mpmath.workdps(FALLBACK_DIGITS):
                 top = max((abs(x) for x in mpmath.svd_r(X, compute_uv=False)), default=mpmath.mpf(0))
             if top > 0:
@@ -245,13 +336,15 @@ class _Analysis:
         fld = self.fld
         size = max((abs(n) for n, _ in fld.multiples.values()), default=0) * min(A.shape)
         if size > EXACT_BUDGET:
-            raise NotExact(f"exact elimination with angles up to {size // min(A.shape)} multiples of their common "
-                           f"measure {fld.g} on a {A.rows}×{A.cols} matrix is out of reach in seconds")
+            raise NotExact(
+                f"exact elimination with angles up to {size // min(A.shape)} multiples of their common "
+                f"measure {fld.g} on a {A.rows}×{A.cols} matrix is out of reach in seconds"
+            )
         dA = fld.matrix(A).to_field()
         self.R, self.pivots = dA.rref()
         self.R = self.R.to_list()
         self.rank = len(self.pivots)
-        _, rows = dA.transpose().rref()       # independent rows: the pivot columns of Aᵀ
+        _, rows = dA.transpose().rref()  # independent rows: the pivot columns of Aᵀ
         self.rows = list(rows)
 
     @property
@@ -285,9 +378,10 @@ def _canonical_rows(A: sp.Matrix, an: _Analysis) -> sp.Matrix:
             Bk[:, k] = A.extract(I, [j])
             minor = {}
 
-            def numerator():
+            def numerator(Bk=Bk, minor=minor):
                 minor["d"] = _ring_det(Bk)
                 return minor["d"]
+
             if an.entry_is_zero(k, j, numerator):
                 continue
             out[k, j] = readable_ratio(minor["d"] if "d" in minor else _ring_det(Bk), D)
@@ -304,8 +398,8 @@ def _never_zero(factor: sp.Expr, fld: ExactField) -> bool:
     gens_sym = [fld.t] + list(fld.extra)
     grouped: dict = {}
     for monom, coeff in num.terms():
-        pm = monom[base:base + nparam]
-        val = sp.Mul(fld.K.to_sympy(coeff), *[s ** d for s, d in zip(gens_sym, monom[:base])])
+        pm = monom[base : base + nparam]
+        val = sp.Mul(fld.K.to_sympy(coeff), *[s**d for s, d in zip(gens_sym, monom[:base])])
         grouped[pm] = grouped.get(pm, 0) + val
     tval = sp.tan(fld.g / 2) if fld.g != 0 else sp.S.Zero
     signs = set()
@@ -348,7 +442,7 @@ def _conditions(A: sp.Matrix, an: _Analysis) -> tuple:
     others = itertools.product(itertools.combinations(range(A.rows), r), itertools.combinations(range(A.cols), r))
     common, pivot_factors = None, None
     for I, P in itertools.islice(itertools.chain([first], (c for c in others if c != first)), MAX_MINORS):
-        D = _ring_det(A.extract(list(I), list(P)))     # in the sines and cosines of A (the field's atoms)
+        D = _ring_det(A.extract(list(I), list(P)))  # in the sines and cosines of A (the field's atoms)
         if D == 0 or not an.fld.convert(D):
             continue
         facs = _vanishing_factors(D, an)
@@ -365,6 +459,7 @@ def _conditions(A: sp.Matrix, an: _Analysis) -> tuple:
 # ----------------------------------------------------------------------------------------------
 def _fallback_rank(A: sp.Matrix) -> tuple:
     import mpmath
+
     X = mp_matrix(A)
     with mpmath.workdps(FALLBACK_DIGITS):
         s = mpmath.svd_r(X, compute_uv=False)
@@ -378,6 +473,7 @@ def _fallback_rank(A: sp.Matrix) -> tuple:
 def _fallback_rref(A: sp.Matrix) -> sp.Matrix:
     """Nonzero rows of rref(A), 60-digit arithmetic with partial pivoting, entries as 30-digit Floats."""
     import mpmath
+
     X = mp_matrix(A)
     r, sv = _fallback_rank(A)
     with mpmath.workdps(FALLBACK_DIGITS):
@@ -398,15 +494,20 @@ def _fallback_rref(A: sp.Matrix) -> sp.Matrix:
                     X[i, :] = X[i, :] - X[i, j] * X[row, :]
             piv.append(j)
             row += 1
-        rows = [[sp.Float(mpmath.nstr(X[i, j], 30), 30) if abs(X[i, j]) > tol else sp.S.Zero for j in range(n)]
-                for i in range(row)]
+        rows = [
+            [sp.Float(mpmath.nstr(X[i, j], 30), 30) if abs(X[i, j]) > tol else sp.S.Zero for j in range(n)]
+            for i in range(row)
+        ]
     return sp.Matrix(rows) if rows else sp.zeros(0, n)
 
 
 def _fallback_warning(what: str, why: str):
-    warnings.warn(f"{what}: no exact decision here ({why}); computed with {FALLBACK_DIGITS}-digit numerics "
-                  f"(singular values below 1e-{FALLBACK_ZERO_DIGITS}·σ_max counted as zero, not proven)",
-                  NumericFallbackWarning, stacklevel=3)
+    warnings.warn(
+        f"{what}: no exact decision here ({why}); computed with {FALLBACK_DIGITS}-digit numerics "
+        f"(singular values below 1e-{FALLBACK_ZERO_DIGITS}·σ_max counted as zero, not proven)",
+        NumericFallbackWarning,
+        stacklevel=3,
+    )
 
 
 # ----------------------------------------------------------------------------------------------
@@ -427,8 +528,13 @@ def _numeric_rank_tol(s: np.ndarray, shape) -> float:
 
 
 def _is_numeric_input(J: Any, subs: Any) -> bool:
-    return subs is None and not is_symbolic(J) and not (
-        isinstance(J, (list, tuple)) and any(isinstance(e, (sp.Basic,)) for e in np.asarray(J, dtype=object).flat))
+    return (
+        subs is None
+        and not is_symbolic(J)
+        and not (
+            isinstance(J, (list, tuple)) and any(isinstance(e, (sp.Basic,)) for e in np.asarray(J, dtype=object).flat)
+        )
+    )
 
 
 def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
@@ -486,7 +592,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None)
     if _is_numeric_input(J, subs):
         A = _numeric_J(J)
         s = np.linalg.svd(A, compute_uv=False)
-        return int(np.sum(s > _numeric_rank_tol(s, A.shape)))   # numbers in, a number out
+        return int(np.sum(s > _numeric_rank_tol(s, A.shape)))  # numbers in, a number out
     M, numeric = _evaluated(J, subs, thetas)
     if numeric:
         return rank_at(_as_float(M))
@@ -500,8 +606,11 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None)
 
 def _warn_conditions(what: str, unless: tuple):
     if unless:
-        warnings.warn(f"{what} holds for the parameters where {', '.join(map(sp.sstr, unless))} ≠ 0",
-                      ConditionalResultWarning, stacklevel=3)
+        warnings.warn(
+            f"{what} holds for the parameters where {', '.join(map(sp.sstr, unless))} ≠ 0",
+            ConditionalResultWarning,
+            stacklevel=3,
+        )
 
 
 def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
@@ -548,11 +657,11 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
     if _is_numeric_input(J, subs):
         A = _numeric_J(J)
         U, s, _ = np.linalg.svd(A)
-        return U[:, int(np.sum(s > _numeric_rank_tol(s, A.shape))):]
+        return U[:, int(np.sum(s > _numeric_rank_tol(s, A.shape))) :]
     M, numeric = _evaluated(J, subs, thetas)
     if numeric:
         return left_null_space(_as_float(M))
-    A = M.T                                   # null(Mᵀ) = null(A)
+    A = M.T  # null(Mᵀ) = null(A)
     m = A.cols
     an, why = _analyse(A, "left_null_space")
     if an is None:

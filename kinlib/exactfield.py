@@ -18,6 +18,7 @@ transcendental angle, angles more than ``MAX_MULTIPLE`` common measures apart).
 :func:`mp_value` evaluates such numbers to ``FALLBACK_DIGITS + 40`` digits (shared subexpressions once), for the
 certified numerics of :mod:`kinlib.exact`.
 """
+
 from __future__ import annotations
 
 import math
@@ -27,13 +28,19 @@ import sympy as sp
 from sympy.polys.constructor import construct_domain
 from sympy.polys.fields import field as _field
 from sympy.polys.matrices import DomainMatrix
-from sympy.simplify.fu import TR10i
 
-from .trigpoly import NotTrigPolynomial, TrigRing
+from .trigpoly import normal_form_zero
 
-__all__ = ["ExactField", "NotExact", "exact_is_zero", "decide_zero", "mp_value", "mp_matrix", "readable",
-           "readable_fold", "readable_ratio",
-           "MAX_MULTIPLE", "FALLBACK_DIGITS"]
+__all__ = [
+    "ExactField",
+    "NotExact",
+    "exact_is_zero",
+    "decide_zero",
+    "mp_value",
+    "mp_matrix",
+    "MAX_MULTIPLE",
+    "FALLBACK_DIGITS",
+]
 
 #: the largest |n| with every angle's rational part n·g, above which the exact method is not used
 MAX_MULTIPLE = 240
@@ -42,8 +49,14 @@ FALLBACK_DIGITS = 60
 
 
 class NotExact(ValueError):
-    """The exact method does not apply to these numbers (the message says why)."""
+    """The exact method does not apply to these numbers (the message says why).
 
+    >>> import sympy as sp
+    >>> ExactField([sp.sin(sp.sqrt(2))])   # an angle √2: no exact zero test (a ValueError)
+    Traceback (most recent call last):
+    ...
+    kinlib.exactfield.NotExact: the angle sqrt(2) is not a rational number plus a rational multiple of π
+    """
 
 
 # ----------------------------------------------------------------------------------------------
@@ -106,12 +119,14 @@ class ExactField:
         self.multiples = {f: (int(r / g) if r != 0 else 0, q) for f, (r, q) in parts.items()}
         biggest = max((abs(n) for n, _ in self.multiples.values()), default=0)
         if biggest > MAX_MULTIPLE:
-            raise NotExact(f"the angles are {biggest} multiples of their common measure {g} apart "
-                            f"(the exact method goes up to {MAX_MULTIPLE})")
+            raise NotExact(
+                f"the angles are {biggest} multiples of their common measure {g} apart "
+                f"(the exact method goes up to {MAX_MULTIPLE})"
+            )
         self.params = sorted(set().union(*[e.free_symbols for e in exprs]), key=str) if exprs else []
         # algebraic constants: cos qπ, sin qπ of every angle, and every other constant in the entries
         consts = set()
-        for n, q in self.multiples.values():
+        for _n, q in self.multiples.values():
             consts |= {sp.cos(q * sp.pi), sp.sin(q * sp.pi)}
         repl = {f: sp.Dummy() for f in trig}
 
@@ -122,8 +137,9 @@ class ExactField:
                 if not (isinstance(f, (sp.sin, sp.cos)) and (f.args[0] / sp.pi).is_Rational):
                     return False
             bare = c.xreplace({f: sp.Dummy() for f in c.atoms(sp.sin, sp.cos)})
-            return not bare.has(sp.pi, sp.E) and all(not p.is_Pow or p.exp.is_Rational
-                                                     for p in sp.preorder_traversal(bare) if isinstance(p, sp.Basic))
+            return not bare.has(sp.pi, sp.E) and all(
+                not p.is_Pow or p.exp.is_Rational for p in sp.preorder_traversal(bare) if isinstance(p, sp.Basic)
+            )
 
         def scan(x):
             if x.is_Rational or x in repl or x.is_Symbol:
@@ -140,17 +156,21 @@ class ExactField:
             elif x.is_number and algebraic(x):
                 consts.add(x)
             else:
-                raise NotExact(f"the entry part {x} is not a rational function of sines and cosines, algebraic "
-                                "numbers and parameters")
+                raise NotExact(
+                    f"the entry part {x} is not a rational function of sines and cosines, algebraic "
+                    "numbers and parameters"
+                )
 
         for e in exprs:
             scan(e)
-        self.extra = sorted(extra, key=str)             # π, e: generators (transcendental; no trig angle then)
+        self.extra = sorted(extra, key=str)  # π, e: generators (transcendental; no trig angle then)
         algebraic_consts = sorted((c for c in consts if not c.is_Rational), key=sp.default_sort_key)
         if algebraic_consts:
             K, _ = construct_domain(algebraic_consts, extension=True)
             if K.is_EX:
-                raise NotExact(f"the constants {algebraic_consts} are not algebraic numbers SymPy can do arithmetic with")
+                raise NotExact(
+                    f"the constants {algebraic_consts} are not algebraic numbers SymPy can do arithmetic with"
+                )
         else:
             K = sp.QQ
         self.K = K
@@ -162,7 +182,7 @@ class ExactField:
         ring = self.F.ring
         self.ring = ring
         tt = ring.gens[0]
-        self.one_t2 = 1 + tt ** 2
+        self.one_t2 = 1 + tt**2
         self._pow_cache = {0: ring.one}
         self._atom = {}
         self._powers: dict = {}
@@ -175,8 +195,10 @@ class ExactField:
         m, tt = abs(n), self.ring.gens[0]
         if m not in self._powers:
             re, im = _re_im_power(2 * m)
-            self._powers[m] = (sum((c * tt ** k for k, c in enumerate(re) if c), self.ring.zero),
-                               sum((c * tt ** k for k, c in enumerate(im) if c), self.ring.zero))
+            self._powers[m] = (
+                sum((c * tt**k for k, c in enumerate(re) if c), self.ring.zero),
+                sum((c * tt**k for k, c in enumerate(im) if c), self.ring.zero),
+            )
         cn, sn = self._powers[m]
         sn = sn if n >= 0 else -sn
         cq, sq = self._kconst(sp.cos(q * sp.pi)), self._kconst(sp.sin(q * sp.pi))
@@ -199,16 +221,18 @@ class ExactField:
     def _kconst(self, c):
         return self.ring(self.K.convert(c) if c.is_Rational else self.K.from_sympy(c))
 
-    def to_expr(self, x) -> sp.Expr:
-        """A field element back as a readable SymPy number: t = tan(g/2) written as sin g/(1 + cos g), then
-        one fraction in sin g, cos g with common factors cancelled (an identity, never a guess)."""
+    def to_ratio(self, x) -> tuple[sp.Expr, sp.Expr]:
+        """A field element back as SymPy (numerator, denominator), polynomials in sin g, cos g, the constants
+        and the parameters: t = tan(g/2) written as sin g/(1 + cos g) (an identity, never a guess).
+        :func:`kinlib.display.readable_ratio` makes one readable fraction of them."""
         gens = [self.t] + list(self.extra) + list(self.params)
         num, den = x.numer.as_expr(*gens), x.denom.as_expr(*gens)
         if self.g != 0:
             s, c = sp.sin(self.g), sp.cos(self.g)
-            num, den = sp.fraction(sp.together(sp.expand(num).subs(self.t, s / (1 + c))
-                                               / sp.expand(den).subs(self.t, s / (1 + c))))
-        return readable_ratio(sp.expand(num), sp.expand(den))
+            num, den = sp.fraction(
+                sp.together(sp.expand(num).subs(self.t, s / (1 + c)) / sp.expand(den).subs(self.t, s / (1 + c)))
+            )
+        return sp.expand(num), sp.expand(den)
 
     def __repr__(self) -> str:
         return f"ExactField(t = tan({self.g}/2), K = {self.K}, parameters {list(self.params)})"
@@ -219,7 +243,7 @@ class ExactField:
             return num
         d = e - k
         if d not in self._pow_cache:
-            self._pow_cache[d] = self.one_t2 ** d
+            self._pow_cache[d] = self.one_t2**d
         return num * self._pow_cache[d]
 
     def pair(self, e: sp.Expr):
@@ -307,8 +331,9 @@ class ExactField:
         return DomainMatrix(rows, M.shape, ring.to_domain())
 
     def field_matrix(self, M: sp.Matrix) -> DomainMatrix:
-        return DomainMatrix([[self.convert(M[i, j]) for j in range(M.cols)] for i in range(M.rows)],
-                            M.shape, self.domain)
+        return DomainMatrix(
+            [[self.convert(M[i, j]) for j in range(M.cols)] for i in range(M.rows)], M.shape, self.domain
+        )
 
 
 def exact_is_zero(e: Any) -> bool:
@@ -333,22 +358,27 @@ def exact_is_zero(e: Any) -> bool:
         raise ValueError(f"no exact zero test for {e}: {err}") from None
 
 
-
 def decide_zero(e: Any, what: str = "an entry") -> bool:
-    """Decide e = 0 with a proof, never a guess: the one zero test of kinlib's exact numbers.
+    """Decide e = 0 with a proof, never a guess: kinlib's one zero test, for numbers and for expressions.
 
-    e is a number or an expression in positive parameters (link lengths).
+    e is a number (a configuration's sines and cosines, algebraic constants), an expression in positive
+    parameters (link lengths; "zero" then means zero for all of them), or an expression in other symbols
+    (joint variables: "zero" means identically zero).
 
-    * nonzero: a value above 10⁻³⁰ at ``FALLBACK_DIGITS + 40`` digits (:func:`mp_value`; with parameters this
-      step is skipped);
-    * either way: exact arithmetic in K(tan(g/2), params) (:class:`ExactField`) for sines and cosines of
-      angles r + qπ (r, q rational), algebraic numbers and parameters;
-    * zero, for other constants: the sin² + cos² = 1 normal form (:func:`kinlib.display.is_identically_zero`),
-      the minimal polynomial x of an algebraic number, or ``sp.simplify(e) == 0``.
+    * nonzero number: a value above 10⁻³⁰ at ``FALLBACK_DIGITS + 40`` digits (:func:`mp_value`);
+    * exact arithmetic in K(tan(g/2), params) (:class:`ExactField`) for sines and cosines of angles r + qπ
+      (r, q rational), algebraic numbers and parameters;
+    * the normal form modulo sin² + cos² − 1 (:func:`kinlib.trigpoly.normal_form_zero`) for polynomials and
+      rational functions in the sines and cosines of symbols: True and False are both proofs;
+    * zero only: sin and cos written with exponentials and expanded, the minimal polynomial x of an
+      algebraic number, or ``sp.simplify(e) == 0``.
 
     Anything else raises ``ValueError`` (an honest "cannot decide"), never a silent answer.
 
     >>> decide_zero(sp.sin(3)**2 + sp.cos(3)**2 - 1), decide_zero(sp.sqrt(2)/2 - sp.Rational(7, 10))
+    (True, False)
+    >>> x = sp.Symbol("x")
+    >>> decide_zero(sp.sin(2*x) - 2*sp.sin(x)*sp.cos(x)), decide_zero(sp.sin(x) - sp.cos(x))
     (True, False)
     """
     e = sp.sympify(e)
@@ -358,6 +388,7 @@ def decide_zero(e: Any, what: str = "an entry") -> bool:
         return False
     if not e.free_symbols:
         import mpmath
+
         try:
             with mpmath.workdps(FALLBACK_DIGITS + 40):
                 if abs(mp_value(e, {})) > mpmath.mpf(10) ** -30:
@@ -368,9 +399,11 @@ def decide_zero(e: Any, what: str = "an entry") -> bool:
         return not ExactField([e]).convert(e)
     except NotExact:
         pass
-    from .display import is_identically_zero  # local import: display does not import this module
+    identity = normal_form_zero(e)
+    if identity is not None:
+        return identity
     try:
-        if is_identically_zero(e):
+        if sp.expand(sp.expand_trig(e).rewrite(sp.exp)) == 0:
             return True
     except Exception:  # pragma: no cover - a route that fails is just not a proof
         pass
@@ -383,13 +416,26 @@ def decide_zero(e: Any, what: str = "an entry") -> bool:
             pass
     if sp.simplify(e) == 0:
         return True
-    raise ValueError(f"could not decide exactly whether {what} = {e} is zero (its value is below 1e-30 at "
-                     f"{FALLBACK_DIGITS + 40} digits and no exact identity was found); evaluate numerically instead")
+    raise ValueError(
+        f"could not decide exactly whether {what} = {e} is zero (no exact identity was found"
+        + ("" if e.free_symbols else f" and its value is below 1e-30 at {FALLBACK_DIGITS + 40} digits")
+        + "); evaluate numerically instead"
+    )
 
 
 def mp_value(e: sp.Expr, memo: dict):
-    """e to ``FALLBACK_DIGITS + 40`` digits (call inside mpmath.workdps), shared subexpressions evaluated once."""
+    """e to ``FALLBACK_DIGITS + 40`` digits (call inside mpmath.workdps), shared subexpressions evaluated once.
+
+    >>> import mpmath, sympy as sp
+    >>> memo = {}
+    >>> with mpmath.workdps(FALLBACK_DIGITS + 40):
+    ...     v = mp_value(sp.sin(10) - 2 * sp.sin(5) * sp.cos(5), memo)   # sin 2a − 2 sin a cos a = 0
+    ...     w = mp_value(sp.sqrt(2), memo)
+    >>> abs(v) < mpmath.mpf(10) ** -80, sp.sin(5) in memo, mpmath.nstr(w, 20)
+    (True, True, '1.4142135623730950488')
+    """
     import mpmath
+
     if e in memo:
         return memo[e]
     if e.is_Rational:
@@ -416,57 +462,21 @@ def mp_value(e: sp.Expr, memo: dict):
 
 
 def mp_matrix(A: sp.Matrix):
-    """A as an mpmath matrix, entries to ~100 digits (the SVD then runs at ``FALLBACK_DIGITS``)."""
+    """A as an mpmath matrix, entries to ~100 digits (the SVD then runs at ``FALLBACK_DIGITS``).
+
+    >>> import mpmath, sympy as sp
+    >>> X = mp_matrix(sp.Matrix([[sp.cos(1), -sp.sin(1)], [sp.sin(1), sp.cos(1)]]))   # a rotation: det = 1
+    >>> with mpmath.workdps(FALLBACK_DIGITS):
+    ...     print(X.rows, X.cols, mpmath.nstr(mpmath.det(X), 50))
+    2 2 1.0
+    """
     import mpmath
+
     if A.free_symbols:
-        raise ValueError("no exact decision is possible here and the numeric fallback needs numbers: J still has "
-                         f"the parameters {', '.join(map(str, sorted(A.free_symbols, key=str)))}; substitute them")
+        raise ValueError(
+            "no exact decision is possible here and the numeric fallback needs numbers: J still has "
+            f"the parameters {', '.join(map(str, sorted(A.free_symbols, key=str)))}; substitute them"
+        )
     memo: dict = {}
     with mpmath.workdps(FALLBACK_DIGITS + 40):
         return mpmath.matrix([[mp_value(A[i, j], memo) for j in range(A.cols)] for i in range(A.rows)])
-
-
-# ----------------------------------------------------------------------------------------------
-# readable forms of exact numbers (identities only: never a guess)
-# ----------------------------------------------------------------------------------------------
-def readable(e: sp.Expr) -> sp.Expr:
-    """An exactly equal, readable form of an exact number (or expression in parameters)."""
-    if e == 0 or e.is_Rational:
-        return e
-    num, den = sp.fraction(sp.cancel(sp.together(e))) if not e.has(sp.sin, sp.cos) else sp.fraction(sp.together(e))
-    num, den = readable_fold(num), readable_fold(den)
-    if den == 1:
-        return num
-    if den.could_extract_minus_sign():
-        num, den = -num, -den
-    return num / den
-
-
-def readable_fold(e: sp.Expr) -> sp.Expr:
-    """e (a polynomial in sines, cosines, constants and parameters) reduced by sin² + cos² = 1 and folded."""
-    from .display import simplify_for_display  # local import: display imports nothing from here
-    if e.has(sp.sin, sp.cos):
-        try:
-            return simplify_for_display(e)
-        except Exception:  # pragma: no cover - display only
-            return sp.factor_terms(TR10i(sp.expand(e)))
-    if e.is_Rational:
-        return e
-    return sp.expand(sp.radsimp(e)) if e.is_number else sp.factor_terms(sp.radsimp(sp.expand(e)))
-
-
-def readable_ratio(num: sp.Expr, den: sp.Expr) -> sp.Expr:
-    """num/den for display, with common polynomial factors (in the sines and cosines) cancelled."""
-    if num == 0:
-        return sp.S.Zero
-    try:
-        ring = TrigRing([num, den], opaque=True)
-        if ring.domain.is_EX:
-            raise NotTrigPolynomial(num)
-        pn, pd = ring.normal_form(num), ring.normal_form(den)
-        g = pn.gcd(pd)
-        pn, pd = pn.exquo(g), pd.exquo(g)
-        num, den = ring.to_expr(pn, collect=True), ring.to_expr(pd, collect=True)
-    except (NotTrigPolynomial, Exception):
-        pass
-    return readable(num / den) if den != 1 else readable(num)

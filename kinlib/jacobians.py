@@ -10,32 +10,31 @@ Three Jacobians, one twist convention [ω; v] (angular rows first):
 
 Pinocchio and the Robotics Toolbox put the linear rows first: see :func:`linear_first`.
 """
+
 from __future__ import annotations
 
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_screw_list, as_thetas, as_vector, describe, is_symbolic
+from ._backend import as_matrix, as_vector, describe, is_symbolic
+from .poe import checked_screw_list, fk_space
 from .rigid import check_se3, check_so3, cross, skew
-from .screws import _exp6, _screw_kind
+from .screws import exp6_unchecked
 
 __all__ = [
-    "jacobian_space", "jacobian_body", "geometric_jacobian",
-    "space_to_body", "body_to_space", "body_to_geometric", "geometric_to_body",
-    "space_to_geometric", "geometric_to_space", "linear_first", "angular_first",
+    "jacobian_space",
+    "jacobian_body",
+    "geometric_jacobian",
+    "space_to_body",
+    "body_to_space",
+    "body_to_geometric",
+    "geometric_to_body",
+    "space_to_geometric",
+    "geometric_to_space",
+    "linear_first",
+    "angular_first",
     "position_jacobian",
 ]
-
-
-def _prepare(Slist, thetas, name, symbolic=None):
-    """Validated (screws 6×n, thetas, joint kinds 'R'/'P', symbolic?) for a screw list and joint values."""
-    if symbolic is None:
-        symbolic = is_symbolic(Slist, thetas)
-    S = as_screw_list(Slist, name, symbolic)
-    n = S.shape[1]
-    th = as_thetas(thetas, n, "thetas", symbolic)
-    kinds = [_screw_kind(S[:, i], f"{name} column {i + 1}") for i in range(n)]
-    return S, th, kinds, symbolic
 
 
 def _ad_apply(T, S, symbolic):
@@ -53,15 +52,22 @@ def jacobian_space(Slist, thetas):
     """Space Jacobian J_s(θ) (6×n, rows [ω; v]): V_s = J_s θ̇.
 
     Column i is Ad_{e^{[S1]θ1}⋯e^{[S_{i−1}]θ_{i−1}}} S_i; the first column is S_1.
+
+    >>> from kinlib.robots import planar_2r
+    >>> r = planar_2r()
+    >>> jacobian_space(r.screws, r.thetas).T   # column 1 is S1; column 2 = Ad_{e^{[S1]θ1}} S2 turns with θ1
+    Matrix([
+    [0, 0, 1,              0,               0, 0],
+    [0, 0, 1, L1*sin(theta1), -L1*cos(theta1), 0]])
     """
-    S, th, kinds, symbolic = _prepare(Slist, thetas, "Slist")
+    S, th, kinds, symbolic = checked_screw_list(Slist, thetas, "Slist")
     n = S.shape[1]
     T = sp.eye(4) if symbolic else np.eye(4)
     cols = []
     for i in range(n):
         Si = S[:, i]
         cols.append(Si if i == 0 else _ad_apply(T, Si, symbolic))
-        E = _exp6(Si, th[i], kinds[i], symbolic)
+        E = exp6_unchecked(Si, th[i], kinds[i], symbolic)
         T = T * E if symbolic else T @ E
     return sp.Matrix.hstack(*cols) if symbolic else np.column_stack(cols)
 
@@ -70,15 +76,27 @@ def jacobian_body(Blist, thetas):
     """Body Jacobian J_b(θ) (6×n, rows [ω; v]): V_b = J_b θ̇.
 
     Column i is Ad_{e^{−[B_n]θ_n}⋯e^{−[B_{i+1}]θ_{i+1}}} B_i; the last column is B_n.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> from kinlib.rigid import adjoint, trans_inv
+    >>> r, q = planar_2r(), [0, sp.pi / 2]
+    >>> Jb = jacobian_body(r.body_screws, q)
+    >>> Jb.T   # the last column is B2
+    Matrix([
+    [0, 0, 1, L1, L2, 0],
+    [0, 0, 1,  0, L2, 0]])
+    >>> Jb == adjoint(trans_inv(fk_space(r.M, r.screws, q))) * jacobian_space(r.screws, q)   # J_b = Ad_{T⁻¹} J_s
+    True
     """
-    B, th, kinds, symbolic = _prepare(Blist, thetas, "Blist")
+    B, th, kinds, symbolic = checked_screw_list(Blist, thetas, "Blist")
     n = B.shape[1]
     T = sp.eye(4) if symbolic else np.eye(4)
     cols = [None] * n
     for i in range(n - 1, -1, -1):
         Bi = B[:, i]
         cols[i] = Bi if i == n - 1 else _ad_apply(T, Bi, symbolic)
-        E = _exp6(-Bi, th[i], kinds[i], symbolic)
+        E = exp6_unchecked(-Bi, th[i], kinds[i], symbolic)
         T = T * E if symbolic else T @ E
     return sp.Matrix.hstack(*cols) if symbolic else np.column_stack(cols)
 
@@ -88,8 +106,18 @@ def geometric_jacobian(M, Slist, thetas):
 
     J = blockdiag(R, R) J_b = [[I, 0], [−[p], I]] J_s with T(θ) = e^{[S1]θ1}⋯e^{[Sn]θn} M = [[R, p], [0, 1]]:
     top rows the angular velocity in {s}, bottom rows the velocity of the end-effector origin p in {s}.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r = planar_2r()
+    >>> J = geometric_jacobian(r.M, r.screws, [0, sp.pi / 2])
+    >>> J[[3, 4], :]   # rows ṗ_x, ṗ_y at θ = (0, π/2)
+    Matrix([
+    [-L2, -L2],
+    [ L1,   0]])
+    >>> J[[3, 4], :].det()   # L1 L2 sin θ2 at θ2 = π/2
+    L1*L2
     """
-    from .chains import fk_space  # chains imports this module
     T = fk_space(M, Slist, thetas)
     Js = jacobian_space(Slist, thetas)
     return space_to_geometric(Js, T)
@@ -100,7 +128,15 @@ def _transform(T, name="T"):
 
 
 def space_to_body(Js, T):
-    """J_b = Ad_{T⁻¹} J_s (T = T(θ), the end-effector pose)."""
+    """J_b = Ad_{T⁻¹} J_s (T = T(θ), the end-effector pose).
+
+    >>> import numpy as np
+    >>> from kinlib.robots import planar_2r
+    >>> r, q = planar_2r(1, 1), [0.3, 0.5]
+    >>> Js, T = r.jacobian_space(q), r.fk(q)   # floats in, floats out
+    >>> np.allclose(space_to_body(Js, T), r.jacobian_body(q))
+    True
+    """
     symbolic = is_symbolic(Js, T)
     Js, T = as_matrix(Js, "Js", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
     R, p = T[:3, :3], T[:3, 3]
@@ -113,7 +149,14 @@ def space_to_body(Js, T):
 
 
 def body_to_space(Jb, T):
-    """J_s = Ad_T J_b."""
+    """J_s = Ad_T J_b.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r, q = planar_2r(), [0, sp.pi / 2]
+    >>> body_to_space(jacobian_body(r.body_screws, q), fk_space(r.M, r.screws, q)) == jacobian_space(r.screws, q)
+    True
+    """
     symbolic = is_symbolic(Jb, T)
     Jb, T = as_matrix(Jb, "Jb", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
     R, p = T[:3, :3], T[:3, 3]
@@ -135,7 +178,18 @@ def _rotation_of(T, symbolic, name="T"):
 
 
 def body_to_geometric(Jb, T):
-    """Geometric J = blockdiag(R, R) J_b, with R the rotation of T(θ) (T or R may be given)."""
+    """Geometric J = blockdiag(R, R) J_b, with R the rotation of T(θ) (T or R may be given).
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r, q = planar_2r(), [0, sp.pi / 2]
+    >>> T = fk_space(r.M, r.screws, q)
+    >>> J = body_to_geometric(jacobian_body(r.body_screws, q), T[:3, :3])   # R alone is enough
+    >>> J == geometric_jacobian(r.M, r.screws, q), J[[3, 4], :]
+    (True, Matrix([
+    [-L2, -L2],
+    [ L1,   0]]))
+    """
     symbolic = is_symbolic(Jb, T)
     Jb = as_matrix(Jb, "Jb", (6, None), symbolic)
     R = _rotation_of(T, symbolic)
@@ -145,7 +199,15 @@ def body_to_geometric(Jb, T):
 
 
 def geometric_to_body(J, T):
-    """J_b = blockdiag(Rᵀ, Rᵀ) J (the inverse of :func:`body_to_geometric`)."""
+    """J_b = blockdiag(Rᵀ, Rᵀ) J (the inverse of :func:`body_to_geometric`).
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r, q = planar_2r(), [0, sp.pi / 2]
+    >>> T = fk_space(r.M, r.screws, q)
+    >>> geometric_to_body(geometric_jacobian(r.M, r.screws, q), T) == jacobian_body(r.body_screws, q)
+    True
+    """
     symbolic = is_symbolic(J, T)
     J = as_matrix(J, "J", (6, None), symbolic)
     R = _rotation_of(T, symbolic)
@@ -155,7 +217,22 @@ def geometric_to_body(J, T):
 
 
 def space_to_geometric(Js, T):
-    """Geometric J = [[I, 0], [−[p], I]] J_s: ṗ = v_s + ω_s × p."""
+    """Geometric J = [[I, 0], [−[p], I]] J_s: ṗ = v_s + ω_s × p.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r, q = planar_2r(), [0, sp.pi / 2]
+    >>> Js, T = jacobian_space(r.screws, q), fk_space(r.M, r.screws, q)
+    >>> T[:3, 3].T, Js[[2, 3, 4], :]   # p; rows ω_z, v_x, v_y of J_s
+    (Matrix([[L1, L2, 0]]), Matrix([
+    [1,   1],
+    [0,   0],
+    [0, -L1]]))
+    >>> space_to_geometric(Js, T)[[3, 4], :]   # ṗ = v_s + ω_s × p
+    Matrix([
+    [-L2, -L2],
+    [ L1,   0]])
+    """
     symbolic = is_symbolic(Js, T)
     Js, T = as_matrix(Js, "Js", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
     p = T[:3, 3]
@@ -165,7 +242,15 @@ def space_to_geometric(Js, T):
 
 
 def geometric_to_space(J, T):
-    """J_s = [[I, 0], [[p], I]] J (the inverse of :func:`space_to_geometric`)."""
+    """J_s = [[I, 0], [[p], I]] J (the inverse of :func:`space_to_geometric`).
+
+    >>> import numpy as np
+    >>> from kinlib.robots import planar_2r
+    >>> r, q = planar_2r(1, 1), [0.3, 0.5]
+    >>> J, T = r.jacobian_geometric(q), r.fk(q)
+    >>> np.allclose(geometric_to_space(J, T), r.jacobian_space(q))
+    True
+    """
     symbolic = is_symbolic(J, T)
     J, T = as_matrix(J, "J", (6, None), symbolic), _transform(as_matrix(T, "T", None, symbolic))
     p = T[:3, 3]
@@ -175,7 +260,14 @@ def geometric_to_space(J, T):
 
 
 def linear_first(J):
-    """Rows [ω; v] → [v; ω] (the order of Pinocchio and the Robotics Toolbox); a twist or a 6×n Jacobian."""
+    """Rows [ω; v] → [v; ω] (the order of Pinocchio and the Robotics Toolbox); a twist or a 6×n Jacobian.
+
+    >>> linear_first([1, 2, 3, 4, 5, 6]).tolist()   # V = [ω; v] → [v; ω]
+    [4.0, 5.0, 6.0, 1.0, 2.0, 3.0]
+    >>> from kinlib.robots import planar_2r
+    >>> linear_first(planar_2r().jacobian_space())[:, 1].T
+    Matrix([[L1*sin(theta1), -L1*cos(theta1), 0, 0, 0, 1]])
+    """
     symbolic = is_symbolic(J)
     if isinstance(J, sp.MatrixBase) or (np.ndim(J) == 2):
         X = as_matrix(J, "J", (6, None), symbolic)
@@ -189,7 +281,15 @@ def linear_first(J):
 
 
 def angular_first(J):
-    """Rows [v; ω] → [ω; v] (from Pinocchio/Robotics Toolbox order back to the textbook's)."""
+    """Rows [v; ω] → [ω; v] (from Pinocchio/Robotics Toolbox order back to the textbook's).
+
+    >>> angular_first([4, 5, 6, 1, 2, 3]).tolist()   # [v; ω] → [ω; v]
+    [1.0, 2.0, 3.0, 4.0, 5.0, 6.0]
+    >>> from kinlib.robots import planar_2r
+    >>> Js = planar_2r().jacobian_space()
+    >>> angular_first(linear_first(Js)) == Js
+    True
+    """
     return linear_first(J)  # swapping the two 3-row blocks is its own inverse
 
 
@@ -197,6 +297,14 @@ def position_jacobian(p, thetas):
     """∂p/∂θ for a position map p(θ) written by hand (SymPy expressions): ṗ = (∂p/∂θ) θ̇.
 
     Problem 1.1's cart-pole: p = [θ1 + L cos θ2, h + L sin θ2] gives [[1, −L sin θ2], [0, L cos θ2]].
+
+    >>> import sympy as sp
+    >>> th1, th2 = sp.symbols("theta1 theta2", real=True)
+    >>> L, h = sp.symbols("L h", positive=True)
+    >>> position_jacobian([th1 + L * sp.cos(th2), h + L * sp.sin(th2)], [th1, th2])
+    Matrix([
+    [1, -L*sin(theta2)],
+    [0,  L*cos(theta2)]])
     """
     if isinstance(p, sp.MatrixBase):
         exprs = list(p)
@@ -207,7 +315,9 @@ def position_jacobian(p, thetas):
     if not exprs:
         raise ValueError("p must hold at least one coordinate, got an empty sequence")
     for i, e in enumerate(exprs):
-        if isinstance(e, (str, bytes, bool, np.bool_)) or not isinstance(e, (sp.Expr, int, float, np.integer, np.floating)):
+        if isinstance(e, (str, bytes, bool, np.bool_)) or not isinstance(
+            e, (sp.Expr, int, float, np.integer, np.floating)
+        ):
             raise TypeError(f"p[{i}] must be a SymPy expression in the joint symbols, got {describe(e)}")
     exprs = [as_vector([e], f"p[{i}]", 1, True)[0] for i, e in enumerate(exprs)]  # exact, real and finite
     if isinstance(thetas, sp.Symbol):
@@ -221,8 +331,10 @@ def position_jacobian(p, thetas):
         if not isinstance(t, sp.Symbol):
             raise TypeError(f"thetas[{i}] must be a SymPy Symbol (a joint variable), got {describe(t)}")
         if t.is_real is not True:
-            raise ValueError(f"thetas[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)), got the symbol "
-                             f"{t} with no real assumption")
+            raise ValueError(
+                f"thetas[{i}] must be a real symbol (sp.Symbol({str(t)!r}, real=True)), got the symbol "
+                f"{t} with no real assumption"
+            )
     if len(set(ths)) != len(ths):
         raise ValueError(f"thetas must hold distinct symbols, got {', '.join(map(str, ths))}")
     return sp.Matrix(exprs).jacobian(ths)

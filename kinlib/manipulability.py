@@ -1,6 +1,6 @@
 """Manipulability: how well the robot can move in every task direction at a configuration.
 
-For J (m×n, the rows of the task space: pick them with :func:`kinlib.singularities.task_rows`):
+For J (m×n, the rows of the task space: pick them with :func:`kinlib.taskspace.task_rows`):
 
 * Yoshikawa's manipulability  w = √det(J Jᵀ)  (n ≥ m), or √det(Jᵀ J) when the robot has fewer joints
   than task dimensions (n < m); = σ1 σ2 ⋯ σk, the product of the singular values; 0 exactly at a singularity.
@@ -12,61 +12,34 @@ For J (m×n, the rows of the task space: pick them with :func:`kinlib.singularit
 SymPy input gives exact SymPy results (``simplify=True`` for a display form); numbers give floats, and a
 batch of Jacobians (N, m, n) gives (N,) results.
 """
+
 from __future__ import annotations
 
-import numbers
 from typing import Any
 
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_vector, describe, is_symbolic
-from .singularities import _det, _is_zero, task_rows, trig_simplify
-from .exact import exact_is_zero
+from ._backend import as_vector, describe, exact_jacobian, is_symbolic, numeric_jacobian, numeric_vectors
+from .exact import exact_det
+from .exactfield import decide_zero
+from .singularities import trig_simplify
+from .taskspace import task_rows
 from .trigpoly import TrigRing, angles_in
 
-__all__ = ["manipulability", "condition_number", "isotropy", "velocity_ellipsoid", "twist_speed_form",
-           "twist_speed", "singular_values", "strongest_joints"]
-
-
-def _numeric(J: Any, name: str = "J", ndims: tuple = (2, 3)) -> np.ndarray:
-    """A float array of shape (m, n) or (N, m, n) of finite real numbers (no bools, strings, complex).
-
-    ``ndims=(1, 2)``: a vector (n,) or a batch of them (N, n) instead.
-    """
-    want = ("a matrix (m, n) or a batch (N, m, n)" if ndims == (2, 3) else "a vector (n,) or a batch (N, n)") + \
-        " of real numbers"
-    if isinstance(J, (str, bytes)) or J is None or np.isscalar(J) or isinstance(J, sp.Basic):
-        raise TypeError(f"{name} must be {want}, got {describe(J)}")
-    if isinstance(J, np.ndarray) and J.dtype.kind in "fiu":
-        A = J.astype(float, copy=False)
-    else:
-        try:
-            obj = J if isinstance(J, np.ndarray) else np.asarray(J, dtype=object)
-        except (TypeError, ValueError):
-            raise TypeError(f"{name} must be {want}, got {describe(J)}") from None
-        if obj.dtype.kind != "O":   # bool, complex, string arrays
-            raise TypeError(f"{name} must be {want}, got {describe(J)}")
-        for e in obj.flat:
-            if isinstance(e, (bool, np.bool_)) or not isinstance(e, (numbers.Real, np.integer, np.floating)):
-                raise TypeError(f"{name} must be {want}, got {describe(J)} with an entry {describe(e)}")
-        try:
-            A = np.array(obj.tolist(), dtype=float)
-        except (TypeError, ValueError):
-            raise TypeError(f"{name} must be {want}, got {describe(J)}") from None
-    if A.ndim not in ndims or 0 in A.shape:
-        raise ValueError(f"{name} must be {want}, got {describe(J)}")
-    if not np.isfinite(A).all():
-        raise ValueError(f"{name} must hold finite numbers (no nan/inf), got {describe(J)} with "
-                         f"{int((~np.isfinite(A)).sum())} nan/inf entries")
-    return A
-
-
-def _symbolic(J: Any, name: str = "J") -> sp.Matrix:
-    M = as_matrix(J, name, None, True)
-    if M.rows == 0 or M.cols == 0:
-        raise ValueError(f"{name} must have at least one row and one column, got {describe(M)}")
-    return M
+__all__ = [
+    "manipulability",
+    "condition_number",
+    "isotropy",
+    "velocity_ellipsoid",
+    "twist_speed_form",
+    "twist_speed",
+    "singular_values",
+    "strongest_joints",
+    "manipulability_values",
+    "MEASURES",
+    "measure_label",
+]
 
 
 def _gram(J: sp.Matrix) -> sp.Matrix:
@@ -75,14 +48,22 @@ def _gram(J: sp.Matrix) -> sp.Matrix:
 
 
 def singular_values(J: Any) -> np.ndarray:
-    """σ1 ≥ σ2 ≥ ⋯ ≥ σk (k = min(m, n)) of a numeric J; shape (k,) or (N, k) for a batch."""
-    return np.linalg.svd(_numeric(J), compute_uv=False)
+    """σ1 ≥ σ2 ≥ ⋯ ≥ σk (k = min(m, n)) of a numeric J; shape (k,) or (N, k) for a batch.
+
+    >>> import numpy as np
+    >>> from kinlib.robots import planar_2r
+    >>> J = planar_2r(1, 1).jacobian_geometric([0.0, np.pi / 2])[[3, 4]]   # rows ṗ_x, ṗ_y: [[-1, -1], [1, 0]]
+    >>> s = singular_values(J)
+    >>> s.round(3).tolist(), round(float(s.prod()), 3)   # σ1 σ2 = |det J| = L1 L2 |sin θ2|
+    ([1.618, 0.618], 1.0)
+    """
+    return np.linalg.svd(numeric_jacobian(J), compute_uv=False)
 
 
 def _display_sqrt(G_det: sp.Expr) -> sp.Expr:
     """√D for display: positive factors with even powers come out, the rest is trig-simplified under √."""
     ring = TrigRing([G_det], angles_in([G_det]), opaque=True)
-    D = sp.factor(ring.to_expr(ring.normal_form(G_det), trig=False))   # factored as a polynomial in s_i, c_i
+    D = sp.factor(ring.to_expr(ring.normal_form(G_det), trig=False))  # factored as a polynomial in s_i, c_i
     coeff, factors = sp.factor_list(D)
     outside, inside = sp.sqrt(coeff) if coeff >= 0 else sp.S.One, sp.S.One if coeff >= 0 else coeff
     for f, m in factors:
@@ -94,7 +75,7 @@ def _display_sqrt(G_det: sp.Expr) -> sp.Expr:
                 outside *= ft ** (m // 2)
                 inside *= ft
             else:
-                inside *= ft ** m
+                inside *= ft**m
     inside = sp.trigsimp(inside) if inside.has(sp.sin, sp.cos) else inside
     return outside * sp.sqrt(inside)
 
@@ -105,12 +86,21 @@ def manipulability(J: Any, simplify: bool = False):
     SymPy J: the exact expression (``simplify=True`` gives a display form, e.g. L²√(sin 2θ2 + 1), with
     the square roots of squares of positive parameters taken out). Numeric J (m, n) or a batch (N, m, n):
     the product of the singular values, float or (N,) array.
+
+    >>> import numpy as np
+    >>> from kinlib.robots import planar_2r
+    >>> J = task_rows(planar_2r().jacobian_geometric(), ["vx", "vy"])   # rows ṗ_x, ṗ_y: det J = L1 L2 sin θ2
+    >>> manipulability(J, simplify=True)
+    L1*L2*Abs(sin(theta2))
+    >>> q = np.array([[0, 0], [0, np.pi / 2], [0, np.pi]])   # stretched out, elbow at a right angle, folded
+    >>> (manipulability(planar_2r(1, 1).jacobian_geometric(q)[:, [3, 4]]).round(3) + 0.0).tolist()
+    [0.0, 1.0, 0.0]
     """
     if not is_symbolic(J):
-        A = _numeric(J)
+        A = numeric_jacobian(J)
         return np.prod(np.linalg.svd(A, compute_uv=False), axis=-1)
-    M = _symbolic(J)
-    D = _det(_gram(M))
+    M = exact_jacobian(J)
+    D = exact_det(_gram(M))
     if not simplify:
         return sp.sqrt(D)
     return _display_sqrt(D)
@@ -127,11 +117,8 @@ def _exact_sign(e: sp.Expr, what: str) -> int:
     v = sp.N(e, 50)
     if v.is_real and abs(v) > sp.Float("1e-40", 50):
         return 1 if v > 0 else -1
-    try:
-        if exact_is_zero(e):
-            return 0
-    except ValueError:
-        pass
+    if decide_zero(e, what):  # a ValueError when it cannot be decided either way
+        return 0
     raise ValueError(f"could not decide the sign of {what} = {e} exactly")
 
 
@@ -142,14 +129,14 @@ def _kappa_parts(J: Any, what: str):
     k = 2: λ± = (t ± √(t² − 4d))/2 (t = trace G, d = det G, t² − 4d = (a − c)² + 4b² ≥ 0), so
     κ = √(λ₊/λ₋) = (t + √(t² − 4d)) / (2√d). A constant G: its exact eigenvalues.
     """
-    M = _symbolic(J)
+    M = exact_jacobian(J)
     k = min(M.shape)
     if k == 1:
         return ("one",)
     # G as normal forms modulo sin² + cos² = 1 (canonical and fast; no trigsimp of big expressions)
     ring = TrigRing(list(M), angles_in(list(M)), opaque=True)
     E = [[ring.normal_form(M[i, j]) for j in range(M.cols)] for i in range(M.rows)]
-    A = E if M.rows <= M.cols else [list(col) for col in zip(*E)]          # k×N
+    A = E if M.rows <= M.cols else [list(col) for col in zip(*E)]  # k×N
     R = ring.ring
     G = [[ring.reduce(sum((x * y for x, y in zip(A[i], A[j])), R.zero)) for j in range(k)] for i in range(k)]
     if all(not g or g.is_ground for row in G for g in row):
@@ -172,7 +159,8 @@ def _kappa_parts(J: Any, what: str):
             "eigenvalues are roots of a cubic or worse): evaluate it numerically, e.g. "
             f"{what}(chain.subs(L=1).jacobian_geometric(q)) with float joint values q, or pick 2 task rows "
             "with task_rows(J, [...]) (a 2-row J has a closed form), or give J at a configuration "
-            "(no free symbols) for the exact value")
+            "(no free symbols) for the exact value"
+        )
     t = G[0][0] + G[1][1]
     d = ring.reduce(G[0][0] * G[1][1] - G[0][1] * G[0][1])
     disc = ring.reduce(t * t - 4 * d)
@@ -222,7 +210,7 @@ def condition_number(J: Any):
     (Abs(cos(t)) + 1)/Abs(sin(t))
     """
     if not is_symbolic(J):
-        s = np.linalg.svd(_numeric(J), compute_uv=False)
+        s = np.linalg.svd(numeric_jacobian(J), compute_uv=False)
         smax, smin = s[..., 0], s[..., -1]
         with np.errstate(divide="ignore", invalid="ignore"):
             out = np.where(smin > 1e-12 * np.maximum(smax, 1e-300), smax / np.where(smin > 0, smin, 1), np.inf)
@@ -245,7 +233,7 @@ def isotropy(J: Any):
     1/2
     """
     if not is_symbolic(J):
-        s = np.linalg.svd(_numeric(J), compute_uv=False)
+        s = np.linalg.svd(numeric_jacobian(J), compute_uv=False)
         smax, smin = s[..., 0], s[..., -1]
         with np.errstate(divide="ignore", invalid="ignore"):
             ratio = smin / np.where(smax > 0, smax, 1)
@@ -262,11 +250,21 @@ def isotropy(J: Any):
 def velocity_ellipsoid(J: Any, rows: Any = None):
     """The velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1}: (semi-axis lengths σ_i, unit directions u_i as columns).
 
-    ``rows``: pick task rows first (see :func:`~kinlib.singularities.task_rows`); by default a 6-row J
+    ``rows``: pick task rows first (see :func:`~kinlib.taskspace.task_rows`); by default a 6-row J
     uses its linear rows ("linear" = vx vy vz, the tool velocity ṗ for the geometric Jacobian), any other J
     all of its rows. Numeric J: lengths (k,) sorted descending and directions (m, k), k = min(m, n) (a
     batch gives (N, k), (N, m, k)). SymPy J: exact eigen-decomposition of J Jᵀ (lengths √λ, orthonormal
     directions), for small or evaluated J.
+
+    >>> import numpy as np, sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> lengths, dirs = velocity_ellipsoid(planar_2r(1, 1).jacobian_geometric([0.0, np.pi / 2]))   # rows vx vy vz
+    >>> lengths.round(3).tolist(), dirs.shape   # σ1, σ2; u1, u2 as columns
+    ([1.618, 0.618], (3, 2))
+    >>> velocity_ellipsoid(sp.Matrix([[2, 0], [0, 1]]))   # exact: semi-axes 2 along x, 1 along y
+    ([2, 1], Matrix([
+    [1, 0],
+    [0, 1]]))
     """
     if rows is None:
         shape = J.shape if hasattr(J, "shape") else np.shape(np.asarray(J, dtype=object))
@@ -274,14 +272,14 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
     if rows is not None:
         J = task_rows(J, rows)
     if not is_symbolic(J):
-        A = _numeric(J)
+        A = numeric_jacobian(J)
         U, s, _ = np.linalg.svd(A, full_matrices=False)
         return s, U
-    M = _symbolic(J)
+    M = exact_jacobian(J)
     G = M * M.T
     G = trig_simplify(G) if angles_in(list(G)) else G.applyfunc(sp.simplify)
     pairs = []
-    for lam, mult, vecs in G.eigenvects(simplify=True):
+    for lam, _mult, vecs in G.eigenvects(simplify=True):
         lam = sp.simplify(lam)
         ortho = sp.GramSchmidt(vecs, orthonormal=True)
         for v in ortho:
@@ -289,9 +287,10 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
 
     def key(p):
         try:
-            return -float(p[0].subs({s: 1 for s in p[0].free_symbols}))
+            return -float(p[0].subs(dict.fromkeys(p[0].free_symbols, 1)))
         except TypeError:
             return 0.0
+
     pairs.sort(key=key)
     k = min(M.rows, M.cols)
     pairs = pairs[:k] if M.cols < M.rows else pairs
@@ -303,25 +302,40 @@ def twist_speed_form(J: Any, simplify: bool = False):
     """Jᵀ J, the matrix of problem 6.2's quadratic form V·V = θ̇ᵀ (Jᵀ J) θ̇ (n×n).
 
     Exact for SymPy J (``simplify=True``: trig-simplified for display); floats, or (N, n, n), for numbers.
+
+    >>> from kinlib.robots import planar_2r
+    >>> twist_speed_form(task_rows(planar_2r().jacobian_geometric(), ["vx", "vy"]), simplify=True)   # ṗ·ṗ
+    Matrix([
+    [L1**2 + 2*L1*L2*cos(theta2) + L2**2, L2*(L1*cos(theta2) + L2)],
+    [           L2*(L1*cos(theta2) + L2),                    L2**2]])
     """
     if not is_symbolic(J):
-        A = _numeric(J)
+        A = numeric_jacobian(J)
         return np.swapaxes(A, -1, -2) @ A
-    M = _symbolic(J)
+    M = exact_jacobian(J)
     G = M.T * M
     return trig_simplify(G) if simplify else G
 
 
 def twist_speed(J: Any, qdot: Any, simplify: bool = False):
-    """V·V = θ̇ᵀ (Jᵀ J) θ̇ = ‖J θ̇‖², the squared size of the twist V = J θ̇ (problem 6.2)."""
+    """V·V = θ̇ᵀ (Jᵀ J) θ̇ = ‖J θ̇‖², the squared size of the twist V = J θ̇ (problem 6.2).
+
+    >>> import numpy as np
+    >>> from kinlib.robots import planar_2r
+    >>> J = task_rows(planar_2r().jacobian_geometric(), ["vx", "vy"])
+    >>> twist_speed(J, [1, 0], simplify=True)   # joint 1 alone: |ṗ|² = |p|², the law of cosines
+    L1**2 + 2*L1*L2*cos(theta2) + L2**2
+    >>> float(twist_speed(planar_2r(1, 1).jacobian_space([0.0, np.pi / 2]), [1.0, 1.0]))   # V_s = (0, 0, 2, 0, -1, 0)
+    5.0
+    """
     if not is_symbolic(J, qdot):
-        A = _numeric(J)
-        q = _numeric(qdot, "qdot", (1, 2))
+        A = numeric_jacobian(J)
+        q = numeric_vectors(qdot, "qdot", A.shape[-1], "joint rates θ̇")
         if q.shape[-1:] != (A.shape[-1],):
             raise ValueError(f"qdot must hold {A.shape[-1]} joint rates, got {describe(qdot)}")
         V = np.einsum("...ij,...j->...i", A, q)
         return np.sum(V * V, axis=-1)
-    M = _symbolic(J)
+    M = exact_jacobian(J)
     q = as_vector(qdot, "qdot", M.cols, True)
     e = (q.T * (M.T * M) * q)[0, 0]
     return trig_simplify(sp.expand(e)) if simplify else e
@@ -333,6 +347,14 @@ def strongest_joints(row: Any, tol: float = 1e-9):
     ``row``: the n entries of that row at a configuration (problem 4.1: the ṗ_x row). One joint gives an
     int; a tie gives a tuple of ints, e.g. (1, 2). SymPy entries are compared exactly (|a| − |b|
     simplified to 0); numbers within ``tol`` (relative) tie.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_3r
+    >>> row = planar_3r(1, 1, 1).jacobian_geometric([sp.pi / 2, 0, 0])[3, :]   # the ṗ_x row, arm along y_s
+    >>> row, strongest_joints(row)
+    (Matrix([[-3, -2, -1]]), 1)
+    >>> strongest_joints([0.5, -0.5, 0.1])   # a tie
+    (1, 2)
     """
     if isinstance(row, sp.MatrixBase):
         vals = list(row)
@@ -351,9 +373,70 @@ def strongest_joints(row: Any, tol: float = 1e-9):
             raise ValueError(f"row must hold real numbers (evaluate J at a configuration first), got {vals}")
         mags = [sp.Abs(v) for v in vals]
         top = max(mags, key=lambda m: float(m))
-        best = [i + 1 for i, m in enumerate(mags) if _is_zero(m - top)]
+        best = [i + 1 for i, m in enumerate(mags) if decide_zero(m - top)]
     else:
         a = np.abs(as_vector(vals, "row", None, False))
         top = float(a.max())
         best = [i + 1 for i, m in enumerate(a) if abs(m - top) <= tol * max(top, 1e-300)]
     return best[0] if len(best) == 1 else tuple(best)
+
+
+# ----------------------------------------------------------------------------------------------
+# measures over many configurations (numbers; the pictures plot these)
+# ----------------------------------------------------------------------------------------------
+#: The measures :func:`manipulability_values` knows, and their plain-text labels.
+MEASURES = {
+    "yoshikawa": "√det(J Jᵀ)",
+    "det": "det J",
+    "inverse_condition": "σ_min / σ_max",
+    "min_singular_value": "σ_min",
+}
+
+
+def manipulability_values(J: Any, measure: Any = "yoshikawa") -> np.ndarray:
+    """A manipulability measure of numeric task Jacobians J (m×n, or a batch (N, m, n) → N values):
+
+    * ``'yoshikawa'``: w = √det(J Jᵀ) (√det(Jᵀ J) when n < m) = σ1 ⋯ σk, as :func:`manipulability`;
+    * ``'det'``: det J (square J only; signed, so its zero contour is the singular set);
+    * ``'inverse_condition'``: σ_min/σ_max = :func:`isotropy` (1 = isotropic, 0 = singular);
+    * ``'min_singular_value'``: σ_min;
+    * a callable taking the batch (N, m, n) and returning N values.
+
+    >>> import numpy as np
+    >>> J = np.array([[[2.0, 0.0], [0.0, 0.5]], [[1.0, 1.0], [1.0, 1.0]]])
+    >>> manipulability_values(J).round(12).tolist(), manipulability_values(J, "inverse_condition").round(12).tolist()
+    ([1.0, 0.0], [0.25, 0.0])
+    """
+    if callable(measure):
+        A = numeric_jacobian(J)
+        return np.asarray(measure(A), dtype=float)
+    if not isinstance(measure, str) or measure not in MEASURES:
+        raise ValueError(f"measure must be one of {', '.join(MEASURES)} or a callable, got {describe(measure)}")
+    A = numeric_jacobian(J)
+    if measure == "yoshikawa":
+        return manipulability(A)
+    if measure == "det":
+        if A.shape[-1] != A.shape[-2]:
+            raise ValueError(
+                f"measure='det' needs a square task Jacobian, got rows×joints = {A.shape[-2:]}; "
+                f"use measure='yoshikawa' or choose as many rows as joints"
+            )
+        return np.linalg.det(A)
+    s = np.linalg.svd(A, compute_uv=False)
+    if measure == "min_singular_value":
+        return s[..., -1]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(s[..., 0] > 0, s[..., -1] / s[..., 0], 0.0)
+
+
+def measure_label(measure: Any, m: int, n: int) -> str:
+    """The plain-text name of a measure for an m-row, n-joint task Jacobian (axis labels, legends).
+
+    >>> measure_label("yoshikawa", 2, 3), measure_label("yoshikawa", 3, 2), measure_label("det", 2, 2)
+    ('√det(J Jᵀ)', '√det(Jᵀ J)', 'det J')
+    """
+    if measure == "yoshikawa" and n < m:
+        return "√det(Jᵀ J)"
+    if isinstance(measure, str):
+        return MEASURES.get(measure, measure)
+    return getattr(measure, "__name__", "measure")

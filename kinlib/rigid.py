@@ -3,10 +3,9 @@
 Lynch & Park, *Modern Robotics*, chapter 3. Every function takes SymPy input (exact result, a
 SymPy Matrix) or numeric input (a NumPy float array).
 """
+
 from __future__ import annotations
 
-import math
-import numbers
 import random
 
 import numpy as np
@@ -14,20 +13,45 @@ import sympy as sp
 from sympy.core.function import AppliedUndef
 
 from ._backend import (
-    as_matrix, as_vector, check_real_finite, describe, exact_floats, exact_number, is_symbolic, is_zero, real_array,
+    as_matrix,
+    as_scalar,
+    as_vector,
+    check_real_finite,
+    describe,
+    exact_number,
+    is_symbolic,
+    real_array,
 )
 from .exactfield import decide_zero
 
 __all__ = [
-    "skew", "unskew", "exp3", "rp_to_trans", "trans_to_rp", "trans_inv", "adjoint",
-    "check_so3", "check_se3", "cross",
+    "skew",
+    "unskew",
+    "exp3",
+    "rp_to_trans",
+    "trans_to_rp",
+    "trans_inv",
+    "adjoint",
+    "check_so3",
+    "check_se3",
+    "check_unit_vector",
+    "cross",
+    "log3",
+    "UNIT_ROUNDING",
 ]
 
 _TOL = 1e-6
 
 
 def cross(a, b):
-    """a × b for two 3-vectors (SymPy columns or float arrays); avoids np.cross' overhead."""
+    """a × b for two 3-vectors (SymPy columns or float arrays); avoids np.cross' overhead.
+
+    >>> import sympy as sp
+    >>> cross(sp.Matrix([1, 0, 0]), sp.Matrix([0, 1, 0])).T
+    Matrix([[0, 0, 1]])
+    >>> cross([1.0, 0.0, 0.0], [0.0, 1.0, 0.0]).tolist()
+    [0.0, 0.0, 1.0]
+    """
     if isinstance(a, sp.MatrixBase) or isinstance(b, sp.MatrixBase):
         a, b = sp.Matrix(a), sp.Matrix(b)
         return sp.Matrix([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
@@ -35,7 +59,18 @@ def cross(a, b):
 
 
 def skew(w):
-    """[ω]: the 3×3 skew-symmetric matrix with [ω] x = ω × x."""
+    """[ω]: the 3×3 skew-symmetric matrix with [ω] x = ω × x.
+
+    >>> skew([1, 2, 3]).tolist()
+    [[0.0, -3.0, 2.0], [3.0, 0.0, -1.0], [-2.0, 1.0, 0.0]]
+    >>> import sympy as sp
+    >>> a, b, c = sp.symbols("a b c", real=True)
+    >>> skew(sp.Matrix([a, b, c]))
+    Matrix([
+    [ 0, -c,  b],
+    [ c,  0, -a],
+    [-b,  a,  0]])
+    """
     w = as_vector(w, "w", 3)
     rows = [[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]]
     if isinstance(w, sp.MatrixBase):
@@ -44,11 +79,21 @@ def skew(w):
 
 
 def unskew(W):
-    """ω from [ω]: the inverse of :func:`skew`. ``W`` must be 3×3 and skew-symmetric."""
+    """ω from [ω]: the inverse of :func:`skew`. ``W`` must be 3×3 and skew-symmetric.
+
+    >>> import sympy as sp
+    >>> unskew(sp.Matrix([[0, -3, 2], [3, 0, -1], [-2, 1, 0]])).T
+    Matrix([[1, 2, 3]])
+    >>> unskew(skew([4.0, 5.0, 6.0])).tolist()
+    [4.0, 5.0, 6.0]
+    """
     W = as_matrix(W, "W", (3, 3))
     symbolic = isinstance(W, sp.MatrixBase)
-    bad = (not all(is_zero(W[i, j] + W[j, i]) for i in range(3) for j in range(i, 3))) if symbolic \
+    bad = (
+        (not all(decide_zero(W[i, j] + W[j, i]) for i in range(3) for j in range(i, 3)))
+        if symbolic
         else not np.allclose(W, -W.T, atol=_TOL)
+    )
     if bad:
         raise ValueError(f"W must be skew-symmetric (W = -Wᵀ), got {W.tolist()}")
     v = [W[2, 1], W[0, 2], W[1, 0]]
@@ -60,24 +105,36 @@ def unskew(W):
 UNIT_ROUNDING = sp.Rational(1, 10**9)
 
 
-def _unit_axis(omega, name: str):
+def check_unit_vector(omega, name: str):
     """Check that ω is a unit vector; return it (SymPy column or float array).
 
     Numeric: | |ω| − 1 | ≤ 1e-6. Exact: |ω|² = 1 exactly, except for an axis of plain rational numbers
     (typically typed or computed floats made exact: [0.7071067811865476, 0.7071067811865476, 0]) where
     | |ω|² − 1 | ≤ 1e-9 is accepted and the typed decimals are kept as they are (never rounded to a
     "nice" value): results are exact for the numbers typed. Type sp.sqrt(2)/2 for an exactly unit axis.
+
+    >>> import sympy as sp
+    >>> check_unit_vector(sp.Matrix([0, sp.sqrt(2) / 2, sp.sqrt(2) / 2]), "omega").T
+    Matrix([[0, sqrt(2)/2, sqrt(2)/2]])
+    >>> import numpy as np
+    >>> check_unit_vector(np.array([1.0, 1.0, 0.0]), "omega")
+    Traceback (most recent call last):
+        ...
+    ValueError: omega must be a unit vector (|ω| = 1), got [1.0, 1.0, 0.0] with |ω| = 1.41421
     """
     symbolic = isinstance(omega, sp.MatrixBase)
     if symbolic:
         n2 = (omega.T * omega)[0]
-        if n2 != 1 and not (n2.is_Rational and abs(n2 - 1) <= UNIT_ROUNDING) and not is_zero(n2 - 1):
+        if n2 != 1 and not (n2.is_Rational and abs(n2 - 1) <= UNIT_ROUNDING) and not decide_zero(n2 - 1):
             hint = ""
             if n2.is_Rational and abs(n2 - 1) < sp.Rational(1, 1000):
-                hint = (f" (|ω|² − 1 = {float(n2 - 1):.3g}; decimals are accepted when |ω|² is 1 to within 1e-9: "
-                        f"type more digits, or exact values such as sp.sqrt(2)/2)")
-            raise ValueError(f"{name} must be a unit vector (|ω| = 1), got {list(omega)} with "
-                             f"|ω|² = {sp.simplify(n2)}{hint}")
+                hint = (
+                    f" (|ω|² − 1 = {float(n2 - 1):.3g}; decimals are accepted when |ω|² is 1 to within 1e-9: "
+                    f"type more digits, or exact values such as sp.sqrt(2)/2)"
+                )
+            raise ValueError(
+                f"{name} must be a unit vector (|ω| = 1), got {list(omega)} with |ω|² = {sp.simplify(n2)}{hint}"
+            )
     else:
         n = float(np.sqrt(omega @ omega))
         if abs(n - 1.0) > _TOL:
@@ -86,36 +143,38 @@ def _unit_axis(omega, name: str):
 
 
 def exp3(omega, theta):
-    """Rodrigues: e^{[ω]θ} = I + sin θ [ω] + (1 − cos θ) [ω]², for a unit axis ω."""
+    """Rodrigues: e^{[ω]θ} = I + sin θ [ω] + (1 − cos θ) [ω]², for a unit axis ω.
+
+    >>> import sympy as sp
+    >>> exp3(sp.Matrix([0, 0, 1]), sp.pi / 2)
+    Matrix([
+    [0, -1, 0],
+    [1,  0, 0],
+    [0,  0, 1]])
+    >>> import numpy as np
+    >>> (np.round(exp3([1, 0, 0], np.pi / 2), 3) + 0.0).tolist()
+    [[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]]
+    """
     symbolic = is_symbolic(omega, theta)
-    omega = _unit_axis(as_vector(omega, "omega", 3, symbolic), "omega")
-    theta = _scalar(theta, "theta", symbolic)
+    omega = check_unit_vector(as_vector(omega, "omega", 3, symbolic), "omega")
+    theta = as_scalar(theta, "theta", symbolic)
     W = skew(omega)
     if symbolic:
         return sp.eye(3) + sp.sin(theta) * W + (1 - sp.cos(theta)) * W * W
     return np.eye(3) + np.sin(theta) * W + (1.0 - np.cos(theta)) * (W @ W)
 
 
-def _scalar(x, name: str, symbolic: bool):
-    """A joint value / pitch: exact (symbolic; 0.1 → 1/10) or a finite float; anything else refused."""
-    if symbolic:
-        if isinstance(x, sp.Basic) and not isinstance(x, sp.Float):
-            if not isinstance(x, sp.Expr):
-                raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
-            return check_real_finite(exact_floats(x, name), name)
-        return exact_number(x, name)
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (numbers.Real, np.integer, np.floating)):
-        if isinstance(x, (complex, np.complexfloating)):
-            raise TypeError(f"{name} must be a real number, got the complex number {x!r}")
-        raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
-    x = float(x)
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be a finite real number, got {x!r}")
-    return x
-
-
 def rp_to_trans(R, p):
-    """T = [[R, p], [0, 1]] from a rotation R and a position p."""
+    """T = [[R, p], [0, 1]] from a rotation R and a position p.
+
+    >>> import sympy as sp
+    >>> rp_to_trans(sp.eye(3), sp.Matrix([1, 2, 3]))
+    Matrix([
+    [1, 0, 0, 1],
+    [0, 1, 0, 2],
+    [0, 0, 1, 3],
+    [0, 0, 0, 1]])
+    """
     symbolic = is_symbolic(R, p)
     R = as_matrix(R, "R", (3, 3), symbolic)
     p = as_vector(p, "p", 3, symbolic)
@@ -128,7 +187,16 @@ def rp_to_trans(R, p):
 
 
 def trans_to_rp(T):
-    """(R, p) from T = [[R, p], [0, 1]] ∈ SE(3)."""
+    """(R, p) from T = [[R, p], [0, 1]] ∈ SE(3).
+
+    >>> import sympy as sp
+    >>> R, p = trans_to_rp(sp.Matrix([[0, -1, 0, 1], [1, 0, 0, 2], [0, 0, 1, 3], [0, 0, 0, 1]]))
+    >>> R, p.T
+    (Matrix([
+    [0, -1, 0],
+    [1,  0, 0],
+    [0,  0, 1]]), Matrix([[1, 2, 3]]))
+    """
     T = check_se3(T, "T")
     if isinstance(T, sp.MatrixBase):
         return T[:3, :3], T[:3, 3]
@@ -149,35 +217,67 @@ def _numeric_sample(M):
 
 
 def check_so3(R, name: str = "R"):
-    """R as a matrix after checking RᵀR = I and det R = 1 (numerically at sample points when symbolic)."""
+    """R as a matrix after checking RᵀR = I and det R = 1 (numerically at sample points when symbolic).
+
+    >>> import sympy as sp
+    >>> check_so3(sp.Matrix([[0, -1, 0], [1, 0, 0], [0, 0, 1]])).det()
+    1
+    >>> import numpy as np
+    >>> check_so3(np.diag([2.0, 1.0, 1.0]))  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    ValueError: R must be a rotation matrix in SO(3) (RᵀR = I, det R = 1), got an array of shape (3, 3) ...
+    """
     R = as_matrix(R, name, (3, 3))
     Rn = _numeric_sample(R) if isinstance(R, sp.MatrixBase) else R
     if Rn is None:
         raise ValueError(f"{name} must be a rotation matrix in SO(3); its entries could not be evaluated: {R}")
     if not (np.allclose(Rn.T @ Rn, np.eye(3), atol=_TOL) and abs(np.linalg.det(Rn) - 1) < _TOL):
-        raise ValueError(f"{name} must be a rotation matrix in SO(3) (RᵀR = I, det R = 1), got {describe(R)} "
-                         f"with RᵀR − I of size {np.abs(Rn.T @ Rn - np.eye(3)).max():.3g} and det R = {np.linalg.det(Rn):.6g}")
+        raise ValueError(
+            f"{name} must be a rotation matrix in SO(3) (RᵀR = I, det R = 1), got {describe(R)} "
+            f"with RᵀR − I of size {np.abs(Rn.T @ Rn - np.eye(3)).max():.3g} and det R = {np.linalg.det(Rn):.6g}"
+        )
     return R
 
 
 def check_se3(T, name: str = "T"):
-    """T as a matrix after checking it is a homogeneous transform [[R, p], [0, 1]] with R ∈ SO(3)."""
+    """T as a matrix after checking it is a homogeneous transform [[R, p], [0, 1]] with R ∈ SO(3).
+
+    >>> import numpy as np
+    >>> check_se3(np.eye(4)).shape
+    (4, 4)
+    >>> check_se3(np.diag([1.0, 1.0, 1.0, 2.0]))
+    Traceback (most recent call last):
+        ...
+    ValueError: T must be a homogeneous transform in SE(3) with last row [0, 0, 0, 1], got last row [0.0, 0.0, 0.0, 2.0]
+    """
     T = as_matrix(T, name, None)
     if T.shape != (4, 4):
         raise ValueError(f"{name} must be a 4×4 homogeneous transform in SE(3), got {describe(T)}")
     bottom = list(T[3, :]) if isinstance(T, sp.MatrixBase) else T[3, :].tolist()
     if isinstance(T, sp.MatrixBase):
-        ok = all(is_zero(b - e) for b, e in zip(bottom, (0, 0, 0, 1)))
+        ok = all(decide_zero(b - e) for b, e in zip(bottom, (0, 0, 0, 1)))
     else:
         ok = np.allclose(bottom, (0, 0, 0, 1), atol=_TOL)
     if not ok:
-        raise ValueError(f"{name} must be a homogeneous transform in SE(3) with last row [0, 0, 0, 1], got last row {bottom}")
+        raise ValueError(
+            f"{name} must be a homogeneous transform in SE(3) with last row [0, 0, 0, 1], got last row {bottom}"
+        )
     check_so3(T[:3, :3], f"the rotation part of {name}")
     return T
 
 
 def trans_inv(T):
-    """T⁻¹ = [[Rᵀ, −Rᵀp], [0, 1]]."""
+    """T⁻¹ = [[Rᵀ, −Rᵀp], [0, 1]].
+
+    >>> import sympy as sp
+    >>> trans_inv(sp.Matrix([[0, -1, 0, 1], [1, 0, 0, 2], [0, 0, 1, 3], [0, 0, 0, 1]]))
+    Matrix([
+    [ 0, 1, 0, -2],
+    [-1, 0, 0,  1],
+    [ 0, 0, 1, -3],
+    [ 0, 0, 0,  1]])
+    """
     T = check_se3(T, "T")
     R, p = T[:3, :3], T[:3, 3]
     if isinstance(T, sp.MatrixBase):
@@ -189,7 +289,21 @@ def trans_inv(T):
 
 
 def adjoint(T):
-    """Ad_T = [[R, 0], [[p]R, R]] (6×6), acting on twists [ω; v]."""
+    """Ad_T = [[R, 0], [[p]R, R]] (6×6), acting on twists [ω; v].
+
+    >>> import sympy as sp
+    >>> T = sp.Matrix([[1, 0, 0, 1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])   # a shift by 1 along x
+    >>> adjoint(T)
+    Matrix([
+    [1, 0,  0, 0, 0, 0],
+    [0, 1,  0, 0, 0, 0],
+    [0, 0,  1, 0, 0, 0],
+    [0, 0,  0, 1, 0, 0],
+    [0, 0, -1, 0, 1, 0],
+    [0, 1,  0, 0, 0, 1]])
+    >>> (adjoint(T) * sp.Matrix([0, 0, 1, 0, 0, 0])).T   # spin about z_b seen from {s}: v = −ω × p
+    Matrix([[0, 0, 1, 0, -1, 0]])
+    """
     T = check_se3(T, "T")
     R, p = T[:3, :3], T[:3, 3]
     if isinstance(T, sp.MatrixBase):
@@ -208,18 +322,18 @@ def adjoint(T):
 def _log3_numeric(A: np.ndarray):
     """(vector ω̂θ, axis ω̂, angle θ) for a batch (N, 3, 3) of rotation matrices."""
     ax = 0.5 * np.stack([A[:, 2, 1] - A[:, 1, 2], A[:, 0, 2] - A[:, 2, 0], A[:, 1, 0] - A[:, 0, 1]], axis=-1)
-    s = np.linalg.norm(ax, axis=-1)                                  # = sin θ
-    c = np.clip((np.trace(A, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)   # = cos θ
-    theta = np.arctan2(s, c)                                         # θ ∈ [0, π], accurate near 0 and π
-    vec = ax / np.sinc(theta / np.pi)[:, None]                       # sin θ ω̂ · θ / sin θ  (θ ≤ π/2 branch)
-    big = c < 0                                                      # θ > π/2: the axis from the symmetric part
+    s = np.linalg.norm(ax, axis=-1)  # = sin θ
+    c = np.clip((np.trace(A, axis1=1, axis2=2) - 1.0) / 2.0, -1.0, 1.0)  # = cos θ
+    theta = np.arctan2(s, c)  # θ ∈ [0, π], accurate near 0 and π
+    vec = ax / np.sinc(theta / np.pi)[:, None]  # sin θ ω̂ · θ / sin θ  (θ ≤ π/2 branch)
+    big = c < 0  # θ > π/2: the axis from the symmetric part
     if np.any(big):
         Ab = A[big]
-        B = 0.5 * (Ab + np.swapaxes(Ab, 1, 2)) - c[big][:, None, None] * np.eye(3)   # (1 − cos θ) ω̂ω̂ᵀ
+        B = 0.5 * (Ab + np.swapaxes(Ab, 1, 2)) - c[big][:, None, None] * np.eye(3)  # (1 − cos θ) ω̂ω̂ᵀ
         k = np.argmax(np.diagonal(B, axis1=1, axis2=2), axis=-1)
         col = B[np.arange(len(k)), :, k]
-        w = col / np.linalg.norm(col, axis=-1)[:, None]              # ω̂ up to sign, ω̂_k > 0
-        d = np.einsum("ij,ij->i", w, ax[big])                        # = sin θ (ω̂·ω̂) with the right sign
+        w = col / np.linalg.norm(col, axis=-1)[:, None]  # ω̂ up to sign, ω̂_k > 0
+        d = np.einsum("ij,ij->i", w, ax[big])  # = sin θ (ω̂·ω̂) with the right sign
         # at θ = π (to rounding) either sign is a logarithm: Modern Robotics' choice, the first of
         # ω̂_3, ω̂_2, ω̂_1 with 1 + r_kk = 2ω̂_k² not near 0 (|·| ≥ 1e-6, its NearZero) is positive
         diag1 = 1.0 + np.diagonal(Ab, axis1=1, axis2=2)
@@ -233,8 +347,8 @@ def _log3_numeric(A: np.ndarray):
 
 def _log3_exact(R: sp.Matrix):
     """(ω̂, θ, exactly_zero) for an exact SymPy rotation matrix; see :func:`log3`."""
-    from ._backend import check_real_finite, exact_number
     from .display import is_identically_zero, simplify_for_display
+
     for e in R:
         check_real_finite(e, "R")
     if not R.free_symbols:
@@ -243,9 +357,11 @@ def _log3_exact(R: sp.Matrix):
         for i in range(3):
             for j in range(i, 3):
                 if not decide_zero(D[i, j], f"(RᵀR − I)[{i}, {j}]"):
-                    raise ValueError(f"R must be exactly a rotation matrix (RᵀR = I) for an exact logarithm, got "
-                                     f"{R.tolist()} with (RᵀR − I)[{i}, {j}] = {D[i, j]} ≠ 0; "
-                                     f"give exact entries (sp.sqrt(2)/2, not 0.7071) or a NumPy array for a numeric log")
+                    raise ValueError(
+                        f"R must be exactly a rotation matrix (RᵀR = I) for an exact logarithm, got "
+                        f"{R.tolist()} with (RᵀR − I)[{i}, {j}] = {D[i, j]} ≠ 0; "
+                        f"give exact entries (sp.sqrt(2)/2, not 0.7071) or a NumPy array for a numeric log"
+                    )
         if not decide_zero(R.det() - 1, "det R − 1"):
             raise ValueError(f"R must be a rotation matrix with det R = 1, got det R = {sp.simplify(R.det())}")
         simp = sp.radsimp
@@ -262,14 +378,14 @@ def _log3_exact(R: sp.Matrix):
                     return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), sp.pi, False
             raise AssertionError("unreachable: a rotation by π has some 1 + r_kk = 2ω̂_k² ≠ 0")  # pragma: no cover
         theta = _acos_exact(c)
-        s = sp.sqrt(simp(1 - c ** 2))                                # sin θ > 0 for 0 < θ < π
+        s = sp.sqrt(simp(1 - c**2))  # sin θ > 0 for 0 < θ < π
         w = sp.Matrix([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / (2 * s)
         return w.applyfunc(lambda e: sp.radsimp(sp.simplify(e))), theta, False
     # free symbols: the closed form valid for 0 < θ < π (sin θ ≠ 0)
     if is_identically_zero(R - sp.eye(3)):
         return sp.Matrix([0, 0, 1]), sp.S.Zero, True
     c = simplify_for_display((R.trace() - 1) / 2)
-    s = sp.sqrt(simplify_for_display(1 - c ** 2))
+    s = sp.sqrt(simplify_for_display(1 - c**2))
     w = simplify_for_display(sp.Matrix([R[2, 1] - R[1, 2], R[0, 2] - R[2, 0], R[1, 0] - R[0, 1]]) / 2) / s
     return w, sp.acos(c), False
 
@@ -281,6 +397,7 @@ def _acos_exact(c: sp.Expr) -> sp.Expr:
     cos(pπ/q) − c = 0 is *proved* (:func:`decide_zero`); otherwise acos(c) stays as it is. Exact either way.
     """
     import fractions
+
     theta = sp.acos(c)
     if not isinstance(theta, sp.acos):
         return theta
@@ -358,8 +475,10 @@ def log3(R, form: str = "matrix"):
     if bad.size:
         i = bad[0]
         where = "" if single else f"[{i}]"
-        raise ValueError(f"R{where} must be a rotation matrix in SO(3) (RᵀR = I, det R = 1 to {_TOL:g}), got RᵀR − I "
-                         f"of size {err[i]:.3g} and det R = {det[i]:.6g}")
+        raise ValueError(
+            f"R{where} must be a rotation matrix in SO(3) (RᵀR = I, det R = 1 to {_TOL:g}), got RᵀR − I "
+            f"of size {err[i]:.3g} and det R = {det[i]:.6g}"
+        )
     vec, axis, theta = _log3_numeric(B)
     if single:
         vec, axis, theta = vec[0], axis[0], float(theta[0])

@@ -5,6 +5,7 @@ same names (so ``planar_offset_3r()`` is the problem set's robot in L, and
 ``planar_offset_3r(1)`` a numeric one for the fast path). Python floats are turned into exact
 rationals (0.425 → 17/40), so symbolic work stays exact.
 """
+
 from __future__ import annotations
 
 import sympy as sp
@@ -12,7 +13,17 @@ import sympy as sp
 from ._backend import describe, exact_number
 from .chains import SerialChain
 
-__all__ = ["cart_pole", "planar_offset_3r", "spatial_rppr", "planar_3r", "planar_rpp", "ur5", "length"]
+__all__ = [
+    "cart_pole",
+    "planar_offset_3r",
+    "spatial_rppr",
+    "planar_2r",
+    "planar_3r",
+    "planar_rpp",
+    "ur5",
+    "length",
+    "from_urdf_joints",
+]
 
 
 def length(value, name: str):
@@ -45,48 +56,130 @@ def cart_pole(L=None, h=None) -> SerialChain:
     """Problem 1.1: a cart sliding along x_s (θ1) carrying a pole of length L hinged at height h (θ2 from x_s).
 
     End effector: the tip of the pole, p = (θ1 + L cos θ2, h + L sin θ2, 0).
+
+    >>> import sympy as sp
+    >>> r = cart_pole()
+    >>> r.joint_types, r.params
+    ('PR', (L, h))
+    >>> r.fk([0, sp.pi / 2])[:3, 3].T   # the pole straight up: p = (θ1 + L cos θ2, h + L sin θ2, 0)
+    Matrix([[0, L + h, 0]])
     """
     L, h = length(L, "L"), length(h, "h")
     S = _cols([0, 0, 0, 1, 0, 0], [0, 0, 1, h, 0, 0])
-    return SerialChain(_T([L, h, 0]), S, name="cart_pole", joint_points=_cols([0, 0, 0], [0, h, 0]),
-                       description="cart (prismatic along x_s) + pole (revolute about z_s at height h)")
+    return SerialChain(
+        _T([L, h, 0]),
+        S,
+        name="cart_pole",
+        joint_points=_cols([0, 0, 0], [0, h, 0]),
+        description="cart (prismatic along x_s) + pole (revolute about z_s at height h)",
+    )
 
 
 def planar_offset_3r(L=None) -> SerialChain:
-    """Sections 2 and 5: three revolute joints about z_s at (0, 0), (L, 0), (2L, L); tool frame at (3L, L)."""
+    """Sections 2 and 5: three revolute joints about z_s at (0, 0), (L, 0), (2L, L); tool frame at (3L, L).
+
+    >>> import sympy as sp
+    >>> r = planar_offset_3r()
+    >>> r.M[:3, 3].T, r.screws[:, 2].T
+    (Matrix([[3*L, L, 0]]), Matrix([[0, 0, 1, L, -2*L, 0]]))
+    >>> r.jacobian_space([0, sp.pi / 2, 0])[[2, 3, 4], :]   # rows ω_z, v_x, v_y
+    Matrix([
+    [1,  1, 1],
+    [0,  0, L],
+    [0, -L, 0]])
+    """
     L = length(L, "L")
     S = _cols([0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0], [0, 0, 1, L, -2 * L, 0])
-    return SerialChain(_T([3 * L, L, 0]), S, name="planar_offset_3r",
-                       joint_points=_cols([0, 0, 0], [L, 0, 0], [2 * L, L, 0]),
-                       description="planar RRR with joints at (0,0), (L,0), (2L,L) and the tool at (3L,L)")
+    return SerialChain(
+        _T([3 * L, L, 0]),
+        S,
+        name="planar_offset_3r",
+        joint_points=_cols([0, 0, 0], [L, 0, 0], [2 * L, L, 0]),
+        description="planar RRR with joints at (0,0), (L,0), (2L,L) and the tool at (3L,L)",
+    )
 
 
 def spatial_rppr(L1=None, L2=None) -> SerialChain:
-    """Sections 3 and 6: R about z_s, P along z_s, P along x, R about x through (0, 0, L1 + L2); tool at (L2, 0, L1 + L2)."""
+    """Sections 3 and 6: R about z_s, P along z_s, P along x, R about x through (0, 0, L1 + L2); tool at (L2, 0, L1 + L2).
+
+    >>> import sympy as sp
+    >>> r = spatial_rppr()
+    >>> r.joint_types, r.params
+    ('RPPR', (L1, L2))
+    >>> r.fk([sp.pi / 2, 1, 0, 0])[:3, 3].T   # turn a quarter about z_s, rise by 1
+    Matrix([[0, L2, L1 + L2 + 1]])
+    """
     L1, L2 = length(L1, "L1"), length(L2, "L2")
     H = L1 + L2
     S = _cols([0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 1], [0, 0, 0, 1, 0, 0], [1, 0, 0, 0, H, 0])
-    return SerialChain(_T([L2, 0, H]), S, name="spatial_rppr",
-                       joint_points=_cols([0, 0, 0], [0, 0, L1], [0, 0, H], [L2, 0, H]),
-                       description="spatial RPPR: base rotation, vertical slide, horizontal slide, wrist roll")
+    return SerialChain(
+        _T([L2, 0, H]),
+        S,
+        name="spatial_rppr",
+        joint_points=_cols([0, 0, 0], [0, 0, L1], [0, 0, H], [L2, 0, H]),
+        description="spatial RPPR: base rotation, vertical slide, horizontal slide, wrist roll",
+    )
+
+
+def planar_2r(L1=None, L2=None) -> SerialChain:
+    """The textbook two-link arm: planar RR with links L1, L2 along x_s at home; tool at (L1 + L2, 0).
+
+    Its position Jacobian (rows ṗ_x, ṗ_y) is singular exactly where the arm is stretched out or folded
+    (θ2 = 0 or π).
+
+    >>> r = planar_2r(1, 1)
+    >>> r.fk([0, 0])[:3, 3].tolist()
+    [2.0, 0.0, 0.0]
+    """
+    L1, L2 = length(L1, "L1"), length(L2, "L2")
+    S = _cols([0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0])
+    return SerialChain(
+        _T([L1 + L2, 0, 0]),
+        S,
+        name="planar_2r",
+        joint_points=_cols([0, 0, 0], [L1, 0, 0]),
+        description="planar RR, links L1, L2",
+    )
 
 
 def planar_3r(L1=None, L2=None, L3=None) -> SerialChain:
-    """Section 4: planar RRR with links L1, L2, L3 along x_s at home; tool at (L1 + L2 + L3, 0)."""
+    """Section 4: planar RRR with links L1, L2, L3 along x_s at home; tool at (L1 + L2 + L3, 0).
+
+    >>> import sympy as sp
+    >>> planar_3r().jacobian_geometric([sp.pi / 2, 0, 0])[[3, 4], :]   # rows ṗ_x, ṗ_y; the arm points along y_s
+    Matrix([
+    [-L1 - L2 - L3, -L2 - L3, -L3],
+    [            0,        0,   0]])
+    >>> planar_3r(1, 1, 1).fk([0, sp.pi / 2, 0])[:2, 3].T
+    Matrix([[1, 2]])
+    """
     L1, L2, L3 = length(L1, "L1"), length(L2, "L2"), length(L3, "L3")
     S = _cols([0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0], [0, 0, 1, 0, -(L1 + L2), 0])
-    return SerialChain(_T([L1 + L2 + L3, 0, 0]), S, name="planar_3r",
-                       joint_points=_cols([0, 0, 0], [L1, 0, 0], [L1 + L2, 0, 0]),
-                       description="planar RRR, links L1, L2, L3")
+    return SerialChain(
+        _T([L1 + L2 + L3, 0, 0]),
+        S,
+        name="planar_3r",
+        joint_points=_cols([0, 0, 0], [L1, 0, 0], [L1 + L2, 0, 0]),
+        description="planar RRR, links L1, L2, L3",
+    )
 
 
 def planar_rpp(L=None) -> SerialChain:
-    """Problem 5.5's redesign: R about z_s, then P along x_s and P along y_s (as seen at home); tool offset L along x."""
+    """Problem 5.5's redesign: R about z_s, then P along x_s and P along y_s (as seen at home); tool offset L along x.
+
+    >>> import sympy as sp
+    >>> planar_rpp().fk([sp.pi / 2, 1, 2])[:2, 3].T   # slides (1 + L, 2) turned a quarter about z_s
+    Matrix([[-2, L + 1]])
+    """
     L = length(L, "L")
     S = _cols([0, 0, 1, 0, 0, 0], [0, 0, 0, 1, 0, 0], [0, 0, 0, 0, 1, 0])
-    return SerialChain(_T([L, 0, 0]), S, name="planar_rpp",
-                       joint_points=_cols([0, 0, 0], [0, 0, 0], [0, 0, 0]),
-                       description="planar RPP: a base rotation followed by x and y slides")
+    return SerialChain(
+        _T([L, 0, 0]),
+        S,
+        name="planar_rpp",
+        joint_points=_cols([0, 0, 0], [0, 0, 0], [0, 0, 0]),
+        description="planar RPP: a base rotation followed by x and y slides",
+    )
 
 
 _UR5 = {"W1": "0.109", "W2": "0.082", "L1": "0.425", "L2": "0.392", "H1": "0.089", "H2": "0.095"}
@@ -96,13 +189,27 @@ def ur5(W1=None, W2=None, L1=None, L2=None, H1=None, H2=None) -> SerialChain:
     """The UR5 of Modern Robotics Example 4.5 (6R); defaults are the book's lengths in metres, as exact rationals.
 
     Pass SymPy symbols (e.g. ``ur5(*sp.symbols('W1 W2 L1 L2 H1 H2', positive=True))``) for the symbolic arm.
+
+    >>> import sympy as sp
+    >>> ur5().fk([0, -sp.pi / 2, 0, 0, sp.pi / 2, 0])   # Example 4.5's configuration and T(θ)
+    Matrix([
+    [0, -1, 0,   19/200],
+    [1,  0, 0, 109/1000],
+    [0,  0, 1,  247/250],
+    [0,  0, 0,        1]])
     """
     given = dict(W1=W1, W2=W2, L1=L1, L2=L2, H1=H1, H2=H2)
     v = {k: (sp.Rational(_UR5[k]) if x is None else length(x, k)) for k, x in given.items()}
     W1, W2, L1, L2, H1, H2 = (v[k] for k in ("W1", "W2", "L1", "L2", "H1", "H2"))
     M = _T([L1 + L2, W1 + W2, H1 - H2], [[-1, 0, 0], [0, 0, 1], [0, 1, 0]])
-    S = _cols([0, 0, 1, 0, 0, 0], [0, 1, 0, -H1, 0, 0], [0, 1, 0, -H1, 0, L1],
-              [0, 1, 0, -H1, 0, L1 + L2], [0, 0, -1, -W1, L1 + L2, 0], [0, 1, 0, H2 - H1, 0, L1 + L2])
+    S = _cols(
+        [0, 0, 1, 0, 0, 0],
+        [0, 1, 0, -H1, 0, 0],
+        [0, 1, 0, -H1, 0, L1],
+        [0, 1, 0, -H1, 0, L1 + L2],
+        [0, 0, -1, -W1, L1 + L2, 0],
+        [0, 1, 0, H2 - H1, 0, L1 + L2],
+    )
     pts = _cols([0, 0, 0], [0, 0, H1], [L1, 0, H1], [L1 + L2, 0, H1], [L1 + L2, W1, H1], [L1 + L2, W1, H1 - H2])
     return SerialChain(M, S, name="ur5", joint_points=pts, description="UR5 (Modern Robotics Example 4.5)")
 
@@ -118,6 +225,7 @@ def _rational_cos_sin(a: sp.Rational) -> tuple[sp.Rational, sp.Rational]:
     (a continued-fraction convergent of tan(a/2), computed with 50 digits) with |â − a| ≤ URDF_ANGLE_TOL
     (modulo 2π): an exact rational point on the unit circle at the typed angle, to 1e-18 rad."""
     import mpmath
+
     if a == 0:
         return sp.Integer(1), sp.Integer(0)
     with mpmath.workdps(50):
@@ -138,7 +246,7 @@ def _rational_cos_sin(a: sp.Rational) -> tuple[sp.Rational, sp.Rational]:
 def _urdf_rotation(rpy, where: str) -> sp.Matrix:
     """R = Rz(yaw) Ry(pitch) Rx(roll), URDF's fixed-axis roll-pitch-yaw, exact (see :func:`from_urdf_joints`)."""
     cs = []
-    for k, v in enumerate(_urdf_triple(rpy, f"{where} rpy")):
+    for v in _urdf_triple(rpy, f"{where} rpy"):
         if v.is_Rational:
             cs.append(_rational_cos_sin(v))
         else:  # a SymPy expression (sp.pi/2, a symbol): exactly its cosine and sine
@@ -223,8 +331,13 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
     if not screws:
         raise ValueError(f"joints must hold at least one revolute or prismatic joint, got {describe(joints)}")
     M = sp.Matrix.vstack(sp.Matrix.hstack(R, p), sp.Matrix([[0, 0, 0, 1]]))
-    return SerialChain(M, sp.Matrix(screws).T, name=name, joint_points=sp.Matrix.hstack(*points),
-                       description=description or f"{len(screws)}-joint arm from URDF joint placements")
+    return SerialChain(
+        M,
+        sp.Matrix(screws).T,
+        name=name,
+        joint_points=sp.Matrix.hstack(*points),
+        description=description or f"{len(screws)}-joint arm from URDF joint placements",
+    )
 
 
 __all__ += ["from_urdf_joints"]

@@ -12,6 +12,7 @@ until σ_k decreases. It is the numeric companion of the exact
 :func:`kinlib.singularities.singular_configurations`: it works on any arm (7 joints too), finds
 points (not families) and proves nothing, but each point it returns has σ_k < tol, checked at the end.
 """
+
 from __future__ import annotations
 
 import numbers
@@ -20,13 +21,20 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from ._backend import describe
-from .singularities import task_rows
+from .taskspace import task_rows
 
 __all__ = ["find_singularities", "SingularPoints"]
 
 
 class SingularPoints(NamedTuple):
-    """The configurations found (rows of ``q``, shape (K, n)) and σ_min there (``sigma``, shape (K,))."""
+    """The configurations found (rows of ``q``, shape (K, n)) and σ_min there (``sigma``, shape (K,)).
+
+    >>> from kinlib import robots
+    >>> pts = find_singularities(robots.planar_3r(1, 1, 1), ["vx", "vy"], samples=20)
+    >>> pts.q.shape[1], len(pts.q) == len(pts.sigma), bool(np.all(pts.sigma < 1e-6))
+    (3, True, True)
+    """
+
     q: np.ndarray
     sigma: np.ndarray
 
@@ -55,13 +63,21 @@ def _smallest(J: np.ndarray):
     return s[:, k], U[:, :, k], Vt[:, k, :]
 
 
-def find_singularities(chain, rows: Any = None, *, tol: float = 1e-6, seed: int = 0, samples: int = 200,
-                       max_iter: int = 60, limits: Any = None) -> SingularPoints:
+def find_singularities(
+    chain,
+    rows: Any = None,
+    *,
+    tol: float = 1e-6,
+    seed: int = 0,
+    samples: int = 200,
+    max_iter: int = 60,
+    limits: Any = None,
+) -> SingularPoints:
     """Configurations of ``chain`` where σ_min(J(θ)) < ``tol``: a numeric search (see the module docstring).
 
     J is the **geometric** Jacobian [ω_s; ṗ] (``chain.jacobian_geometric``), all six rows by default; with
     all six rows its rank is that of J_s and J_b (J = [[I, 0], [−[p], I]] J_s), so the singular
-    configurations are the same. ``rows`` picks task rows as in :func:`kinlib.singularities.task_rows`
+    configurations are the same. ``rows`` picks task rows as in :func:`kinlib.taskspace.task_rows`
     (e.g. ``["vx", "vy"]`` for a planar arm's tool position ṗ): rows of the geometric J.
 
     ``samples`` seeded random starts (``numpy.random.default_rng(seed)``: same seed, same output), revolute
@@ -76,11 +92,14 @@ def find_singularities(chain, rows: Any = None, *, tol: float = 1e-6, seed: int 
     True
     """
     from .chains import SerialChain
+
     if not isinstance(chain, SerialChain):
         raise TypeError(f"chain must be a kinlib SerialChain, got {describe(chain)}")
     if chain.params:
-        raise ValueError(f"chain must have numeric link lengths; {chain.name} has the parameters "
-                         f"{', '.join(map(str, chain.params))}: use chain.subs({chain.params[0]}=...) first")
+        raise ValueError(
+            f"chain must have numeric link lengths; {chain.name} has the parameters "
+            f"{', '.join(map(str, chain.params))}: use chain.subs({chain.params[0]}=...) first"
+        )
     tol = _positive_number(tol, "tol")
     samples = _count(samples, "samples")
     max_iter = _count(max_iter, "max_iter", 0)
@@ -98,8 +117,10 @@ def find_singularities(chain, rows: Any = None, *, tol: float = 1e-6, seed: int 
         except (TypeError, ValueError):
             raise TypeError(f"limits must be (lo, hi) per joint, shape ({n}, 2), got {describe(limits)}") from None
         if lim.shape != (n, 2) or not np.all(np.isfinite(lim)) or np.any(lim[:, 0] >= lim[:, 1]):
-            raise ValueError(f"limits must be finite (lo, hi) with lo < hi for each of the {n} joints, "
-                             f"shape ({n}, 2), got {describe(limits)}")
+            raise ValueError(
+                f"limits must be finite (lo, hi) with lo < hi for each of the {n} joints, "
+                f"shape ({n}, 2), got {describe(limits)}"
+            )
         lo, hi = lim[:, 0], lim[:, 1]
 
     def jac(Q):
@@ -122,8 +143,8 @@ def find_singularities(chain, rows: Any = None, *, tol: float = 1e-6, seed: int 
         s, u, v = _smallest(jac(P))
         shifted = np.concatenate([P[:, None, :] + eye[None], P[:, None, :] - eye[None]], axis=1).reshape(-1, n)
         dJ = jac(shifted)
-        dJ = dJ.reshape(idx.size, 2, n, *dJ.shape[1:])                   # (N, ±, joint j, m, n)
-        dJ = (dJ[:, 0] - dJ[:, 1]) / (2 * h)                              # (N, n_j, m, n)
+        dJ = dJ.reshape(idx.size, 2, n, *dJ.shape[1:])  # (N, ±, joint j, m, n)
+        dJ = (dJ[:, 0] - dJ[:, 1]) / (2 * h)  # (N, n_j, m, n)
         g = np.einsum("pm,pjmn,pn->pj", u, dJ, v)
         gg = np.sum(g * g, axis=1)
         ok = gg > 1e-300

@@ -24,31 +24,39 @@ vanish are dropped only with a proof (:mod:`kinlib.trigsign`). A time budget bou
 the answer says it is incomplete (``SingularSet.complete``) and names the numeric search
 :func:`kinlib.singular_search.find_singularities`.
 """
+
 from __future__ import annotations
 
 import itertools
-import numbers
 import time
 import warnings
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols
-from .display import _exact_zero
+from ._backend import as_jacobian, describe, exact_number, is_symbolic, joint_symbols
+from .exact import column_space, evaluate_at, left_null_space, rank_at
+from .taskspace import ROW_NAMES, task_rows
 from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
 from .trigsign import generator_kinds, proves_nonzero
 
 __all__ = [
-    "ROW_NAMES", "task_rows", "singular_configurations", "SingularSet", "IncompleteResultWarning", "representatives", "rank_at", "column_space",
-    "left_null_space", "evaluate_at", "trig_simplify", "periodic_family", "K",
+    "ROW_NAMES",
+    "task_rows",
+    "singular_configurations",
+    "SingularSet",
+    "IncompleteResultWarning",
+    "representatives",
+    "rank_at",
+    "column_space",
+    "left_null_space",
+    "evaluate_at",
+    "trig_simplify",
+    "periodic_family",
+    "K",
 ]
-
-#: Names of the six rows of a Jacobian in the textbook's [ω; v] order (for the geometric J, v is ṗ).
-ROW_NAMES = ("wx", "wy", "wz", "vx", "vy", "vz")
-_ALIASES = {"px": "vx", "py": "vy", "pz": "vz", "ωx": "wx", "ωy": "wy", "ωz": "wz"}
-_PRESETS = {"planar": ("wz", "vx", "vy"), "angular": ("wx", "wy", "wz"), "linear": ("vx", "vy", "vz")}
 
 #: The integer that indexes a periodic family of joint values, {b + p·k : k ∈ ℤ}.
 K = sp.Symbol("k", integer=True)
@@ -59,15 +67,6 @@ _TWO_PI = 2 * sp.pi
 # ----------------------------------------------------------------------------------------------
 # input checks
 # ----------------------------------------------------------------------------------------------
-def _jacobian(J: Any, name: str = "J", symbolic: bool | None = None):
-    """J as a 2-D SymPy Matrix (symbolic) or float array; a clear error for anything else."""
-    if not isinstance(J, (sp.MatrixBase, np.ndarray, list, tuple)):
-        raise TypeError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
-    if isinstance(J, np.ndarray) and J.ndim != 2:
-        raise ValueError(f"{name} must be a matrix (m×n Jacobian), got {describe(J)}")
-    return as_matrix(J, name, None, symbolic)
-
-
 def _check_params(J: sp.Matrix, thetas, params) -> tuple[sp.Symbol, ...]:
     """Symbols of J other than the joints must be parameters: given in ``params`` or declared positive."""
     extra = J.free_symbols - set(thetas)
@@ -85,65 +84,9 @@ def _check_params(J: sp.Matrix, thetas, params) -> tuple[sp.Symbol, ...]:
         raise ValueError(
             f"J contains the symbol(s) {', '.join(map(str, bad))}, which are not among the joints "
             f"thetas=({', '.join(map(str, thetas))}); parameters must be positive symbols (link lengths) "
-            f"or listed in params=")
+            f"or listed in params="
+        )
     return tuple(sorted(J.free_symbols - set(thetas), key=str))
-
-
-def _row_index(r: Any) -> int:
-    if isinstance(r, (bool, np.bool_)):
-        raise TypeError(f"rows must be row indices or names among {ROW_NAMES}, got the bool {r!r}")
-    if isinstance(r, (numbers.Integral, np.integer)):
-        return int(r)
-    if isinstance(r, str):
-        key = _ALIASES.get(r.lower(), r.lower())
-        if key in ROW_NAMES:
-            return ROW_NAMES.index(key)
-        raise ValueError(f"rows: unknown row name; names are {', '.join(ROW_NAMES)} "
-                         f"(ṗ aliases px, py, pz) or a preset among {', '.join(_PRESETS)}; got {r!r}")
-    raise TypeError(f"rows must be row indices or names among {ROW_NAMES}, got {describe(r)}")
-
-
-# ----------------------------------------------------------------------------------------------
-# task rows
-# ----------------------------------------------------------------------------------------------
-def task_rows(J: Any, rows: Any):
-    """The rows of J for a task space: ``task_rows(Js, "planar")`` = rows (ω_z, v_x, v_y).
-
-    ``rows``: a preset ("planar" = wz vx vy, "angular" = wx wy wz, "linear" = vx vy vz), a sequence of
-    names among wx wy wz vx vy vz (aliases px py pz for the geometric Jacobian's ṗ rows) or of row
-    indices. Names need J with 6 rows ([ω; v] order); indices work for any J. A numeric batch
-    (N, 6, n) is accepted and gives (N, k, n).
-    """
-    if isinstance(rows, str):
-        rows = _PRESETS.get(rows.lower(), (rows,))
-    if isinstance(rows, (numbers.Integral, np.integer)) and not isinstance(rows, bool):
-        rows = (rows,)
-    if not isinstance(rows, (Sequence, np.ndarray)) or isinstance(rows, (str, bytes)):
-        raise TypeError(f"rows must be a preset name, or a sequence of row names or indices, got {describe(rows)}")
-    rows = list(rows)
-    if not rows:
-        raise ValueError("rows must name at least one row, got an empty sequence")
-    named = any(isinstance(r, str) for r in rows)
-    idx = [_row_index(r) for r in rows]
-    if len(set(idx)) != len(idx):
-        raise ValueError(f"rows must not repeat a row, got {rows!r}")
-    batch = isinstance(J, np.ndarray) and J.ndim == 3 and not is_symbolic(J)
-    if batch:
-        m = J.shape[1]
-    else:
-        J = _jacobian(J)
-        m = J.shape[0]
-    if named and m != 6:
-        raise ValueError(f"row names need a 6-row Jacobian ([ω; v] rows), got J with {m} rows; use indices")
-    for i in idx:
-        if not -m <= i < m:
-            raise ValueError(f"rows: index {i} is out of range for J with {m} rows (indices −{m}…{m - 1}); "
-                             f"got rows = {rows!r}")
-    if batch:
-        return np.asarray(J, dtype=float)[:, idx, :]
-    if isinstance(J, sp.MatrixBase):
-        return J.extract(idx, list(range(J.cols)))
-    return J[idx, :]
 
 
 # ----------------------------------------------------------------------------------------------
@@ -153,6 +96,13 @@ def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
     """A display form: expand the trig functions, reduce with sin² + cos² = 1, then trigsimp and factor.
 
     Works entry-wise on matrices. Much faster than ``sp.simplify`` on product-of-exponentials output.
+
+    >>> from kinlib.robots import planar_2r
+    >>> J = task_rows(planar_2r().jacobian_geometric(), ["vx", "vy"])   # the 2R arm's rows ṗ_x, ṗ_y
+    >>> J.det()
+    L1*L2*sin(theta1)**2*sin(theta2) + L1*L2*sin(theta2)*cos(theta1)**2
+    >>> trig_simplify(J.det())
+    L1*L2*sin(theta2)
     """
     if isinstance(e, sp.MatrixBase):
         return e.applyfunc(lambda x: trig_simplify(x, thetas))
@@ -163,13 +113,13 @@ def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
     if not angles:
         if e.free_symbols:
             return sp.factor(e)
-        if e.is_number and not e.has(sp.Float):   # exact rewriting only (never nsimplify: it guesses from floats)
+        if e.is_number and not e.has(sp.Float):  # exact rewriting only (never nsimplify: it guesses from floats)
             e = sp.radsimp(e)
             return sp.trigsimp(e) if e.has(sp.sin, sp.cos) else e
         return e
     try:
         ring = TrigRing([e], angles, opaque=True)
-        p = ring.to_expr(ring.normal_form(e), trig=False)   # in s_i, c_i: factored as a polynomial
+        p = ring.to_expr(ring.normal_form(e), trig=False)  # in s_i, c_i: factored as a polynomial
     except NotTrigPolynomial:  # sin/cos under a root or in a denominator: trigsimp alone
         return sp.factor_terms(sp.trigsimp(e))
     return sp.factor_terms(sp.trigsimp(ring.to_trig(sp.factor(p))))
@@ -178,23 +128,19 @@ def trig_simplify(e: Any, thetas: Sequence[sp.Symbol] | None = None):
 # ----------------------------------------------------------------------------------------------
 # singular configurations
 # ----------------------------------------------------------------------------------------------
-def _det(M: sp.Matrix) -> sp.Expr:
-    try:
-        from sympy.polys.matrices import DomainMatrix
-        dM = DomainMatrix.from_Matrix(M)
-        if dM.domain.is_EX:  # algebraic constants such as √2: plain fraction-free elimination
-            raise ValueError
-        return dM.domain.to_sympy(dM.det())
-    except Exception:
-        return sp.expand(M.det(method="bareiss"))
-
-
 def periodic_family(points: Sequence) -> sp.Set:
     """{b + p k : k ∈ ℤ}: the angles ≡ one of ``points`` (exact, one period [0, 2π)) modulo 2π, written with
-    period π when the points come in pairs π apart (sin θ = 0 → {kπ}); bases in (−π/2, π/2] or (−π, π]."""
+    period π when the points come in pairs π apart (sin θ = 0 → {kπ}); bases in (−π/2, π/2] or (−π, π].
+
+    >>> import sympy as sp
+    >>> periodic_family([0, sp.pi])   # sin θ = 0 on [0, 2π): θ = kπ
+    ImageSet(Lambda(k, pi*k), Integers)
+    >>> periodic_family([3 * sp.pi / 4, 7 * sp.pi / 4]), periodic_family([sp.pi / 2])
+    (ImageSet(Lambda(k, pi*k - pi/4), Integers), ImageSet(Lambda(k, 2*pi*k + pi/2), Integers))
+    """
     if isinstance(points, (str, bytes)) or not isinstance(points, (Sequence, set, frozenset, sp.FiniteSet)):
         raise TypeError(f"points must be a sequence of real numbers, got {describe(points)}")
-    points = [exact_number(p, "points") for p in points]     # a float means the decimal typed, never a guess
+    points = [exact_number(p, "points") for p in points]  # a float means the decimal typed, never a guess
     if not points or not all(p.is_number and p.is_real for p in points):
         raise ValueError(f"points must be real numbers, got {points}")
     points = [p - _TWO_PI * sp.floor(p / _TWO_PI) for p in points]
@@ -253,6 +199,15 @@ class SingularSet(list):
     It is a plain list otherwise: ``conds == []``, ``conds[0]``, ``len(conds)`` work as before, and it prints
     as a list (so SymPy's notebook printing typesets it); an incomplete answer is announced by an
     :class:`IncompleteResultWarning` carrying the note when it is made.
+
+    >>> import sympy as sp
+    >>> from kinlib.robots import planar_2r
+    >>> r = planar_2r()
+    >>> conds = singular_configurations(task_rows(r.jacobian_geometric(), ["vx", "vy"]), r.thetas)
+    >>> conds, conds.complete, conds.note   # det J = L1 L2 sin θ2: stretched out or folded
+    ([{theta2: ImageSet(Lambda(k, pi*k), Integers)}], True, 'from the factors of det J')
+    >>> conds[0] == {r.thetas[1]: periodic_family([0, sp.pi])}   # a plain list otherwise
+    True
     """
 
     def __init__(self, conditions=(), complete: bool = True, note: str = ""):
@@ -262,14 +217,25 @@ class SingularSet(list):
 
 
 class IncompleteResultWarning(UserWarning):
-    """A closed-form answer was out of reach: the result is partial (its ``note`` says what is missing)."""
+    """A closed-form answer was out of reach: the result is partial (its ``note`` says what is missing).
+
+    >>> import warnings
+    >>> from kinlib.robots import planar_2r
+    >>> r = planar_2r()
+    >>> J = task_rows(r.jacobian_geometric(), ["vx", "vy"])
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     conds = singular_configurations(J, r.thetas, time_budget=0)   # no time for det J at all
+    >>> caught[0].category.__name__, conds, conds.complete
+    ('IncompleteResultWarning', [], False)
+    """
 
 
 class _OutOfTime(Exception):
     pass
 
 
-_MAX_PRODUCT = 2_000_000   # term pairs in one polynomial product (about a second of pure-Python arithmetic)
+_MAX_PRODUCT = 2_000_000  # term pairs in one polynomial product (about a second of pure-Python arithmetic)
 
 
 def _mul(a, b, deadline: float):
@@ -313,7 +279,7 @@ def _minors_reduced(rows: list, ring, deadline: float) -> list:
         for S in itertools.combinations(range(n), r + 1):
             acc = R.zero
             for idx, j in enumerate(S):
-                a, sub = rows[r][j], prev.get(S[:idx] + S[idx + 1:])
+                a, sub = rows[r][j], prev.get(S[:idx] + S[idx + 1 :])
                 if a and sub:
                     term = _mul(a, sub, deadline)
                     acc = acc + term if (r + idx) % 2 == 0 else acc - term
@@ -327,15 +293,17 @@ def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float
     s_i, c_i (Bareiss: factors stay visible); when those grow too large, reduced modulo s_i² + c_i² − 1
     at every step (smaller, but a factor such as sin θ3 may then hide inside a bigger one)."""
     m, n = shape
-    rows = [entries[i * n:(i + 1) * n] for i in range(m)]
+    rows = [entries[i * n : (i + 1) * n] for i in range(m)]
     if m > n:
         rows = [list(c) for c in zip(*rows)]
         m, n = n, m
     start = time.monotonic()
     raw_deadline = min(deadline, start + max(1.0, (deadline - start) / 8))
     try:
-        return [_bareiss([[r[j] for j in cols] for r in rows], ring, raw_deadline)
-                for cols in itertools.combinations(range(n), m)]
+        return [
+            _bareiss([[r[j] for j in cols] for r in rows], ring, raw_deadline)
+            for cols in itertools.combinations(range(n), m)
+        ]
     except _OutOfTime:
         if time.monotonic() > deadline:
             raise
@@ -351,7 +319,7 @@ def _cheap_points(g_expr: sp.Expr, joint: sp.Symbol, revolute: bool):
         return None
     if sol is sp.S.EmptySet:
         return []
-    pts = [p for p in sol] if isinstance(sol, sp.FiniteSet) else representatives(sol)
+    pts = list(sol) if isinstance(sol, sp.FiniteSet) else representatives(sol)
     out = []
     for p in pts:
         if revolute:
@@ -405,7 +373,10 @@ def _solve_system(qs: list, ring, ctx: dict, depth: int = 0):
     for j, p, sv, cv in best:
         if j in ctx["revolute"]:
             i = ring.angles.index(j)
-            subs = [(ring.gens[i], ring.domain.from_sympy(sv)), (ring.gens[len(ring.angles) + i], ring.domain.from_sympy(cv))]
+            subs = [
+                (ring.gens[i], ring.domain.from_sympy(sv)),
+                (ring.gens[len(ring.angles) + i], ring.domain.from_sympy(cv)),
+            ]
         else:
             subs = [(ring.gens[2 * len(ring.angles) + ring.variables.index(j)], ring.domain.from_sympy(p))]
         sub = _solve_system([q.subs(subs) for q in qs], ring, ctx, depth + 1)
@@ -450,8 +421,9 @@ def _display_condition(p, ring, deadline: float) -> sp.Expr:
     return _normalize_expr(expr)
 
 
-def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequence[sp.Symbol] | None = None,
-                            *, time_budget: float = 40.0) -> SingularSet:
+def singular_configurations(
+    J: Any, thetas: Sequence[sp.Symbol], params: Sequence[sp.Symbol] | None = None, *, time_budget: float = 40.0
+) -> SingularSet:
     """Where J(θ) loses rank, in closed form: a list of conditions (``[]``: no singular configuration).
 
     J (m×n) has full rank k = min(m, n) unless every k×k minor vanishes (for square J: det J = 0; in
@@ -488,7 +460,7 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
     t0 = time.monotonic()
     if not is_symbolic(J):
         raise TypeError(f"J must be a symbolic Jacobian (a SymPy Matrix in the joint symbols), got {describe(J)}")
-    J = _jacobian(J, "J", True)
+    J = as_jacobian(J, "J", True)
     thetas = joint_symbols(thetas, J.cols, per="one per column of J")
     _check_params(J, thetas, params)
     if J.rows == 0 or J.cols == 0:
@@ -502,11 +474,13 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
         return not (a.free_symbols & joint_set) and not a.has(sp.sin, sp.cos, sp.tan)
 
     def bad_entry(e):
-        return ValueError("J must be polynomial in sin θ_i, cos θ_i of the revolute joints and in the "
-                          f"prismatic joint values; got the entry {e}")
+        return ValueError(
+            "J must be polynomial in sin θ_i, cos θ_i of the revolute joints and in the "
+            f"prismatic joint values; got the entry {e}"
+        )
 
     try:
-        ring = TrigRing(list(J), thetas, opaque=parameter_atom)   # s_i = sin θ_i, c_i = cos θ_i, θ_j, L, ...
+        ring = TrigRing(list(J), thetas, opaque=parameter_atom)  # s_i = sin θ_i, c_i = cos θ_i, θ_j, L, ...
     except NotTrigPolynomial:
         for e in J:
             try:
@@ -514,12 +488,17 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
             except NotTrigPolynomial:
                 raise bad_entry(e) from None
         raise
-    revolute = set(ring.found)                   # joints inside sin/cos; the others enter polynomially
-    mixed = revolute & set(ring.variables)       # θ sin θ is not a trigonometric polynomial
+    revolute = set(ring.found)  # joints inside sin/cos; the others enter polynomially
+    mixed = revolute & set(ring.variables)  # θ sin θ is not a trigonometric polynomial
     if mixed:
         raise bad_entry(next(e for e in J if mixed & set(TrigRing([e], thetas, opaque=parameter_atom).variables)))
-    ctx = {"deadline": deadline, "thetas": thetas, "joint_set": joint_set, "revolute": revolute,
-           "kinds": generator_kinds(ring)}
+    ctx = {
+        "deadline": deadline,
+        "thetas": thetas,
+        "joint_set": joint_set,
+        "revolute": revolute,
+        "kinds": generator_kinds(ring),
+    }
     conditions: list = []
 
     def add(cond):
@@ -532,9 +511,11 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
         return (1 if c.free_symbols & joint_set else 2, 0, str(c))
 
     def out_of_reach(stage: str):
-        note = (f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
-                "(maybe none) are singular, others may be missing. For a numeric search use "
-                "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths.")
+        note = (
+            f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
+            "(maybe none) are singular, others may be missing. For a numeric search use "
+            "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths."
+        )
         warnings.warn(f"singular_configurations: {note}", IncompleteResultWarning, stacklevel=3)
         return SingularSet(sorted(conditions, key=key), complete=False, note=note)
 
@@ -547,8 +528,9 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
         return out_of_reach(f"computing {what}")
     minors = [q for q in minors if ring.reduce(q)]
     if not minors:
-        raise ValueError("J never has full rank (its rank-test determinant is identically zero): "
-                         "every configuration is singular")
+        raise ValueError(
+            "J never has full rank (its rank-test determinant is identically zero): every configuration is singular"
+        )
     try:
         G = minors[0]
         for q in minors[1:]:
@@ -574,7 +556,7 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
         # lower-dimensional part: all q_i = 0 together
         total = sum(len(q.terms()) for q in qs)
         S = None
-        if sum(len(q.terms()) ** 2 for q in qs) <= 1_000_000:   # Σ q_i² > 0 proved: no common zero
+        if sum(len(q.terms()) ** 2 for q in qs) <= 1_000_000:  # Σ q_i² > 0 proved: no common zero
             S = ring.reduce(sum((q * q for q in qs), ring.ring.zero))
         if S is not None and proves_nonzero(ring, S, ctx["kinds"]):
             pass
@@ -582,8 +564,12 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
             sol = _solve_system(qs, ring, ctx)
             if sol is not None:
                 for d in sol:
-                    add({j: periodic_family(sorted(v, key=float)) if j in revolute else sp.FiniteSet(*v)
-                         for j, v in sorted(d.items(), key=lambda kv: thetas.index(kv[0]))})
+                    add(
+                        {
+                            j: periodic_family(sorted(v, key=float)) if j in revolute else sp.FiniteSet(*v)
+                            for j, v in sorted(d.items(), key=lambda kv: thetas.index(kv[0]))
+                        }
+                    )
                 note += "; where all of them vanish together: solved joint by joint"
             elif time.monotonic() > deadline:
                 return out_of_reach("the common zeros of the minors")
@@ -596,7 +582,14 @@ def singular_configurations(J: Any, thetas: Sequence[sp.Symbol], params: Sequenc
 
 
 def representatives(family: sp.Set, lo=0, hi=2 * sp.pi) -> list:
-    """The members of a family of joint values in [lo, hi) (sorted, exact): e.g. θ2 = −π/4 + kπ → [3π/4, 7π/4]."""
+    """The members of a family of joint values in [lo, hi) (sorted, exact): e.g. θ2 = −π/4 + kπ → [3π/4, 7π/4].
+
+    >>> import sympy as sp
+    >>> representatives(periodic_family([3 * sp.pi / 4, 7 * sp.pi / 4]))   # θ = −π/4 + kπ in [0, 2π)
+    [3*pi/4, 7*pi/4]
+    >>> representatives(periodic_family([0, sp.pi]), -sp.pi, sp.pi)
+    [-pi, 0]
+    """
     lo, hi = sp.sympify(lo), sp.sympify(hi)
     if not isinstance(family, sp.Set):
         raise TypeError(f"family must be a SymPy Set, got {describe(family)}")
@@ -623,27 +616,7 @@ def representatives(family: sp.Set, lo=0, hi=2 * sp.pi) -> list:
         elif part is sp.S.EmptySet:
             continue
         else:
-            raise ValueError(f"family must be a FiniteSet, an ImageSet over the integers or a Union of them; got {part}")
+            raise ValueError(
+                f"family must be a FiniteSet, an ImageSet over the integers or a Union of them; got {part}"
+            )
     return sorted(set(out), key=lambda v: float(v))
-
-
-# ----------------------------------------------------------------------------------------------
-# exact values at a configuration: kinlib.exact (re-exported here, where they have always been imported from)
-# ----------------------------------------------------------------------------------------------
-from .exact import column_space, evaluate_at, exact_is_zero, left_null_space, rank_at  # noqa: E402
-
-
-def _is_zero(e: Any) -> bool:
-    """Exact zero test: numbers and expressions in positive parameters by :func:`kinlib.exact.exact_is_zero`;
-    polynomials in the sines and cosines of joint symbols by the trig normal form; otherwise ``sp.simplify``."""
-    e = sp.sympify(e)
-    if e == 0:
-        return True
-    try:
-        return exact_is_zero(e)
-    except ValueError:
-        pass
-    exact = _exact_zero(e)
-    if exact is not None:
-        return exact
-    return bool(sp.simplify(e) == 0)

@@ -7,9 +7,10 @@ recording each distinct product and sum once. ``Tape.compile`` turns the recorde
 recursions on a tape to generate its numeric code (issue 11, item 6: a dense 7-joint arm from URDF
 placements went from seconds to a fraction of a second, the UR5's code is unchanged).
 """
+
 from __future__ import annotations
 
-from typing import Sequence
+from collections.abc import Sequence
 
 import sympy as sp
 
@@ -36,7 +37,7 @@ class TapeValue:
 
     __slots__ = ("tape", "const", "terms")
 
-    def __init__(self, tape: "Tape", const: float, terms: dict):
+    def __init__(self, tape: Tape, const: float, terms: dict):
         self.tape, self.const, self.terms = tape, const, terms
 
     def __add__(self, other):
@@ -82,7 +83,7 @@ class TapeValue:
     def _factor(self) -> tuple[float, int]:
         """(c, node) with self = c·node: a single term as it is, anything else a sum node."""
         if not self.const and len(self.terms) == 1:
-            (k, c), = self.terms.items()
+            ((k, c),) = self.terms.items()
             return c, k
         return 1.0, self.tape._node(("sum", self.const, tuple(sorted(self.terms.items()))))
 
@@ -169,7 +170,7 @@ class Tape:
                     stack += [j for j, _ in key[2]]
         return uses
 
-    def compile(self, entries, args: Sequence[sp.Symbol], name: str = "matrix", cse: bool = True) -> "CompiledMatrix":
+    def compile(self, entries, args: Sequence[sp.Symbol], name: str = "matrix", cse: bool = True) -> CompiledMatrix:
         """The :class:`CompiledMatrix` of a rectangular list of rows of entries (values or numbers).
 
         ``cse=True``: the recorded nodes are written out as one SymPy expression per entry (shared
@@ -182,8 +183,10 @@ class Tape:
         entries = [list(row) for row in entries]
         shape = (len(entries), len(entries[0]) if entries else 0)
         if any(len(row) != shape[1] for row in entries) or len(args) != self.n:
-            raise ValueError(f"entries must be a rectangular list of rows and args {self.n} symbols, "
-                             f"got {describe(entries)} and {describe(list(args))}")
+            raise ValueError(
+                f"entries must be a rectangular list of rows and args {self.n} symbols, "
+                f"got {describe(entries)} and {describe(list(args))}"
+            )
         uses = self._used(entries)
         qs = [sp.Symbol(f"_q{i}") for i in range(self.n)]
         expr: dict[int, sp.Expr] = {}
@@ -199,8 +202,10 @@ class Tape:
         def value(e):
             if type(e) is not TapeValue:
                 return c(float(e))
-            return sp.Add(*([c(e.const)] if e.const else []),
-                          *[c(co) * expr[k] if co != 1.0 else expr[k] for k, co in e.terms.items()])
+            return sp.Add(
+                *([c(e.const)] if e.const else []),
+                *[c(co) * expr[k] if co != 1.0 else expr[k] for k, co in e.terms.items()],
+            )
 
         for k in sorted(uses):
             key = self.nodes[k]

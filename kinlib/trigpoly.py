@@ -13,35 +13,65 @@ makes it fast) and converts between SymPy expressions and ring elements. It is s
 * :func:`kinlib.singularities.trig_simplify`, the determinant in
   :func:`kinlib.singularities.singular_configurations`, and :func:`kinlib.manipulability.manipulability`.
 """
+
 from __future__ import annotations
 
-from typing import Any, Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from typing import Any
 
 import sympy as sp
 from sympy.polys.constructor import construct_domain
 from sympy.polys.rings import ring as _ring
 
-__all__ = ["TrigRing", "NotTrigPolynomial", "single_angle_form", "angles_in", "is_variable"]
+__all__ = ["TrigRing", "NotTrigPolynomial", "single_angle_form", "angles_in", "is_variable", "normal_form_zero"]
 
 
 class NotTrigPolynomial(ValueError):
-    """The expression is not a polynomial in the sines and cosines of the angles (e.g. √L, 1/sin θ, exp)."""
+    """The expression is not a polynomial in the sines and cosines of the angles (e.g. √L, 1/sin θ, exp).
+
+    >>> import sympy as sp
+    >>> L, t = sp.Symbol("L", positive=True), sp.Symbol("t", real=True)
+    >>> TrigRing([sp.sqrt(L) * sp.sin(t)])   # exact mode: √L is not a polynomial generator
+    Traceback (most recent call last):
+        ...
+    kinlib.trigpoly.NotTrigPolynomial: sqrt(L)
+    """
 
 
 def is_variable(x) -> bool:
-    """A symbol, a function of time θ(t) or a derivative θ̇(t): an independent variable at one instant."""
+    """A symbol, a function of time θ(t) or a derivative θ̇(t): an independent variable at one instant.
+
+    >>> import sympy as sp
+    >>> t = sp.Symbol("t", real=True)
+    >>> q = sp.Function("q")(t)
+    >>> is_variable(t), is_variable(q), is_variable(q.diff(t)), is_variable(sp.sin(t))
+    (True, True, True, False)
+    """
     return isinstance(x, (sp.Symbol, sp.Derivative, sp.core.function.AppliedUndef))
 
 
 def single_angle_form(e: sp.Expr) -> sp.Expr:
-    """Expand sin/cos of sums and integer multiples (sin(θ1 + θ2), cos 2θ) into single-angle functions."""
+    """Expand sin/cos of sums and integer multiples (sin(θ1 + θ2), cos 2θ) into single-angle functions.
+
+    >>> import sympy as sp
+    >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
+    >>> single_angle_form(sp.sin(t1 + t2)), single_angle_form(sp.cos(2 * t1))
+    (sin(theta1)*cos(theta2) + sin(theta2)*cos(theta1), 2*cos(theta1)**2 - 1)
+    """
     compound = [f for f in e.atoms(sp.sin, sp.cos) if not is_variable(f.args[0])]
     return sp.expand_trig(e) if compound else e
 
 
 def angles_in(exprs: Iterable, candidates: Any = None) -> list[sp.Symbol]:
     """The symbols inside sin/cos (after expanding sums: sin(θ1 + θ2) counts θ1 and θ2), sorted by name;
-    only those among ``candidates`` when given."""
+    only those among ``candidates`` when given.
+
+    >>> import sympy as sp
+    >>> t, t1, t2 = sp.symbols("t theta1 theta2", real=True)
+    >>> L = sp.Symbol("L", positive=True)
+    >>> angles_in([L * sp.cos(t1 + t2), sp.sin(t)]), angles_in([sp.cos(t1 + t2)], candidates=[t2])
+    ([t, theta1, theta2], [theta2])
+    """
     found: set = set()
     for e in exprs:
         for f in single_angle_form(sp.sympify(e)).atoms(sp.sin, sp.cos):
@@ -64,15 +94,24 @@ class TrigRing:
       ``atom -> bool`` deciding which such subexpressions are allowed.
 
     ``ring.normal_form(e)`` is the reduced ring element, ``ring.to_expr(p)`` the SymPy expression again.
+
+    >>> import sympy as sp
+    >>> t = sp.Symbol("theta1", real=True)
+    >>> ring = TrigRing([sp.sin(t)**3 + sp.sin(t) * sp.cos(t)**2, sp.sin(t)**2])
+    >>> ring.to_expr(ring.normal_form(sp.sin(t)**3 + sp.sin(t) * sp.cos(t)**2))   # sin θ (sin²θ + cos²θ)
+    sin(theta1)
+    >>> ring.to_expr(ring.normal_form(sp.sin(t)**2))   # degree ≤ 1 in sin θ
+    1 - cos(theta1)**2
     """
 
-    def __init__(self, exprs: Iterable, angles: Sequence | None = None,
-                 opaque: bool | Callable[[sp.Expr], bool] = False):
+    def __init__(
+        self, exprs: Iterable, angles: Sequence | None = None, opaque: bool | Callable[[sp.Expr], bool] = False
+    ):
         self.exact = opaque is False
         allow = (lambda a: True) if opaque is True else (opaque or None)
         exprs = [self._prepare(sp.sympify(e)) for e in exprs]
         angle_set = None if angles is None else set(angles)
-        trig: dict = {}        # angle -> True (seen)
+        trig: dict = {}  # angle -> True (seen)
         variables: dict = {}
         others: dict = {}
         consts: dict = {}
@@ -123,8 +162,11 @@ class TrigRing:
         # generators: s_i, c_i (lex order: s before c, so the normal form has degree ≤ 1 in each s_i),
         # then the variables and other atoms (ring symbols: themselves when a Symbol, else a Dummy)
         rest = self.variables + self.others
-        syms = ([self.s[a] for a in self.angles] + [self.c[a] for a in self.angles]
-                + [g if isinstance(g, sp.Symbol) else sp.Dummy() for g in rest])
+        syms = (
+            [self.s[a] for a in self.angles]
+            + [self.c[a] for a in self.angles]
+            + [g if isinstance(g, sp.Symbol) else sp.Dummy() for g in rest]
+        )
         self.atoms = tuple([sp.sin(a) for a in self.angles] + [sp.cos(a) for a in self.angles] + list(rest))
         #: the SymPy symbol standing for each generator in ``to_expr(p, trig=False)``
         self.symbols = tuple(syms[: 2 * k]) + rest
@@ -220,3 +262,32 @@ class TrigRing:
         used = [i for i, d in enumerate(p.degrees()) if d > 0]
         return {self._owner[i] for i in used if i in self._owner}
 
+
+def normal_form_zero(e: Any) -> bool | None:
+    """Whether e ≡ 0, decided by the normal form modulo sin² + cos² − 1 when e (or its numerator) is a
+    polynomial in sines, cosines and symbols with exact coefficients; ``None`` when it is of another form
+    (√L, exp, a constant SymPy cannot compute with exactly). True and False are both proofs.
+
+    >>> import sympy as sp
+    >>> x, L = sp.symbols("x L")
+    >>> normal_form_zero(L * (sp.sin(x)**2 + sp.cos(x)**2) - L), normal_form_zero(sp.sin(2*x) - sp.sin(x))
+    (True, False)
+    >>> normal_form_zero(sp.sqrt(L) - 1) is None, normal_form_zero(sp.sin(6) - 2*sp.sin(3)*sp.cos(3)) is None
+    (True, True)
+    """
+    e = sp.sympify(e)
+    if e == 0:
+        return True
+    if any(not a.args[0].free_symbols for a in single_angle_form(e).atoms(sp.sin, sp.cos, sp.tan)):
+        return None  # sin 6 and 2 sin 3 cos 3 would be independent generators: no proof either way
+    for f in (e, None):
+        if f is None:
+            f = sp.fraction(sp.together(e))[0]  # a rational function is 0 exactly where its numerator is
+        try:
+            ring = TrigRing([f])  # exact mode: NotTrigPolynomial unless a polynomial in sin/cos
+            if ring.domain.is_EX:  # constants SymPy cannot do exact arithmetic with
+                raise NotTrigPolynomial(f)
+            return not ring.normal_form(f)
+        except NotTrigPolynomial:
+            continue
+    return None

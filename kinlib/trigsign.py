@@ -27,6 +27,7 @@ True
 >>> proves_nonzero(ring, ring.normal_form(L - sp.cos(t)))   # zero when L ≤ 1
 False
 """
+
 from __future__ import annotations
 
 __all__ = ["proves_nonzero", "proves_positive", "generator_kinds"]
@@ -37,7 +38,14 @@ _MAX_DEPTH = 4
 
 def generator_kinds(ring) -> list[str]:
     """For each generator of a :class:`~kinlib.trigpoly.TrigRing`: 's' / 'c' (sine, cosine of an angle),
-    'pos' (a positive parameter: a symbol or atom SymPy knows is positive) or 'real' (any other variable)."""
+    'pos' (a positive parameter: a symbol or atom SymPy knows is positive) or 'real' (any other variable).
+
+    >>> import sympy as sp
+    >>> from kinlib.trigpoly import TrigRing
+    >>> L, d, t = sp.Symbol("L", positive=True), sp.Symbol("d", real=True), sp.Symbol("t", real=True)
+    >>> generator_kinds(TrigRing([L * sp.sin(t) + d], [t], opaque=True))   # sin t, cos t, L > 0, d real
+    ['s', 'c', 'pos', 'real']
+    """
     k = len(ring.angles)
     kinds = ["s"] * k + ["c"] * k
     for g in ring.variables + ring.others:
@@ -69,15 +77,15 @@ def _box(ring, p, kinds) -> bool:
         if real:
             if sgn < 0 or any(e % 2 for e in real) or any(e % 2 for e in trig):
                 return False
-            continue                                    # ≥ 0
+            continue  # ≥ 0
         if not trig:
             add = coeff
         elif not any(e % 2 for e in trig):
             if sgn > 0:
-                continue                                # t ∈ [0, 1]: ≥ 0
+                continue  # t ∈ [0, 1]: ≥ 0
             add = coeff
         else:
-            add = -coeff if sgn > 0 else coeff          # t ∈ [−1, 1]: ≥ −|a|
+            add = -coeff if sgn > 0 else coeff  # t ∈ [−1, 1]: ≥ −|a|
         bound[key] = bound.get(key, ring.domain.zero) + add
     bound = {m: c for m, c in bound.items() if c}
     return bool(bound) and all(_sign(ring, c) == 1 for c in bound.values())
@@ -96,7 +104,17 @@ def _split(ring, p, idx: int) -> dict:
 
 
 def proves_positive(ring, p, kinds: list[str] | None = None, depth: int = 0) -> bool:
-    """True only when p > 0 is proved for all admissible values (see the module docstring)."""
+    """True only when p > 0 is proved for all admissible values (see the module docstring).
+
+    >>> import sympy as sp
+    >>> from kinlib.trigpoly import TrigRing
+    >>> L, d, t = sp.Symbol("L", positive=True), sp.Symbol("d", real=True), sp.Symbol("t", real=True)
+    >>> ring = TrigRing([1 + (L + d)**2, 2 + sp.cos(t)], opaque=True)
+    >>> proves_positive(ring, ring.normal_form(1 + (L + d)**2)), proves_positive(ring, ring.normal_form(2 + sp.cos(t)))
+    (True, True)
+    >>> proves_positive(ring, ring.normal_form(-2 - sp.cos(t)))   # negative everywhere: not positive
+    False
+    """
     if kinds is None:
         kinds = generator_kinds(ring)
     if not p:
@@ -118,13 +136,14 @@ def proves_positive(ring, p, kinds: list[str] | None = None, depth: int = 0) -> 
             continue
         parts = _split(ring, p, i)
         A_B = {e: _split(ring, q, k + i) for e, q in parts.items()}
-        if 1 in A_B and 1 in A_B[1]:                     # a sin·cos term
+        if 1 in A_B and 1 in A_B[1]:  # a sin·cos term
             continue
         A = A_B.get(0, {}).get(0, ring.ring.zero)
         C = A_B.get(0, {}).get(1, ring.ring.zero)
         B = A_B.get(1, {}).get(0, ring.ring.zero)
-        if proves_positive(ring, A, kinds, depth + 1) and \
-                proves_positive(ring, ring.reduce(A * A - B * B - C * C), kinds, depth + 1):
+        if proves_positive(ring, A, kinds, depth + 1) and proves_positive(
+            ring, ring.reduce(A * A - B * B - C * C), kinds, depth + 1
+        ):
             return True
     # one real (then positive) variable of degree exactly 2
     for want in ("real", "pos"):
@@ -133,15 +152,26 @@ def proves_positive(ring, p, kinds: list[str] | None = None, depth: int = 0) -> 
                 continue
             parts = _split(ring, p, idx)
             a, b, c = (parts.get(e, ring.ring.zero) for e in (2, 1, 0))
-            if proves_positive(ring, a, kinds, depth + 1) and \
-                    proves_positive(ring, ring.reduce(4 * a * c - b * b), kinds, depth + 1):
+            if proves_positive(ring, a, kinds, depth + 1) and proves_positive(
+                ring, ring.reduce(4 * a * c - b * b), kinds, depth + 1
+            ):
                 return True
     return False
 
 
 def proves_nonzero(ring, p, kinds: list[str] | None = None) -> bool:
     """True only when p ≠ 0 is proved for every real angle, real variable and positive parameter
-    (p > 0 or p < 0 everywhere); False when not shown."""
+    (p > 0 or p < 0 everywhere); False when not shown.
+
+    >>> import sympy as sp
+    >>> from kinlib.trigpoly import TrigRing
+    >>> L, t = sp.Symbol("L", positive=True), sp.Symbol("t", real=True)
+    >>> ring = TrigRing([-2 - sp.cos(t), L - sp.cos(t)], opaque=True)
+    >>> proves_nonzero(ring, ring.normal_form(-2 - sp.cos(t)))   # −2 − cos t ≤ −1
+    True
+    >>> proves_nonzero(ring, ring.normal_form(L - sp.cos(t)))    # vanishes for L ≤ 1: not shown
+    False
+    """
     if kinds is None:
         kinds = generator_kinds(ring)
     return proves_positive(ring, p, kinds) or proves_positive(ring, -p, kinds)

@@ -20,6 +20,7 @@ with V = J θ̇ (twists [ω; v], angular first):
 One API, two backends: SymPy J → exact SymPy results (the pseudoinverse needs a constant J: substitute a
 configuration first); numbers → NumPy floats, batches (N, m, n) allowed.
 """
+
 from __future__ import annotations
 
 import warnings
@@ -28,13 +29,29 @@ from typing import Any, NamedTuple
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_vector, check_real_finite, describe, exact_number, is_symbolic, real_array
+from ._backend import (
+    as_vector,
+    check_real_finite,
+    exact_jacobian,
+    exact_number,
+    is_symbolic,
+    numeric_jacobian,
+    numeric_vectors,
+)
+from .display import readable, readable_ratio
 from .exactfield import decide_zero
 from .manipulability import velocity_ellipsoid
-from .singularities import task_rows
+from .taskspace import task_rows
 
-__all__ = ["pseudoinverse", "inverse_velocity", "damped_least_squares", "joint_torques", "force_ellipsoid",
-           "PinvReport", "SingularityWarning"]
+__all__ = [
+    "pseudoinverse",
+    "inverse_velocity",
+    "damped_least_squares",
+    "joint_torques",
+    "force_ellipsoid",
+    "PinvReport",
+    "SingularityWarning",
+]
 
 _EPS = np.finfo(float).eps
 #: joint-rate amplification 1/σ_min (relative to 1/σ_max) above which a numeric pseudoinverse warns
@@ -42,11 +59,30 @@ _WARN_COND = 1e8
 
 
 class SingularityWarning(UserWarning):
-    """J is singular or nearly singular: a pseudoinverse dropped directions, or amplifies V enormously."""
+    """J is singular or nearly singular: a pseudoinverse dropped directions, or amplifies V enormously.
+
+    >>> import warnings
+    >>> import numpy as np
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     P = pseudoinverse(np.array([[1.0, 1.0], [1.0, 1.0]]))   # rank 1 < 2
+    >>> [type(w.message).__name__ for w in caught]
+    ['SingularityWarning']
+    """
 
 
 class PinvReport(NamedTuple):
-    """What a pseudoinverse used: the rank kept, the singular values, the cut-off (numeric only)."""
+    """What a pseudoinverse used: the rank kept, the singular values, the cut-off (numeric only).
+
+    >>> import sympy as sp
+    >>> pseudoinverse(sp.Matrix([[1, 0], [0, 2], [0, 0]]), full_output=True)[1]   # exact: the rank only
+    PinvReport(rank=2, singular_values=None, tol=None)
+    >>> import numpy as np
+    >>> rep = pseudoinverse(np.diag([3.0, 1.0]), full_output=True)[1]
+    >>> rep.rank, rep.singular_values.tolist(), bool(rep.tol < 1e-12)
+    (2, [3.0, 1.0], True)
+    """
+
     rank: Any
     singular_values: Any
     tol: Any
@@ -55,27 +91,6 @@ class PinvReport(NamedTuple):
 # ----------------------------------------------------------------------------------------------
 # input checks
 # ----------------------------------------------------------------------------------------------
-def _numeric_J(J: Any, name: str = "J") -> np.ndarray:
-    A = real_array(J, name, "a Jacobian (m, n) or a batch (N, m, n) of real numbers")
-    if A.ndim not in (2, 3) or 0 in A.shape:
-        raise ValueError(f"{name} must be a Jacobian (m, n) or a batch (N, m, n) with m, n ≥ 1, got {describe(J)}")
-    return A
-
-
-def _exact_J(J: Any, name: str = "J") -> sp.Matrix:
-    M = as_matrix(J, name, None, True)
-    if M.rows == 0 or M.cols == 0:
-        raise ValueError(f"{name} must have at least one row and one column, got {describe(M)}")
-    return M.applyfunc(lambda e: exact_number(e, name))      # Floats → the decimal typed; refuses I, nan, oo
-
-
-def _numeric_vectors(x: Any, name: str, m: int, what: str) -> np.ndarray:
-    a = real_array(x, name, f"{what} of length {m} (or a batch (N, {m}))")
-    if a.ndim not in (1, 2) or a.shape[-1] != m:
-        raise ValueError(f"{name} must be {what} of length {m} (or a batch (N, {m})) to match J, got {describe(x)}")
-    return a
-
-
 def _apply(M: np.ndarray, x: np.ndarray, name: str) -> np.ndarray:
     """M x for M (…, p, q) and x (…, q), broadcasting the batch axes."""
     if M.ndim == 3 and x.ndim == 2 and M.shape[0] != x.shape[0]:
@@ -96,8 +111,10 @@ def _damping(lam: Any) -> sp.Expr:
     if e.is_negative:
         raise ValueError(f"damping must be ≥ 0 (λ in Jᵀ(J Jᵀ + λ²I)⁻¹), got {lam!r}")
     if e.is_nonnegative is not True:
-        raise ValueError(f"damping must be ≥ 0 (λ in Jᵀ(J Jᵀ + λ²I)⁻¹): could not show {e} ≥ 0; declare its "
-                         f"symbols positive (sp.Symbol('lam', positive=True)) or give a number")
+        raise ValueError(
+            f"damping must be ≥ 0 (λ in Jᵀ(J Jᵀ + λ²I)⁻¹): could not show {e} ≥ 0; declare its "
+            f"symbols positive (sp.Symbol('lam', positive=True)) or give a number"
+        )
     return e
 
 
@@ -125,18 +142,29 @@ def _warn(rank, s, tol, k: int, stacklevel: int = 3):
     with np.errstate(divide="ignore", invalid="ignore"):
         amp = np.where(smin_kept > 0, smax / smin_kept, np.inf)
     near = ~deficient & (amp > _WARN_COND)
-    where = lambda mask: "" if len(rank) == 1 else f" ({int(mask.sum())} of {len(rank)} Jacobians, first at index {int(np.flatnonzero(mask)[0])})"
+    where = lambda mask: (
+        ""
+        if len(rank) == 1
+        else f" ({int(mask.sum())} of {len(rank)} Jacobians, first at index {int(np.flatnonzero(mask)[0])})"
+    )
     if deficient.any():
         i = int(np.flatnonzero(deficient)[0])
-        warnings.warn(f"J is singular{where(deficient)}: rank {int(rank[i])} < {k}, singular values "
-                      f"{np.array2string(s[i], precision=3)}; the {k - int(rank[i])} smallest (≤ tol = {tol[i]:.3g}) "
-                      f"were dropped, so J⁺V has no component along their directions (the minimum-norm "
-                      f"least-squares θ̇); pass rtol to change the cut-off", SingularityWarning, stacklevel=stacklevel)
+        warnings.warn(
+            f"J is singular{where(deficient)}: rank {int(rank[i])} < {k}, singular values "
+            f"{np.array2string(s[i], precision=3)}; the {k - int(rank[i])} smallest (≤ tol = {tol[i]:.3g}) "
+            f"were dropped, so J⁺V has no component along their directions (the minimum-norm "
+            f"least-squares θ̇); pass rtol to change the cut-off",
+            SingularityWarning,
+            stacklevel=stacklevel,
+        )
     if near.any():
         i = int(np.flatnonzero(near)[0])
-        warnings.warn(f"J is nearly singular{where(near)}: σ_max/σ_min = {amp[i]:.3g} > {_WARN_COND:.0e}, so J⁺ "
-                      f"amplifies V by up to 1/σ_min = {1 / smin_kept[i]:.3g}; consider damped_least_squares",
-                      SingularityWarning, stacklevel=stacklevel)
+        warnings.warn(
+            f"J is nearly singular{where(near)}: σ_max/σ_min = {amp[i]:.3g} > {_WARN_COND:.0e}, so J⁺ "
+            f"amplifies V by up to 1/σ_min = {1 / smin_kept[i]:.3g}; consider damped_least_squares",
+            SingularityWarning,
+            stacklevel=stacklevel,
+        )
 
 
 def _exact_pinv(M: sp.Matrix, name: str = "J"):
@@ -149,9 +177,11 @@ def _exact_pinv(M: sp.Matrix, name: str = "J"):
     """
     if M.free_symbols:
         syms = ", ".join(sorted(map(str, M.free_symbols)))
-        raise ValueError(f"{name} must be constant for an exact pseudoinverse (its form changes where the rank drops), "
-                         f"got entries in {syms}: substitute a configuration first (J.subs({{...}})), or use "
-                         f"damped_least_squares with damping > 0, which is exact for every configuration")
+        raise ValueError(
+            f"{name} must be constant for an exact pseudoinverse (its form changes where the rank drops), "
+            f"got entries in {syms}: substitute a configuration first (J.subs({{...}})), or use "
+            f"damped_least_squares with damping > 0, which is exact for every configuration"
+        )
     m, n = M.shape
     try:
         from .exactfield import ExactField, NotExact
@@ -164,17 +194,17 @@ def _exact_pinv(M: sp.Matrix, name: str = "J"):
         except NotExact:
             A = None
         if A is not None:
-            if fld.K == sp.QQ:   # rational coefficients: field Gauss–Jordan is fastest
+            if fld.K == sp.QQ:  # rational coefficients: field Gauss–Jordan is fastest
                 P, r = _pinv_formula(A, A.rank(), m, n, lambda X: X.inv())
-            else:                # algebraic coefficients (√2 ...): fraction-free, far faster there
+            else:  # algebraic coefficients (√2 ...): fraction-free, far faster there
                 P, r = _field_pinv(A, m, n)
             return _back(fld, P), r
     iz = lambda e: decide_zero(e, f"an entry in the elimination of {name}")
     if all(iz(e) for e in M):
         return sp.zeros(n, m), 0
-    B, C = M.rank_decomposition(iszerofunc=iz)     # M = B C, B: m×r pivot columns, C: r×n (rref rows)
+    B, C = M.rank_decomposition(iszerofunc=iz)  # M = B C, B: m×r pivot columns, C: r×n (rref rows)
     P, r = _pinv_formula(M, B.cols, m, n, lambda X: X.inv(method="LU", iszerofunc=iz), (B, C))
-    return P.applyfunc(tidy), r
+    return P.applyfunc(readable), r
 
 
 def _field_pinv(A, m: int, n: int):
@@ -185,13 +215,13 @@ def _field_pinv(A, m: int, n: int):
     if r == 0:
         return A.transpose().mul(A.domain.zero), 0
 
-    def frac(X):                                  # X = N / d, N over the polynomial ring
+    def frac(X):  # X = N / d, N over the polynomial ring
         d, N = X.clear_denoms(convert=True)
         return N, getattr(d, "element", d)
 
     def inv(X):
         N, d = frac(X)
-        adj, det = N.inv_den()                    # N⁻¹ = adj / det
+        adj, det = N.inv_den()  # N⁻¹ = adj / det
         return adj.mul(d), det
 
     def mul(*fs):
@@ -207,7 +237,7 @@ def _field_pinv(A, m: int, n: int):
         N, d = mul(frac(At), inv(A * At))
     elif r == n:
         N, d = mul(inv(At * A), frac(At))
-    else:                                         # J = B C: B the pivot columns, C the nonzero rref rows
+    else:  # J = B C: B the pivot columns, C the nonzero rref rows
         B, C = A.extract(list(range(m)), list(piv)), R.extract(list(range(r)), list(range(n)))
         Ct, Bt = C.transpose(), B.transpose()
         N, d = mul(frac(Ct), inv(C * Ct), inv(Bt * B), frac(Bt))
@@ -227,23 +257,12 @@ def _pinv_formula(A, r: int, m: int, n: int, inv, BC=None):
         return T(A) * inv(A * T(A)), r
     if r == n:
         return inv(T(A) * A) * T(A), r
-    if BC is None:                                # rank decomposition from the rref: B = pivot columns of A
+    if BC is None:  # rank decomposition from the rref: B = pivot columns of A
         R, piv = A.rref()
         B, C = A.extract(list(range(m)), list(piv)), R.extract(list(range(r)), list(range(n)))
     else:
         B, C = BC
     return T(C) * inv(C * T(C)) * inv(T(B) * B) * T(B), r
-
-
-def tidy(e: sp.Expr) -> sp.Expr:
-    """An exact constant in a readable form (an identity, never a numeric guess): one fraction whose
-    numerator and denominator are reduced modulo sin² + cos² = 1 (:func:`kinlib.simplify_for_display`);
-    expressions without sines and cosines by ``radsimp(simplify(·))``."""
-    from .display import simplify_for_display
-    if not e.has(sp.sin, sp.cos):
-        return sp.radsimp(sp.simplify(e))
-    num, den = sp.fraction(sp.together(e))
-    return simplify_for_display(sp.expand(num)) / simplify_for_display(sp.expand(den))
 
 
 def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
@@ -268,7 +287,12 @@ def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
     [1,   0, 0],
     [0, 1/2, 0]])
     >>> import numpy as np
-    >>> P, rep = pseudoinverse(np.array([[1.0, 1.0], [1.0, 1.0]]), full_output=True)   # warns: rank 1 < 2
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     P, rep = pseudoinverse(np.array([[1.0, 1.0], [1.0, 1.0]]), full_output=True)
+    >>> caught[0].category.__name__                     # rank 1 < 2: the smallest singular value was dropped
+    'SingularityWarning'
     >>> P, rep.rank
     (array([[0.25, 0.25],
            [0.25, 0.25]]), 1)
@@ -276,9 +300,9 @@ def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
     if is_symbolic(J):
         if rtol is not None:
             raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
-        P, r = _exact_pinv(_exact_J(J))
+        P, r = _exact_pinv(exact_jacobian(J))
         return (P, PinvReport(r, None, None)) if full_output else P
-    A = _numeric_J(J)
+    A = numeric_jacobian(J)
     rtol = _rtol(rtol)
     batch = A.ndim == 3
     P, rank, s, tol = _svd_pinv(A if batch else A[None], rtol)
@@ -312,13 +336,13 @@ def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False
     if is_symbolic(J, V):
         if rtol is not None:
             raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
-        M = _exact_J(J)
+        M = exact_jacobian(J)
         v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
         P, r = _exact_pinv(M)
         out = (P * v).applyfunc(sp.radsimp)
         return (out, PinvReport(r, None, None)) if full_output else out
-    A = _numeric_J(J)
-    v = _numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
+    A = numeric_jacobian(J)
+    v = numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
     batch = A.ndim == 3
     P, rank, s, tol = _svd_pinv(A if batch else A[None], _rtol(rtol))
     _warn(rank, s, tol, min(A.shape[-2:]))
@@ -348,7 +372,7 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
     """
     if is_symbolic(J, V, damping):
         lam = _damping(damping)
-        M = _exact_J(J)
+        M = exact_jacobian(J)
         v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
         if lam == 0:
             return inverse_velocity(M, v)
@@ -359,14 +383,15 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
             return fast if not v.free_symbols else (fast * v).applyfunc(sp.radsimp)
         kw = {"iszerofunc": lambda e: decide_zero(e, "a pivot")} if const else {}
         if m <= n:
-            out = M.T * (M * M.T + lam ** 2 * sp.eye(m)).LUsolve(v, **kw)
+            out = M.T * (M * M.T + lam**2 * sp.eye(m)).LUsolve(v, **kw)
         else:
-            out = (M.T * M + lam ** 2 * sp.eye(n)).LUsolve(M.T * v, **kw)
-        return out.applyfunc(lambda e: sp.radsimp(sp.simplify(e)) if const and not e.has(sp.sin, sp.cos)
-                             else sp.cancel(e))
+            out = (M.T * M + lam**2 * sp.eye(n)).LUsolve(M.T * v, **kw)
+        return out.applyfunc(
+            lambda e: sp.radsimp(sp.simplify(e)) if const and not e.has(sp.sin, sp.cos) else sp.cancel(e)
+        )
     lam = float(_damping(damping))
-    A = _numeric_J(J)
-    v = _numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
+    A = numeric_jacobian(J)
+    v = numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
     if lam == 0:
         return inverse_velocity(A, v)
     U, s, Vt = np.linalg.svd(A, full_matrices=False)
@@ -381,9 +406,10 @@ def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
     const_v = not v.free_symbols
     try:
         from .exactfield import ExactField
+
         fld = ExactField(list(M) + [lam] + (list(v) if const_v else []))
         A = fld.field_matrix(M)
-        l2 = fld.convert(lam ** 2)
+        l2 = fld.convert(lam**2)
         b = fld.field_matrix(v) if const_v else None
     except (ImportError, ValueError):
         return None
@@ -394,7 +420,7 @@ def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
     if const_v:
         x = At * G.lu_solve(b) if m <= n else G.lu_solve(At * b)
         return _back(fld, x)
-    d, N = G.clear_denoms(convert=True)          # fraction-free: G⁻¹ = d · adj(N)/det(N)
+    d, N = G.clear_denoms(convert=True)  # fraction-free: G⁻¹ = d · adj(N)/det(N)
     adj, det = N.inv_den()
     Gi = adj.convert_to(K).mul(K.convert_from(getattr(d, "element", d), N.domain) / K.convert_from(det, N.domain))
     X = At * Gi if m <= n else Gi * At
@@ -405,8 +431,15 @@ def _back(fld, X) -> sp.Matrix:
     """A matrix over the exact field written back readably in the configuration's sines and cosines."""
     rows, cols = X.shape
     L = X.to_list()
-    return sp.Matrix(rows, cols, [fld.to_expr(fld.F(L[i][j])) if L[i][j] else sp.S.Zero
-                                  for i in range(rows) for j in range(cols)])
+    return sp.Matrix(
+        rows,
+        cols,
+        [
+            readable_ratio(*fld.to_ratio(fld.F(L[i][j]))) if L[i][j] else sp.S.Zero
+            for i in range(rows)
+            for j in range(cols)
+        ],
+    )
 
 
 # ----------------------------------------------------------------------------------------------
@@ -428,11 +461,11 @@ def joint_torques(J: Any, F: Any):
     Matrix([[cos(theta1) + cos(theta1 + theta2), cos(theta1 + theta2)]])
     """
     if is_symbolic(J, F):
-        M = _exact_J(J)
+        M = exact_jacobian(J)
         f = _exact_vector(F, "F", M.rows, "a wrench (the rows of J)")
         return M.T * f
-    A = _numeric_J(J)
-    f = _numeric_vectors(F, "F", A.shape[-2], "a wrench (the rows of J)")
+    A = numeric_jacobian(J)
+    f = numeric_vectors(F, "F", A.shape[-2], "a wrench (the rows of J)")
     return _apply(np.swapaxes(A, -1, -2), f, "F")
 
 
@@ -459,10 +492,15 @@ def force_ellipsoid(J: Any, rows: Any = None):
         lengths, U = velocity_ellipsoid(J, rows)
         out = []
         for s in lengths:
-            zero = decide_zero(s, "a singular value") if not s.free_symbols else sp.simplify(s) == 0
+            try:
+                zero = decide_zero(s, "a singular value")
+            except ValueError:
+                if not s.free_symbols:
+                    raise
+                zero = False  # not identically zero: 1/s is exact wherever s ≠ 0
             out.append(sp.oo if zero else sp.radsimp(1 / s))
         return out, U
-    A = _numeric_J(J)
+    A = numeric_jacobian(J)
     if rows is None and A.shape[-2] == 6:
         rows = "linear"
     if rows is not None:

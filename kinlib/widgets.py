@@ -7,58 +7,94 @@ PNG into an ``ipywidgets.Image``. This works with the plain inline backend in Ju
 VS Code (no ipympl needed), and the last picture is kept in the saved widget state.
 
 Velocities come from the **geometric Jacobian** J(θ) = blockdiag(R, R) J_b, rows [ω_s; ṗ].
-Singularity test: the task rows J_r of J (default (ω_z, ṗ_x, ṗ_y) for a planar chain, all six rows
-otherwise) at θ; with σ_max ≥ … ≥ σ_min its singular values and w = √det(J_r J_rᵀ) (√det(J_rᵀ J_r)
-when fewer joints than rows) the manipulability, the configuration is called
+Singularity test: the task rows J_r (m×n) of J at θ, by default the arm's task space
+(:func:`kinlib.taskspace.default_task_rows`: (ω_z, ṗ_x, ṗ_y) for a planar arm with ≥ 3 joints, (ṗ_x, ṗ_y)
+with fewer; all six rows for a spatial arm with ≥ 6 joints, (ṗ_x, ṗ_y, ṗ_z) with fewer); with
+σ_max ≥ … ≥ σ_min its min(m, n) singular values and w = √det(J_r J_rᵀ) (√det(J_rᵀ J_r) when fewer joints
+than rows) the manipulability (both from :mod:`kinlib.manipulability`), the configuration is called
 
-* ``"singular"`` when σ_min/σ_max < ``tol`` (default 10⁻⁶: J_r loses rank),
+* ``"singular"`` when the rank of J_r (the singular values above ``tol`` · σ_max, default 10⁻⁶) is below
+  min(m, n): J_r loses rank,
 * ``"near"`` when w < ``near`` · w_max (default 0.1; w_max = the largest w over a fixed sample of the
   slider ranges: a relative, unit-free threshold),
 * ``"regular"`` otherwise.
 
 Speed: the static part of the figure (axes, grid, ticks, legend, {s}) is rendered once and cached;
 a slider move restores it, draws only the moving artists (blitting with Agg) and encodes a PNG.
+
+>>> from kinlib.robots import planar_2r
+>>> ex = explorer(planar_2r(1, 1), q=[0.3, 0.0])
+>>> ex.state, ex.update([0.3, 1.0]).state
+('singular', 'regular')
 """
+
 from __future__ import annotations
 
 import html
 import io
 import math
-from typing import Mapping, Sequence
+from collections.abc import Mapping, Sequence
 
-import numpy as np
 import ipywidgets as W
-from matplotlib.figure import Figure
+import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
+from matplotlib.figure import Figure
 
-from . import plotting as P
 from ._backend import describe
+from .manipulability import manipulability_values, singular_values, strongest_joints
+from .plotting import (
+    JOINT_COLORS,
+    default_ranges,
+    draw_chain,
+    draw_joint_velocities,
+    draw_velocity,
+    draw_velocity_ellipse,
+)
+from .plotting.common import as_configuration, checked_numeric, theta_tex
+from .taskspace import ROW_LABELS, ROW_TEX, default_task_rows, is_planar, rows_label, task_row_indices, task_rows
 
 __all__ = ["explorer", "Explorer", "config_picker", "ConfigPicker", "classify"]
 
 
 def classify(J_rows: np.ndarray, tol: float = 1e-6, near: float = 0.1, w_max: float | None = None) -> dict:
-    """Numbers for the readout of task rows J_r (m×n): rank, det (square only), manipulability w
-    (√det(J Jᵀ), or √det(Jᵀ J) when n < m), ratio σ_min/σ_max, ``relative`` = w / w_max and ``state``:
-    'singular' when σ_min/σ_max < tol, 'near' when w / w_max < near (w_max: the largest w over the
-    joint ranges; without it, the ratio σ_min/σ_max is compared with ``near``), else 'regular'."""
+    """Numbers for the readout of task rows J_r (m×n), from :mod:`kinlib.manipulability`: ``rank`` (the
+    singular values above tol · σ_max), ``full_rank`` = min(m, n), ``det`` (square only), ``manipulability``
+    w (√det(J Jᵀ), or √det(Jᵀ J) when n < m), ``ratio`` σ_min/σ_max, ``relative`` = w / w_max and ``state``:
+    'singular' when rank < min(m, n), 'near' when w / w_max < near (w_max: the largest w over the joint
+    ranges; without it, the ratio σ_min/σ_max is compared with ``near``), else 'regular'.
+
+    >>> import numpy as np
+    >>> info = classify(np.array([[1.0, 1.0], [0.0, 0.0]]))
+    >>> info["state"], info["rank"], info["full_rank"]
+    ('singular', 1, 2)
+    >>> classify(np.eye(2))["state"]
+    'regular'
+    """
     J = np.asarray(J_rows, float)
-    s = np.linalg.svd(J, compute_uv=False)
-    smax = float(s[0]) if s.size else 0.0
-    ratio = float(s[-1] / smax) if smax > 0 else 0.0
+    s = singular_values(J)
+    smax = float(s[0])
     full = min(J.shape)
-    rank = int(np.sum(s > tol * max(smax, 1e-300))) if smax > 0 else 0
-    w = float(P.manipulability_values(J[None], "yoshikawa")[0])
+    rank = int(np.sum(s > tol * smax)) if smax > 0 else 0
+    ratio = float(manipulability_values(J, "inverse_condition"))
+    w = float(manipulability_values(J, "yoshikawa"))
     rel = w / w_max if w_max else ratio
-    state = "singular" if ratio < tol else ("near" if rel < near else "regular")
-    return {"rank": rank, "full_rank": full, "det": float(np.linalg.det(J)) if J.shape[0] == J.shape[1] else None,
-            "manipulability": w, "ratio": ratio, "relative": rel, "state": state}
+    state = "singular" if rank < full else ("near" if rel < near else "regular")
+    return {
+        "rank": rank,
+        "full_rank": full,
+        "det": float(manipulability_values(J, "det")) if J.shape[0] == J.shape[1] else None,
+        "manipulability": w,
+        "ratio": ratio,
+        "relative": rel,
+        "state": state,
+    }
 
 
 def _png(canvas, fmt: str = "png") -> bytes:
     """The canvas as PNG (RGB, fast zlib level 1: about 2/3 of the time of RGBA) or JPEG (quality 90,
     several times faster to encode, slightly soft lines)."""
     from PIL import Image
+
     w, h = canvas.get_width_height(physical=True)
     im = Image.frombuffer("RGBA", (w, h), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
     buf = io.BytesIO()
@@ -69,7 +105,7 @@ def _png(canvas, fmt: str = "png") -> bytes:
     return buf.getvalue()
 
 
-def _render_png(fig: Figure, dpi: float = None) -> bytes:
+def _render_png(fig: Figure) -> bytes:
     """Draw the whole figure with Agg and encode it as PNG."""
     fig.canvas.draw()
     return _png(fig.canvas)
@@ -83,9 +119,6 @@ class _Blitter:
         self.fig, self.artists, self.fmt = fig, [a for a in artists if a is not None], fmt
         for a in self.artists:
             a.set_animated(True)
-        self.background = None
-
-    def invalidate(self):
         self.background = None
 
     def render(self) -> bytes:
@@ -103,14 +136,11 @@ class _Blitter:
         return _png(canvas, self.fmt)
 
 
-def _new_figure(figsize, dpi, three_d: bool, ncols: int = 1):
+def _new_figure(figsize, dpi, three_d: bool):
+    """A Figure with an Agg canvas, not registered with pyplot, and its one (2-D or 3-D) axes."""
     fig = Figure(figsize=figsize, dpi=dpi)
     FigureCanvasAgg(fig)
-    if ncols == 1:
-        ax = fig.add_subplot(projection="3d" if three_d else None)
-        return fig, ax
-    ax = fig.add_subplot(1, ncols, 1, projection="3d" if three_d else None)
-    return fig, ax
+    return fig, fig.add_subplot(projection="3d" if three_d else None)
 
 
 def _slider_label(chain, i: int, rate: bool = False) -> str:
@@ -131,36 +161,56 @@ class Explorer(W.VBox):
     "singular" exactly when at or near a singular configuration), ``readout`` (HTML), ``image``
     (the rendered PNG), ``fig``/``ax``, ``arm``/``velocity``/``ellipse`` artists, ``q``, ``qdot``,
     ``info`` (the last :func:`classify` result), ``update(q=None, qdot=None)``.
+
+    >>> from kinlib.robots import planar_offset_3r
+    >>> ex = Explorer(planar_offset_3r(1), q=[0.3, 0.7, 0.2])
+    >>> ex.rows, ex.state
+    ((2, 3, 4), 'regular')
     """
 
-    def __init__(self, chain, *, q=None, qdot=None, rows=None, ranges=None, show_ellipse=True,
-                 show_velocity=True, rate_sliders=True, ellipse_rows=None, velocity_scale=0.5,
-                 tol=1e-6, near=0.1, params=None, figsize=(5.2, 5.0), dpi=80, step=None,
-                 continuous_update=True, title=None, image_format="png", show_maximum=True):
+    # the options grouped by what they set: configuration, task space, drawing, readout, image
+    # fmt: off
+    def __init__(self, chain, *, q=None, qdot=None, params=None, ranges=None, step=None, continuous_update=True,
+                 rows=None, ellipse_rows=None, tol=1e-6, near=0.1,
+                 show_ellipse=True, show_velocity=True, rate_sliders=True, velocity_scale=0.5, title=None,
+                 show_maximum=True, figsize=(5.2, 5.0), dpi=80, image_format="png"):
+        # fmt: on
         if image_format not in ("png", "jpeg"):
             raise ValueError(f"image_format must be 'png' or 'jpeg', got {image_format!r}")
-        chain = P.numeric_chain(chain, params)
+        chain = checked_numeric(chain, params)
         self.chain = chain
         n = chain.n
-        self.rows = P.task_row_indices(rows) if rows is not None else P._default_task_rows(chain)
+        self.rows = task_row_indices(rows, default=default_task_rows(chain))
         self.tol, self.near = float(tol), float(near)
-        self.show_maximum = bool(show_maximum)     # False: no w_max in the text (a problem may ask for it)
-        self.dpi = dpi
-        self.ranges = P.default_ranges(chain, ranges)
-        q0 = P._as_q(chain, q)
-        qd0 = P._as_q(chain, qdot, "qdot") if qdot is not None else np.ones(n)
+        self.show_maximum = bool(show_maximum)  # False: no w_max in the text (a problem may ask for it)
+        self.ranges = default_ranges(chain, ranges)
+        q0 = as_configuration(chain, q)
+        qd0 = as_configuration(chain, qdot, "qdot") if qdot is not None else np.ones(n)
         for i, (lo, hi) in enumerate(self.ranges):
             q0[i] = min(max(q0[i], lo), hi)
         self.q, self.qdot = q0, qd0
-        self.planar = P.is_planar(chain)
+        self.planar = is_planar(chain)
         self.fig, self.ax = _new_figure(figsize, dpi, not self.planar)
-        self.arm = P.draw_chain(chain, q0, self.ax, ranges=self.ranges, title=title or chain.name)
-        self.ellipse = (P.draw_velocity_ellipse(self.ax, chain, q0, rows=ellipse_rows, scale=velocity_scale,
-                                                label=f"velocity ellipse (×{velocity_scale:g})")
-                        if show_ellipse else None)
-        self.velocity = (P.draw_velocity(self.ax, chain, q0, qd0, scale=velocity_scale,
-                                         label=rf"$\dot p = J\,\dot\theta$ (×{velocity_scale:g})")
-                         if show_velocity else None)
+        self.arm = draw_chain(chain, q0, self.ax, ranges=self.ranges, title=title or chain.name)
+        self.ellipse = (
+            draw_velocity_ellipse(
+                self.ax,
+                chain,
+                q0,
+                rows=ellipse_rows,
+                scale=velocity_scale,
+                label=f"velocity ellipse (×{velocity_scale:g})",
+            )
+            if show_ellipse
+            else None
+        )
+        self.velocity = (
+            draw_velocity(
+                self.ax, chain, q0, qd0, scale=velocity_scale, label=rf"$\dot p = J\,\dot\theta$ (×{velocity_scale:g})"
+            )
+            if show_velocity
+            else None
+        )
         if show_ellipse or show_velocity:
             self.ax.legend(loc="upper left", fontsize=7, framealpha=0.8)
         self.fig.tight_layout()
@@ -168,20 +218,40 @@ class Explorer(W.VBox):
         self.sliders = []
         for i, (lo, hi) in enumerate(self.ranges):
             st = step if step is not None else (math.pi / 180 if chain.joint_types[i] == "R" else (hi - lo) / 200)
-            self.sliders.append(W.FloatSlider(value=q0[i], min=lo, max=hi, step=st, description=_slider_label(chain, i),
-                                              readout_format=".3f", continuous_update=continuous_update,
-                                              style={"description_width": "70px"},
-                                              layout=W.Layout(width="330px")))
+            self.sliders.append(
+                W.FloatSlider(
+                    value=q0[i],
+                    min=lo,
+                    max=hi,
+                    step=st,
+                    description=_slider_label(chain, i),
+                    readout_format=".3f",
+                    continuous_update=continuous_update,
+                    style={"description_width": "70px"},
+                    layout=W.Layout(width="330px"),
+                )
+            )
         self.rate_sliders = []
         if rate_sliders and show_velocity:
             for i in range(n):
-                self.rate_sliders.append(W.FloatSlider(value=qd0[i], min=-2.0, max=2.0, step=0.05,
-                                                       description=_slider_label(chain, i, rate=True),
-                                                       readout_format=".2f", continuous_update=continuous_update,
-                                                       style={"description_width": "70px"},
-                                                       layout=W.Layout(width="330px")))
-        moving = self.arm.artists + (self.ellipse.artists if self.ellipse is not None else []) + \
-            (self.velocity.artists if self.velocity is not None else [])
+                self.rate_sliders.append(
+                    W.FloatSlider(
+                        value=qd0[i],
+                        min=-2.0,
+                        max=2.0,
+                        step=0.05,
+                        description=_slider_label(chain, i, rate=True),
+                        readout_format=".2f",
+                        continuous_update=continuous_update,
+                        style={"description_width": "70px"},
+                        layout=W.Layout(width="330px"),
+                    )
+                )
+        moving = (
+            self.arm.artists
+            + (self.ellipse.artists if self.ellipse is not None else [])
+            + (self.velocity.artists if self.velocity is not None else [])
+        )
         self._blit = _Blitter(self.fig, moving, image_format)
         self.w_max = self._max_manipulability()
         self.status = W.HTML(value="")
@@ -207,10 +277,10 @@ class Explorer(W.VBox):
         self._hold = True
         try:
             if q is not None:
-                for s, v in zip(self.sliders, P._as_q(self.chain, q)):
+                for s, v in zip(self.sliders, as_configuration(self.chain, q)):
                     s.value = float(v)
             if qdot is not None:
-                qd = P._as_q(self.chain, qdot, "qdot")
+                qd = as_configuration(self.chain, qdot, "qdot")
                 if self.rate_sliders:
                     for s, v in zip(self.rate_sliders, qd):
                         s.value = float(v)
@@ -232,7 +302,7 @@ class Explorer(W.VBox):
             self.ellipse.update(q)
         if self.velocity is not None:
             self.velocity.update(q, self.qdot)
-        J = self.chain.jacobian_geometric(q)[list(self.rows)]
+        J = task_rows(self.chain.jacobian_geometric(q), self.rows)
         self.info = info = classify(J, self.tol, self.near, self.w_max)
         self.readout.value = self._readout_html(info)
         self.status.value = self._status_html(info)
@@ -244,11 +314,11 @@ class Explorer(W.VBox):
         lo = np.array([r[0] for r in self.ranges])
         hi = np.array([r[1] for r in self.ranges])
         Q = np.vstack([lo + (hi - lo) * rng.random((4000, self.chain.n)), self.q])
-        J = self.chain.jacobian_geometric(Q)[:, list(self.rows), :]
-        return float(np.max(P.manipulability_values(J, "yoshikawa")))
+        J = task_rows(self.chain.jacobian_geometric(Q), self.rows)
+        return float(np.max(manipulability_values(J, "yoshikawa")))
 
     def _readout_html(self, info) -> str:
-        rows = P._rows_label(self.rows)
+        rows = rows_label(self.rows)
         lines = [f"task rows of J: ({rows})"]
         if info["det"] is not None:
             lines.append(f"det J = {info['det']:+.4f}")
@@ -264,8 +334,13 @@ class Explorer(W.VBox):
 
     def _status_html(self, info) -> str:
         if info["state"] == "singular":
-            msg, color = (f"SINGULAR configuration: J loses rank (rank {info['rank']} of {info['full_rank']}); "
-                          f"some end-effector velocities are impossible here (singular)"), "#b00020"
+            msg, color = (
+                (
+                    f"SINGULAR configuration: J loses rank (rank {info['rank']} of {info['full_rank']}); "
+                    f"some end-effector velocities are impossible here (singular)"
+                ),
+                "#b00020",
+            )
         elif info["state"] == "near":
             share = f" (manipulability {100 * info['relative']:.1f}% of its maximum)" if self.show_maximum else ""
             msg, color = f"near a singular configuration{share}: some directions need large joint rates", "#b36b00"
@@ -290,7 +365,13 @@ def explorer(chain, **kwargs) -> Explorer:
     ``show_maximum`` (False: the text never states the largest manipulability, e.g. in a problem that asks for it),
     ``params`` ({"L": 1} for a symbolic chain), ``figsize``, ``dpi``, ``step`` (slider step; π/180 for
     angles so that multiples of 1° such as −π/4 are reachable), ``continuous_update``, ``title``,
-    ``image_format`` ('png' or the faster 'jpeg')."""
+    ``image_format`` ('png' or the faster 'jpeg').
+
+    >>> from kinlib.robots import planar_2r
+    >>> ex = explorer(planar_2r(1, 1), q=[0.5, 0.0])   # stretched out: (ṗ_x, ṗ_y) lose rank
+    >>> ex.rows, ex.state, ex.info["rank"]
+    ((3, 4), 'singular', 1)
+    """
     return Explorer(chain, **kwargs)
 
 
@@ -302,16 +383,25 @@ class ConfigPicker(W.VBox):
 
     ``rows``: one row for all configurations ('vx', 'vy', …) or a dict {name: row}.
     State: ``buttons``, ``table`` (HTML), ``image``, ``contributions`` (n values of the current row),
-    ``best`` (1-based joints with the largest |contribution|), ``select(name)``.
+    ``best`` (1-based joints with the largest |contribution|, from
+    :func:`kinlib.manipulability.strongest_joints`), ``select(name)``.
+
+    >>> from kinlib.robots import planar_3r
+    >>> import math
+    >>> cp = ConfigPicker(planar_3r(1, 1, 1), {"home": [0, 0, 0], "c": [math.pi / 2, -math.pi / 8, -math.pi / 2]},
+    ...                   rows="vy")
+    >>> cp.best, cp.select("c").best   # problem 4.1 (c): joints 1 and 2 tie
+    ((1,), (1, 2))
     """
 
-    def __init__(self, chain, configs: Mapping, *, rows="vx", params=None, scale=1.0, figsize=(9.5, 4.3),
-                 dpi=80, title=None):
-        chain = P.numeric_chain(chain, params)
+    def __init__(
+        self, chain, configs: Mapping, *, rows="vx", params=None, scale=1.0, figsize=(9.5, 4.3), dpi=80, title=None
+    ):
+        chain = checked_numeric(chain, params)
         self.chain = chain
         if not isinstance(configs, Mapping) or not configs:
             raise TypeError(f"configs must be a non-empty dict {{name: q}}, got {describe(configs)}")
-        self.configs = {str(k): P._as_q(chain, v, f"configs[{k!r}]") for k, v in configs.items()}
+        self.configs = {str(k): as_configuration(chain, v, f"configs[{k!r}]") for k, v in configs.items()}
         if isinstance(rows, Mapping):
             missing = set(self.configs) - set(map(str, rows))
             if missing:
@@ -319,9 +409,8 @@ class ConfigPicker(W.VBox):
             self.rows = {str(k): self._one_row(v) for k, v in rows.items()}
         else:
             r = self._one_row(rows)
-            self.rows = {k: r for k in self.configs}
-        self.dpi = dpi
-        planar = P.is_planar(chain)
+            self.rows = dict.fromkeys(self.configs, r)
+        planar = is_planar(chain)
         self.fig = Figure(figsize=figsize, dpi=dpi)
         FigureCanvasAgg(self.fig)
         self.ax = self.fig.add_subplot(1, 2, 1, projection=None if planar else "3d")
@@ -338,15 +427,13 @@ class ConfigPicker(W.VBox):
         d = 2 if planar else 3
         c = 0.5 * (pts.min(1) + pts.max(1))[:d]
         h = 0.5 * float(np.max(pts.max(1) - pts.min(1))) * 1.15 + 1e-9
-        self.arm = P.draw_chain(chain, q0, self.ax, limits=np.stack([c - h, c + h], axis=1),
-                                title=title or chain.name)
-        self.arrows = P.draw_joint_velocities(self.ax, chain, q0, scale=scale)
+        self.arm = draw_chain(chain, q0, self.ax, limits=np.stack([c - h, c + h], axis=1), title=title or chain.name)
+        self.arrows = draw_joint_velocities(self.ax, chain, q0, scale=scale)
         n = chain.n
-        self.bars = self.ax_bar.bar(np.arange(1, n + 1), np.zeros(n),
-                                    color=[P.JOINT_COLORS[i % 10] for i in range(n)])
+        self.bars = self.ax_bar.bar(np.arange(1, n + 1), np.zeros(n), color=[JOINT_COLORS[i % 10] for i in range(n)])
         self.bar_texts = [self.ax_bar.text(i + 1, 0, "", ha="center", va="bottom", fontsize=9) for i in range(n)]
         self.ax_bar.axhline(0, color="k", lw=0.8)
-        self.ax_bar.set_xticks(np.arange(1, n + 1), [P._theta_tex(i + 1, dot=True) for i in range(n)])
+        self.ax_bar.set_xticks(np.arange(1, n + 1), [theta_tex(i + 1, dot=True) for i in range(n)])
         self.ax_bar.grid(True, axis="y", lw=0.4, alpha=0.5)
         # a common y-range over all configurations, so bars compare across them
         vals = [chain.jacobian_geometric(qq)[self.rows[k]] for k, qq in self.configs.items()]
@@ -362,7 +449,7 @@ class ConfigPicker(W.VBox):
 
     @staticmethod
     def _one_row(r) -> int:
-        idx = P.task_row_indices(r)
+        idx = task_row_indices(r)
         if len(idx) != 1:
             raise ValueError(f"rows must name one row per configuration (e.g. 'vx'), got {describe(r)}")
         return idx[0]
@@ -385,22 +472,35 @@ class ConfigPicker(W.VBox):
             t.set_position((t.get_position()[0], v))
             t.set_va("bottom" if v >= 0 else "top")
             t.set_text(f"{v:+.3f}")
-        lab = P.ROW_LABELS[row]
-        self.ax_bar.set_title(f"{name}: {P.ROW_TEX[row]} for each " + r"$\dot\theta_i = 1$", fontsize=10)
-        a = np.abs(c)
-        self.best = tuple(int(i) + 1 for i in np.flatnonzero(a >= a.max() - 1e-9 * max(a.max(), 1e-300)))
-        cells = "".join(f"<td style='padding:0 8px'>{'<b>' if i + 1 in self.best else ''}{v:+.4f}"
-                        f"{'</b>' if i + 1 in self.best else ''}</td>" for i, v in enumerate(c))
+        lab = ROW_LABELS[row]
+        self.ax_bar.set_title(f"{name}: {ROW_TEX[row]} for each " + r"$\dot\theta_i = 1$", fontsize=10)
+        best = strongest_joints(c)
+        self.best = best if isinstance(best, tuple) else (best,)
+        cells = "".join(
+            f"<td style='padding:0 8px'>{'<b>' if i + 1 in self.best else ''}{v:+.4f}"
+            f"{'</b>' if i + 1 in self.best else ''}</td>"
+            for i, v in enumerate(c)
+        )
         heads = "".join(f"<th style='padding:0 8px'>θ̇{i + 1}</th>" for i in range(len(c)))
-        who = (f"joint {self.best[0]}" if len(self.best) == 1 else
-               "a tie between joints " + " and ".join(map(str, self.best)))
-        self.table.value = (f"<table><tr><th>{html.escape(lab)} per unit rate</th>{heads}</tr>"
-                            f"<tr><td>θ = ({', '.join(f'{x:.4f}' for x in q)})</td>{cells}</tr></table>"
-                            f"<div>largest |{html.escape(lab)}|: {who}</div>")
-        self.image.value = _render_png(self.fig, self.dpi)
+        who = (
+            f"joint {self.best[0]}"
+            if len(self.best) == 1
+            else "a tie between joints " + " and ".join(map(str, self.best))
+        )
+        self.table.value = (
+            f"<table><tr><th>{html.escape(lab)} per unit rate</th>{heads}</tr>"
+            f"<tr><td>θ = ({', '.join(f'{x:.4f}' for x in q)})</td>{cells}</tr></table>"
+            f"<div>largest |{html.escape(lab)}|: {who}</div>"
+        )
+        self.image.value = _render_png(self.fig)
         return self
 
 
 def config_picker(chain, configs: Mapping, **kwargs) -> ConfigPicker:
-    """A :class:`ConfigPicker` (keywords: rows, params, scale, figsize, dpi, title)."""
+    """A :class:`ConfigPicker` (keywords: rows, params, scale, figsize, dpi, title).
+
+    >>> from kinlib.robots import planar_3r
+    >>> config_picker(planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]}).contributions.shape
+    (3,)
+    """
     return ConfigPicker(chain, configs, **kwargs)

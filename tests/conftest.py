@@ -1,4 +1,5 @@
 """pytest configuration and fixtures. Shared test helpers live in tests/helpers.py (import them from there)."""
+
 import sys
 
 import numpy as np

@@ -1,5 +1,6 @@
 """An independent 60-digit oracle for tests: the space Jacobian of a chain by the product of exponentials,
 written here in mpmath from the screw axes alone (no kinlib code), and its singular values."""
+
 from __future__ import annotations
 
 import mpmath
@@ -9,6 +10,7 @@ DIGITS = 60
 
 def _mp(x):
     import sympy as sp
+
     return mpmath.mpf(str(sp.N(sp.sympify(x), DIGITS + 15)))
 
 

@@ -7,19 +7,20 @@
   built with plain NumPy/modern_robotics, *not* with kinlib, so it can serve as an independent input.
 * :data:`FAST` – hypothesis settings for quick, reproducible property tests.
 """
+
 from __future__ import annotations
 
 import random
 
 import numpy as np
-import pytest
 import sympy as sp
 
 try:  # hypothesis is in environment.txt; keep conftest importable without it
     from hypothesis import HealthCheck, settings
 
-    FAST = settings(max_examples=25, deadline=None, derandomize=True, database=None,
-                    suppress_health_check=[HealthCheck.too_slow])
+    FAST = settings(
+        max_examples=25, deadline=None, derandomize=True, database=None, suppress_health_check=[HealthCheck.too_slow]
+    )
 except ImportError:  # pragma: no cover
     FAST = None
 
@@ -121,12 +122,14 @@ def assert_sym_equal(a, b, label: str = "", *, spot_checks: int = 3, tol: float 
             i, j = bad[0]
             raise AssertionError(
                 f"{label}: entry ({i}, {j}) differs at {vals}:\n  got      {A[i, j]}\n  expected {B[i, j]}\n"
-                f"  difference {Dn[i, j]:.6g}")
+                f"  difference {Dn[i, j]:.6g}"
+            )
     for i in range(D.rows):
         for j in range(D.cols):
             assert _is_zero_exact(D[i, j]), (
                 f"{label}: entry ({i}, {j}) not proved equal by simplification:\n"
-                f"  got      {A[i, j]}\n  expected {B[i, j]}")
+                f"  got      {A[i, j]}\n  expected {B[i, j]}"
+            )
 
 
 def assert_no_floats(M, label: str = "") -> None:
@@ -146,6 +149,7 @@ def _unit(v):
 def random_transform(rng: np.random.Generator) -> np.ndarray:
     """A random T ∈ SE(3) from the modern_robotics exponential of a random twist."""
     import modern_robotics as mr
+
     return mr.MatrixExp6(mr.VecTose3(rng.normal(size=6)))
 
 

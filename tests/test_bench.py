@@ -1,4 +1,5 @@
 """Smoke test of the benchmark script (bench/bench.py): it runs and writes the table. No timing assertions."""
+
 import subprocess
 import sys
 from pathlib import Path
@@ -11,18 +12,47 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.mark.slow
 def test_bench_quick_writes_table(tmp_path):
     out = tmp_path / "bench.md"
-    p = subprocess.run([sys.executable, str(ROOT / "bench" / "bench.py"), "--quick", "--reps", "1",
-                        "--singular-timeout", "120", "--out", str(out)],
-                       capture_output=True, text=True, timeout=600, cwd=ROOT)
+    p = subprocess.run(
+        [
+            sys.executable,
+            str(ROOT / "bench" / "bench.py"),
+            "--quick",
+            "--reps",
+            "1",
+            "--singular-timeout",
+            "120",
+            "--out",
+            str(out),
+        ],
+        capture_output=True,
+        text=True,
+        timeout=600,
+        cwd=ROOT,
+    )
     assert p.returncode == 0, p.stderr[-2000:]
     text = out.read_text(encoding="utf-8")
     assert text == p.stdout.rstrip("\n") or text in p.stdout
-    for needle in ["# kinlib benchmark", "| CPU |", "| Python |", "| numpy |", "| sympy |", "| date |",
-                   "## Targets", "## Numeric kinematics", "| robot | quantity | call | kinlib (best) | modern-robotics",
-                   "## Symbolic", "UR5 J_s built", "## First numeric call of a 7-joint chain",
-                   "## Exact analysis at a configuration", "## Singular sets of a redundant arm",
-                   "symbolic condition number and isotropy", "## Notebooks", "## Explorers", "## Instructor checker",
-                   "import kinlib"]:
+    for needle in [
+        "# kinlib benchmark",
+        "| CPU |",
+        "| Python |",
+        "| numpy |",
+        "| sympy |",
+        "| date |",
+        "## Targets",
+        "## Numeric kinematics",
+        "| robot | quantity | call | kinlib (best) | modern-robotics",
+        "## Symbolic",
+        "UR5 J_s built",
+        "## First numeric call of a 7-joint chain",
+        "## Exact analysis at a configuration",
+        "## Singular sets of a redundant arm",
+        "symbolic condition number and isotropy",
+        "## Notebooks",
+        "## Explorers",
+        "## Instructor checker",
+        "import kinlib",
+    ]:
         assert needle in text, needle
     # every robot and quantity has a single and a batched row, each with a figure for kinlib
     for robot in ["ur5", "planar_offset_3r", "spatial_rppr", "cart_pole", "planar_3r", "planar_rpp"]:

@@ -9,6 +9,7 @@ downloaded browser, with the network blocked.
 2. JupyterLab on a free loopback port runs notebook 05; its joint slider is moved with the keyboard to
    a singular configuration; the explorer then says so and its picture changes.
 """
+
 from __future__ import annotations
 
 import math
@@ -31,15 +32,26 @@ FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 VENDOR = ROOT / "build" / "vendor"
 SCREENSHOTS = ROOT / "build" / "screenshots"
 CHROMIUM = "/usr/bin/chromium"
-ARGS = ["--no-sandbox", "--headless", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run"]
+ARGS = [
+    "--no-sandbox",
+    "--headless",
+    "--disable-gpu",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+    "--no-first-run",
+]
 
 pytestmark = [pytest.mark.browser]
 
 REAL = sorted(p.stem for p in NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
 FIXTURE = sorted(p.stem for p in FIXTURES.glob("[0-9][0-9]_*.ipynb"))
-PAGES = ([("handouts", "index", None)] + [("handouts", k, s) for s in REAL for k in ("problems", "solutions")]
-         + [("fixture", "index", None)] + [("fixture", k, s) for s in FIXTURE for k in ("problems", "solutions")])
+PAGES = (
+    [("handouts", "index", None)]
+    + [("handouts", k, s) for s in REAL for k in ("problems", "solutions")]
+    + [("fixture", "index", None)]
+    + [("fixture", k, s) for s in FIXTURE for k in ("problems", "solutions")]
+)
 
 
 def _page_id(p):
@@ -50,11 +62,13 @@ def _page_id(p):
 # ---------------------------------------------------------------------------------------------------
 # fixtures
 
+
 @pytest.fixture(scope="session")
 def browser():
     if not Path(CHROMIUM).exists():
         pytest.fail(f"{CHROMIUM} is missing: `make chromium` (or apt-get install chromium) installs Debian's")
     from playwright.sync_api import sync_playwright
+
     with sync_playwright() as p:
         b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
         yield b
@@ -68,7 +82,8 @@ def sites(tmp_path_factory):
     ``KINLIB_HANDOUTS_DIR=build/handouts`` tests an existing build of the real notebooks instead (a quick
     loop after ``make handouts``). A failing real notebook fails its pages' tests, not the fixture's.
     """
-    from kinlib import handouts
+    from kinlib.course import handouts
+
     base = tmp_path_factory.mktemp("browser")
     out = {}
     handouts.build(FIXTURES, base / "fixture", vendor=VENDOR, jobs=1, verify=False, log=lambda s: None)
@@ -77,7 +92,7 @@ def sites(tmp_path_factory):
         out["handouts"] = Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
     elif REAL:
         built = ROOT / "build" / "handouts"
-        if _fresh(built):                   # `make handouts` just ran: test what it made
+        if _fresh(built):  # `make handouts` just ran: test what it made
             out["handouts"] = built
         else:
             try:
@@ -93,7 +108,7 @@ def _fresh(built: Path) -> bool:
     index = built / "index.html"
     if not index.exists():
         return False
-    sources = list(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")) + list((ROOT / "kinlib").glob("*.py"))
+    sources = list(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")) + list((ROOT / "kinlib").rglob("*.py"))
     if max(p.stat().st_mtime for p in sources) >= index.stat().st_mtime:
         return False
     return all((built / k / f"{s}.html").exists() for s in REAL for k in ("problems", "solutions"))
@@ -102,7 +117,7 @@ def _fresh(built: Path) -> bool:
 def _site(sites, name):
     site = sites.get(name)
     if site is None:
-        pytest.skip("no real notebooks in notebooks/ yet")
+        pytest.fail(f"no {name} pages were built: notebooks/ has no NN_*.ipynb notebook", pytrace=False)
     if isinstance(site, Exception):
         pytest.fail(f"make handouts fails: {site}", pytrace=False)
     return site
@@ -151,6 +166,7 @@ _MATHJAX_DONE = """() => new Promise(resolve => {
 # ---------------------------------------------------------------------------------------------------
 # 1. the static pages
 
+
 @pytest.mark.parametrize("spec", PAGES, ids=_page_id)
 def test_handout_page_renders_offline(sites, browser, spec):
     site, kind, stem = spec
@@ -173,8 +189,8 @@ def test_handout_page_renders_offline(sites, browser, spec):
                 assert n_math > 0, "the page has TeX but no typeset math"
             assert page.locator(".MathJax_Error, .noError, merror").count() == 0, "MathJax errors"
             rendered = page.eval_on_selector_all(
-                ".jp-RenderedMarkdown, .jp-RenderedLatex",
-                "els => els.map(e => e.innerText).join('\\n')")
+                ".jp-RenderedMarkdown, .jp-RenderedLatex", "els => els.map(e => e.innerText).join('\\n')"
+            )
             for raw in ("$$", "\\begin{", "\\frac", "\\left[", "\\theta"):
                 assert raw not in rendered, f"raw TeX {raw!r} visible"
             # the saved widgets are shown
@@ -186,14 +202,19 @@ def test_handout_page_renders_offline(sites, browser, spec):
                 assert page.locator(".jupyter-widgets-error-widget").count() == 0
             # figures: every image decoded; as many as the page embeds
             page.wait_for_function("() => Array.from(document.images).every(i => i.complete)")
-            broken = page.evaluate("() => Array.from(document.images).filter(i => !i.naturalWidth)"
-                                   ".map(i => (i.src || '').slice(0, 60))")
+            broken = page.evaluate(
+                "() => Array.from(document.images).filter(i => !i.naturalWidth).map(i => (i.src || '').slice(0, 60))"
+            )
             assert not broken, f"images that did not load: {broken}"
             n_png = len(re.findall(r"<img[^>]*src=\"data:image/", html))
             assert page.locator("img").count() >= n_png
             if kind == "problems":
-                assert page.locator(".jp-InputPrompt").evaluate_all(
-                    "els => els.filter(e => /\\d/.test(e.innerText)).length") == 0, "prompt numbers shown"
+                assert (
+                    page.locator(".jp-InputPrompt").evaluate_all(
+                        "els => els.filter(e => /\\d/.test(e.innerText)).length"
+                    )
+                    == 0
+                ), "prompt numbers shown"
             page.wait_for_timeout(200)
         watch.assert_clean(path.name)
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)
@@ -205,6 +226,7 @@ def test_handout_page_renders_offline(sites, browser, spec):
 def _has_tex(html: str) -> bool:
     """Whether the page's markdown or LaTeX outputs hold TeX (before MathJax)."""
     from bs4 import BeautifulSoup
+
     soup = BeautifulSoup(html, "html.parser")
     text = "\n".join(e.get_text() for e in soup.select(".jp-RenderedMarkdown, .jp-RenderedLatex"))
     return bool(re.search(r"\$|\\\(|\\\[|\\begin\{", text))
@@ -224,7 +246,7 @@ def _animation_pages(sites):
 def test_an_animation_plays_without_a_kernel(sites, browser):
     pages = _animation_pages(sites)
     assert any(site == "fixture" for site, _ in pages)
-    for site, path in pages:
+    for _site, path in pages:
         page, watch = _open(browser, path)
         try:
             img = page.locator("img[id^='_anim_img']").first
@@ -244,15 +266,17 @@ def test_an_animation_plays_without_a_kernel(sites, browser):
             watch.assert_clean(path.name)
         finally:
             page.close()
-    if "05_singularities_planar" in REAL:
-        _site(sites, "handouts")
-        assert any(site == "handouts" for site, _ in pages), (
-            "no real handout carries an animation: notebook 05 should show "
-            "kinlib.plotting.animate_singularity(...) as HTML(anim.to_jshtml())")
+    assert "05_singularities_planar" in REAL, "notebooks/05_singularities_planar.ipynb is missing"
+    _site(sites, "handouts")
+    assert any(site == "handouts" for site, _ in pages), (
+        "no real handout carries an animation: notebook 05 should show "
+        "kinlib.plotting.animate_singularity(...) as HTML(anim.to_jshtml())"
+    )
 
 
 # ---------------------------------------------------------------------------------------------------
 # 2. JupyterLab: notebook 05's explorer reaches a singular configuration
+
 
 def _free_port() -> int:
     with socket.socket() as s:
@@ -263,25 +287,42 @@ def _free_port() -> int:
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
     nb05 = NOTEBOOKS / "05_singularities_planar.ipynb"
-    if not nb05.exists():
-        pytest.skip("notebooks/05_singularities_planar.ipynb is absent")
+    assert nb05.exists(), "notebooks/05_singularities_planar.ipynb is missing"
     work = tmp_path_factory.mktemp("lab")
     scratch = work / "notebooks"
     shutil.copytree(NOTEBOOKS, scratch)
     port = _free_port()
     jupyter = Path(sys.executable).parent / "jupyter"
-    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(work / "config"), JUPYTERLAB_SETTINGS_DIR=str(work / "settings"),
-               JUPYTERLAB_WORKSPACES_DIR=str(work / "workspaces"))
+    env = dict(
+        os.environ,
+        JUPYTER_CONFIG_DIR=str(work / "config"),
+        JUPYTERLAB_SETTINGS_DIR=str(work / "settings"),
+        JUPYTERLAB_WORKSPACES_DIR=str(work / "workspaces"),
+    )
     notif = work / "settings" / "@jupyterlab" / "apputils-extension" / "notification.jupyterlab-settings"
     notif.parent.mkdir(parents=True)
-    notif.write_text('{"fetchNews": "false", "checkForUpdates": false}')       # no news toast
+    notif.write_text('{"fetchNews": "false", "checkForUpdates": false}')  # no news toast
     log = open(work / "lab.log", "w")
     proc = subprocess.Popen(
-        [str(jupyter), "lab", "--no-browser", "--IdentityProvider.token=", "--expose-app-in-browser",
-         "--allow-root", f"--port={port}", "--ServerApp.ip=127.0.0.1", "--ServerApp.port_retries=0",
-         f"--ServerApp.root_dir={scratch}", "--LabApp.news_url=None",
-         "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate"],
-        stdout=log, stderr=subprocess.STDOUT, env=env, start_new_session=True)
+        [
+            str(jupyter),
+            "lab",
+            "--no-browser",
+            "--IdentityProvider.token=",
+            "--expose-app-in-browser",
+            "--allow-root",
+            f"--port={port}",
+            "--ServerApp.ip=127.0.0.1",
+            "--ServerApp.port_retries=0",
+            f"--ServerApp.root_dir={scratch}",
+            "--LabApp.news_url=None",
+            "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
+        ],
+        stdout=log,
+        stderr=subprocess.STDOUT,
+        env=env,
+        start_new_session=True,
+    )
     url = f"http://127.0.0.1:{port}"
     try:
         deadline = time.time() + 60
@@ -291,7 +332,7 @@ def lab(tmp_path_factory):
                 break
             except OSError:
                 if proc.poll() is not None or time.time() > deadline:
-                    raise RuntimeError("JupyterLab did not start:\n" + (work / "lab.log").read_text()[-3000:])
+                    raise RuntimeError("JupyterLab did not start:\n" + (work / "lab.log").read_text()[-3000:]) from None
                 time.sleep(0.3)
         yield url
     finally:
@@ -328,8 +369,12 @@ def test_lab_explorer_reaches_a_singular_configuration(browser, lab):
         page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
         page.wait_for_timeout(500)
         page.wait_for_function(_RUN_ALL_DONE, timeout=90000, polling=250)
-        assert page.locator(".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.stderr'] "
-                            ":text('Traceback')").count() == 0
+        assert (
+            page.locator(
+                ".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.stderr'] :text('Traceback')"
+            ).count()
+            == 0
+        )
         errors = page.locator(".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
         assert errors.count() == 0, "a cell raised: " + errors.first.inner_text()[:500]
 
@@ -354,9 +399,8 @@ def test_lab_explorer_reaches_a_singular_configuration(browser, lab):
             handle.press("ArrowLeft" if value > target else "ArrowRight")
         else:
             pytest.fail(f"the θ2 slider did not reach {target:.3f} (at {readout.inner_text()})")
-        page.wait_for_function("(el) => el.innerText.includes('SINGULAR')", arg=status.element_handle(),
-                               timeout=20000)
-        page.wait_for_timeout(500)                       # the last picture
+        page.wait_for_function("(el) => el.innerText.includes('SINGULAR')", arg=status.element_handle(), timeout=20000)
+        page.wait_for_timeout(500)  # the last picture
         after = picture.screenshot()
         assert after != before, "the explorer's picture did not change"
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)

@@ -7,6 +7,7 @@ prismatic joints and tilted, non-unit axes) are checked against modern_robotics 
 independently from the same URDF numbers with NumPy. No test asserts a wall-clock time: the guards
 are that a numeric call builds no symbolic matrix, and operation counts of the generated code.
 """
+
 from __future__ import annotations
 
 import ast
@@ -17,7 +18,8 @@ import mpmath
 import numpy as np
 import pytest
 import sympy as sp
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from kinlib import robots
 from kinlib.robots import from_urdf_joints
@@ -110,8 +112,12 @@ def test_urdf_arm_matches_modern_robotics(arm):
     want = {"fk": [], "jacobian_space": [], "jacobian_body": [], "jacobian_geometric": []}
     for q in Q:
         T, Jb = mr.FKinSpace(M, S, q), mr.JacobianBody(B, q)
-        for method, w in (("fk", T), ("jacobian_space", mr.JacobianSpace(S, q)), ("jacobian_body", Jb),
-                          ("jacobian_geometric", _geometric(T, Jb))):
+        for method, w in (
+            ("fk", T),
+            ("jacobian_space", mr.JacobianSpace(S, q)),
+            ("jacobian_body", Jb),
+            ("jacobian_geometric", _geometric(T, Jb)),
+        ):
             np.testing.assert_allclose(getattr(chain, method)(q), w, atol=1e-12, rtol=0, err_msg=f"{arm} {method}")
             want[method].append(w)
     for method, w in want.items():  # the batched code, made on the first batched call
@@ -197,7 +203,9 @@ def test_urdf_numbers_are_exact():
     assert list(one.M[:3, 3]) == [sp.Rational("0.0388353"), sp.Rational("-8.97657e-09"), sp.Rational("0.0624")]
     exact = from_urdf_joints([("revolute", (0, 0, 0), (sp.pi / 2, 0, 0), (0, 0, 1))])  # SymPy angle: exact
     assert exact.M[:3, :3] == sp.Matrix([[1, 0, 0], [0, 0, -1], [0, 1, 0]])
-    tilted = from_urdf_joints([("revolute", (0, 0, 0), (0, 0, 0), (1, 1, 0)), ("prismatic", (0, 0, 0), (0, 0, 0), (0, 2, 0))])
+    tilted = from_urdf_joints(
+        [("revolute", (0, 0, 0), (0, 0, 0), (1, 1, 0)), ("prismatic", (0, 0, 0), (0, 0, 0), (0, 2, 0))]
+    )
     assert list(tilted.screws[:, 0]) == [sp.sqrt(2) / 2, sp.sqrt(2) / 2, 0, 0, 0, 0]
     assert list(tilted.screws[:, 1]) == [0, 0, 0, 0, 1, 0]
     assert tilted.joint_types == "RP"
@@ -206,20 +214,23 @@ def test_urdf_numbers_are_exact():
     assert symbolic.params == (L,)
 
 
-@pytest.mark.parametrize("joints, tool, word", [
-    ("revolute", None, "joints"),
-    ([("revolute", (0, 0), (0, 0, 0), (0, 0, 1))], None, "xyz"),
-    ([("ball", (0, 0, 0), (0, 0, 0), (0, 0, 1))], None, "type"),
-    ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 0))], None, "axis"),
-    ([("revolute", (0, 0, 0), (0, 0, float("nan")), (0, 0, 1))], None, "rpy"),
-    ([("revolute", (0, 0, "1"), (0, 0, 0), (0, 0, 1))], None, "xyz"),
-    ([("revolute", (0, 0, 0), (0, 0, 0))], None, r"joints\[0\] must be \(type, xyz, rpy, axis\)"),
-    ([("fixed", (0, 0, 0), (0, 0, 0), None)], None, "at least one"),
-    ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1))], ((0, 0, 0),), "tool"),
-    ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1))], 5, "tool"),
-    ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1))], ((0, 0, 0), (0, 0)), "tool rpy"),
-    ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1j))], None, "axis"),
-])
+@pytest.mark.parametrize(
+    "joints, tool, word",
+    [
+        ("revolute", None, "joints"),
+        ([("revolute", (0, 0), (0, 0, 0), (0, 0, 1))], None, "xyz"),
+        ([("ball", (0, 0, 0), (0, 0, 0), (0, 0, 1))], None, "type"),
+        ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 0))], None, "axis"),
+        ([("revolute", (0, 0, 0), (0, 0, float("nan")), (0, 0, 1))], None, "rpy"),
+        ([("revolute", (0, 0, "1"), (0, 0, 0), (0, 0, 1))], None, "xyz"),
+        ([("revolute", (0, 0, 0), (0, 0, 0))], None, r"joints\[0\] must be \(type, xyz, rpy, axis\)"),
+        ([("fixed", (0, 0, 0), (0, 0, 0), None)], None, "at least one"),
+        ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1))], ((0, 0, 0),), "tool"),
+        ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1))], 5, "tool"),
+        ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1))], ((0, 0, 0), (0, 0)), "tool rpy"),
+        ([("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1j))], None, "axis"),
+    ],
+)
 def test_from_urdf_joints_refuses_bad_input(joints, tool, word):
     with pytest.raises((TypeError, ValueError), match=word):
         from_urdf_joints(joints, tool)
@@ -237,7 +248,8 @@ def test_tape_folds_constants():
 
 
 _LEAVES = st.sampled_from(["q0", "q1", "s0", "c0", "s1", "c1"]) | st.floats(-3, 3, allow_nan=False).map(
-    lambda v: round(v, 3))
+    lambda v: round(v, 3)
+)
 _EXPRS = st.recursive(_LEAVES, lambda kids: st.tuples(st.sampled_from("+-*"), kids, kids), max_leaves=12)
 
 
@@ -255,8 +267,14 @@ def test_tape_code_equals_direct_evaluation(exprs, q):
     """Whatever is recorded, the generated code (with and without cse) computes it (floats to rounding)."""
     tp = Tape(2)
     env = {"q0": tp.q(0), "q1": tp.q(1), "s0": tp.sin(0), "c0": tp.cos(0), "s1": tp.sin(1), "c1": tp.cos(1)}
-    direct = {"q0": q[0], "q1": q[1], "s0": math.sin(q[0]), "c0": math.cos(q[0]),
-              "s1": math.sin(q[1]), "c1": math.cos(q[1])}
+    direct = {
+        "q0": q[0],
+        "q1": q[1],
+        "s0": math.sin(q[0]),
+        "c0": math.cos(q[0]),
+        "s1": math.sin(q[1]),
+        "c1": math.cos(q[1]),
+    }
     rows = [[_run(e, env) for e in exprs]]
     want = np.array([[_run(e, direct) for e in exprs]])
     scale = 1 + np.abs(want)

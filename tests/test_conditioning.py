@@ -1,4 +1,5 @@
 """Symbolic condition number and isotropy (issue 11, item 5) against NumPy's SVD at random points."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -15,8 +16,11 @@ L1, L2 = sp.symbols("L1 L2", positive=True)
 
 
 def planar_2r():
-    return SerialChain(sp.Matrix([[1, 0, 0, L1 + L2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
-                       [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0]], name="2R")
+    return SerialChain(
+        sp.Matrix([[1, 0, 0, L1 + L2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+        [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0]],
+        name="2R",
+    )
 
 
 def np_cond(J):
@@ -77,9 +81,9 @@ def test_special_values():
     assert condition_number(D) == 2 and isotropy(D) == sp.Rational(1, 2)
     assert condition_number(sp.Matrix([[1, 1], [1, 1]])) == sp.oo and isotropy(sp.Matrix([[1, 1], [1, 1]])) == 0
     t = sp.Symbol("t", real=True)
-    R = sp.Matrix([[1, 0, 0], [0, sp.cos(t), -sp.sin(t)], [0, sp.sin(t), sp.cos(t)]])   # J Jᵀ = I for every t
+    R = sp.Matrix([[1, 0, 0], [0, sp.cos(t), -sp.sin(t)], [0, sp.sin(t), sp.cos(t)]])  # J Jᵀ = I for every t
     assert condition_number(R) == 1 and isotropy(R) == 1
-    assert condition_number(sp.Matrix([[sp.cos(t), sp.sin(t)]])) == 1                   # k = 1
+    assert condition_number(sp.Matrix([[sp.cos(t), sp.sin(t)]])) == 1  # k = 1
     # k = 2 with a circle everywhere: κ = 1 exactly
     assert condition_number(sp.Matrix([[sp.cos(t), -sp.sin(t)], [sp.sin(t), sp.cos(t)]])) == 1
 
@@ -95,13 +99,16 @@ def test_three_singular_values_with_free_joints_is_refused_with_the_numeric_alte
     assert np.isclose(float(condition_number(Jc)), np.linalg.cond(A), rtol=1e-10)
 
 
-@pytest.mark.parametrize("bad, exc", [
-    (np.array([[1.0, np.nan], [0.0, 1.0]]), ValueError),
-    (np.array([[1.0, np.inf], [0.0, 1.0]]), ValueError),
-    (np.array([[1.0, 1j], [0.0, 1.0]]), TypeError),
-    ([[1.0, "2"], [0.0, 1.0]], TypeError),
-    ([[True, False], [False, True]], TypeError),
-])
+@pytest.mark.parametrize(
+    "bad, exc",
+    [
+        (np.array([[1.0, np.nan], [0.0, 1.0]]), ValueError),
+        (np.array([[1.0, np.inf], [0.0, 1.0]]), ValueError),
+        (np.array([[1.0, 1j], [0.0, 1.0]]), TypeError),
+        ([[1.0, "2"], [0.0, 1.0]], TypeError),
+        ([[True, False], [False, True]], TypeError),
+    ],
+)
 def test_numeric_bad_input_refused(bad, exc):
     for f in (condition_number, isotropy):
         with pytest.raises(exc, match="J"):

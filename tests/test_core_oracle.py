@@ -5,6 +5,7 @@ random configurations, to 1e-9: exp6, FK (space and body forms), the space and b
 both through the free functions and through SerialChain's generated fast path (single and batched),
 and the UR5 of Modern Robotics Example 4.5 at the book's pose.
 """
+
 from __future__ import annotations
 
 import modern_robotics as mr
@@ -13,9 +14,8 @@ import pytest
 import sympy as sp
 
 import kinlib
-from kinlib import robots
-
 from helpers import random_arm, random_thetas
+from kinlib import robots
 
 TOL = 1e-9
 SEEDS = range(6)
@@ -43,8 +43,9 @@ def test_exp6_matches_mr(seed):
     np.testing.assert_allclose(kinlib.exp6(S, theta), expected, atol=TOL, rtol=0)
     # exp3 against mr.MatrixExp3 for the rotation part
     if kind == "R":
-        np.testing.assert_allclose(kinlib.exp3(S[:3], theta), mr.MatrixExp3(mr.VecToso3(S[:3] * theta)),
-                                   atol=TOL, rtol=0)
+        np.testing.assert_allclose(
+            kinlib.exp3(S[:3], theta), mr.MatrixExp3(mr.VecToso3(S[:3] * theta)), atol=TOL, rtol=0
+        )
 
 
 @pytest.mark.parametrize("n", NJOINTS)
@@ -87,10 +88,12 @@ def test_chain_fast_path_matches_mr(seed, n):
         T = mr.FKinSpace(M, S, th)
         Jb = mr.JacobianBody(B, th)
         Jg = np.vstack([T[:3, :3] @ Jb[:3], T[:3, :3] @ Jb[3:]])
-        for got_single, got_batch, want in [(chain.fk(th), fk[k], T),
-                                            (chain.jacobian_space(th), js[k], mr.JacobianSpace(S, th)),
-                                            (chain.jacobian_body(th), jb[k], Jb),
-                                            (chain.jacobian_geometric(th), jg[k], Jg)]:
+        for got_single, got_batch, want in [
+            (chain.fk(th), fk[k], T),
+            (chain.jacobian_space(th), js[k], mr.JacobianSpace(S, th)),
+            (chain.jacobian_body(th), jb[k], Jb),
+            (chain.jacobian_geometric(th), jg[k], Jg),
+        ]:
             assert isinstance(got_single, np.ndarray) and got_single.dtype == float
             np.testing.assert_allclose(got_single, want, atol=TOL, rtol=0)
             np.testing.assert_allclose(got_batch, want, atol=TOL, rtol=0)
@@ -132,9 +135,17 @@ def test_adjoint_trans_inv_match_mr(seed):
 # --------------------------------------------------------------------------------------------
 W1, W2, L1, L2, H1, H2 = 0.109, 0.082, 0.425, 0.392, 0.089, 0.095
 UR5_M = np.array([[-1, 0, 0, L1 + L2], [0, 0, 1, W1 + W2], [0, 1, 0, H1 - H2], [0, 0, 0, 1]], dtype=float)
-UR5_S = np.array([[0, 0, 1, 0, 0, 0], [0, 1, 0, -H1, 0, 0], [0, 1, 0, -H1, 0, L1],
-                  [0, 1, 0, -H1, 0, L1 + L2], [0, 0, -1, -W1, L1 + L2, 0], [0, 1, 0, H2 - H1, 0, L1 + L2]],
-                 dtype=float).T
+UR5_S = np.array(
+    [
+        [0, 0, 1, 0, 0, 0],
+        [0, 1, 0, -H1, 0, 0],
+        [0, 1, 0, -H1, 0, L1],
+        [0, 1, 0, -H1, 0, L1 + L2],
+        [0, 0, -1, -W1, L1 + L2, 0],
+        [0, 1, 0, H2 - H1, 0, L1 + L2],
+    ],
+    dtype=float,
+).T
 BOOK_POSE = [0, -np.pi / 2, 0, 0, np.pi / 2, 0]  # Example 4.5: θ2 = −π/2, θ5 = π/2, others 0
 BOOK_T = np.array([[0, -1, 0, 0.095], [1, 0, 0, 0.109], [0, 0, 1, 0.988], [0, 0, 0, 1]])
 
@@ -156,8 +167,14 @@ def test_ur5_book_pose(ur5):
     np.testing.assert_allclose(ur5.fk(BOOK_POSE), BOOK_T, atol=1e-12)
     np.testing.assert_allclose(kinlib.fk_space(UR5_M, UR5_S, BOOK_POSE), BOOK_T, atol=1e-12)
     exact = ur5.fk([0, -sp.pi / 2, 0, 0, sp.pi / 2, 0])
-    assert exact == sp.Matrix([[0, -1, 0, sp.Rational("0.095")], [1, 0, 0, sp.Rational("0.109")],
-                               [0, 0, 1, sp.Rational("0.988")], [0, 0, 0, 1]])
+    assert exact == sp.Matrix(
+        [
+            [0, -1, 0, sp.Rational("0.095")],
+            [1, 0, 0, sp.Rational("0.109")],
+            [0, 0, 1, sp.Rational("0.988")],
+            [0, 0, 0, 1],
+        ]
+    )
 
 
 @pytest.mark.parametrize("pose", [BOOK_POSE, [0.3, -1.1, 0.7, 0.2, 1.4, -0.5], [0.0] * 6])
@@ -181,8 +198,9 @@ def test_ur5_exact_jacobian_at_book_pose_matches_mr(ur5):
     q = [0, -sp.pi / 2, 0, 0, sp.pi / 2, 0]
     Js = ur5.jacobian_space(q)
     assert isinstance(Js, sp.MatrixBase) and not Js.atoms(sp.Float)
-    np.testing.assert_allclose(np.array(Js.evalf(), dtype=float), mr.JacobianSpace(UR5_S, BOOK_POSE),
-                               atol=1e-12, rtol=0)
+    np.testing.assert_allclose(
+        np.array(Js.evalf(), dtype=float), mr.JacobianSpace(UR5_S, BOOK_POSE), atol=1e-12, rtol=0
+    )
 
 
 def test_ur5_symbolic_lengths_screws_from_axes():

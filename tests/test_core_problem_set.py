@@ -12,15 +12,15 @@ while doing so (the computation wins):
   (L2 + θ3)²; it is (L2 + θ3)² + 1, since column 1 of J also has ω_z = 1.
 Apart from those, every printed closed form of sections 2 and 3 and eq. (33) agrees with the computation.
 """
+
 from __future__ import annotations
 
 import pytest
 import sympy as sp
 
 import kinlib
-from kinlib import robots
-
 from helpers import assert_no_floats, assert_sym_equal
+from kinlib import robots
 
 sin, cos, sqrt, pi = sp.sin, sp.cos, sp.sqrt, sp.pi
 
@@ -54,8 +54,12 @@ def test_cart_pole_chain_matches_eq5():
     assert_sym_equal(J[3:5, :], sp.Matrix([[1, -L * sin(t2)], [0, L * cos(t2)]]), "cart-pole ṗ_x, ṗ_y rows")
     # the other rows: ω_s = [0, 0, θ̇2], ṗ_z = 0
     assert_sym_equal(J[[0, 1, 2, 5], :], sp.Matrix([[0, 0], [0, 0], [0, 1], [0, 0]]), "cart-pole other rows")
-    # and the same through the free function on the chain's M and screws
-    assert_sym_equal(kinlib.geometric_jacobian(r.M, r.screws, list(r.thetas)), J, "geometric_jacobian(M, S, θ)")
+    # and the same through the free function on the cart-pole's M and screws typed by hand (prismatic along x,
+    # revolute about z through (0, h)), against eq. (5) and the rows ω_z = θ̇2 (not the chain's own output)
+    M = sp.Matrix([[1, 0, 0, L], [0, 1, 0, h], [0, 0, 1, 0], [0, 0, 0, 1]])
+    S = sp.Matrix([[0, 0, 0, 1, 0, 0], [0, 0, 1, h, 0, 0]]).T
+    J5 = sp.Matrix([[0, 0], [0, 0], [0, 1], [1, -L * sin(t2)], [0, L * cos(t2)], [0, 0]])
+    assert_sym_equal(kinlib.geometric_jacobian(M, S, list(r.thetas)), J5, "geometric_jacobian(M, S, θ), eq. (5)")
     # position_jacobian of the chain's own p(θ) equals the geometric rows
     assert_sym_equal(kinlib.position_jacobian(T[:2, 3], list(r.thetas)), J[3:5, :], "∂p/∂θ of the chain")
 
@@ -77,25 +81,44 @@ def _sec2_printed(t1, t2, t3):
     a = t1 + t2 + pi / 4
     M = sp.Matrix([[1, 0, 0, 3 * L], [0, 1, 0, L], [0, 0, 1, 0], [0, 0, 0, 1]])  # (14)
     S = sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0], [0, 0, 1, L, -2 * L, 0]]).T  # (16)
-    T = sp.Matrix([  # (17)
-        [c123, -s123, 0, L * c123 + L * c1 + L * sqrt(2) * cos(a)],
-        [s123, c123, 0, L * s123 + L * s1 + L * sqrt(2) * sin(a)],
-        [0, 0, 1, 0], [0, 0, 0, 1]])
-    Js = sp.Matrix([  # (18), 6×3 (the transcription prints 4 entries in rows 1-3)
-        [0, 0, 0], [0, 0, 0], [1, 1, 1],
-        [0, L * s1, L * s1 + L * sqrt(2) * sin(a)],
-        [0, -L * c1, -L * c1 - L * sqrt(2) * cos(a)],
-        [0, 0, 0]])
-    Jb = sp.Matrix([  # (20)
-        [0, 0, 0], [0, 0, 0], [1, 1, 1],
-        [L * sin(t2 + t3) - L * sqrt(2) * cos(t3 + pi / 4), -L * sqrt(2) * cos(t3 + pi / 4), 0],
-        [L * cos(t2 + t3) + L * sqrt(2) * sin(t3 + pi / 4) + L, L * sqrt(2) * sin(t3 + pi / 4) + L, L],
-        [0, 0, 0]])
-    J = sp.Matrix([  # 2.4
-        [0, 0, 0], [0, 0, 0], [1, 1, 1],
-        [-L * s123 - L * s1 - L * sqrt(2) * sin(a), -L * s123 - L * sqrt(2) * sin(a), -L * s123],
-        [L * c123 + L * c1 + L * sqrt(2) * cos(a), L * c123 + L * sqrt(2) * cos(a), L * c123],
-        [0, 0, 0]])
+    T = sp.Matrix(
+        [  # (17)
+            [c123, -s123, 0, L * c123 + L * c1 + L * sqrt(2) * cos(a)],
+            [s123, c123, 0, L * s123 + L * s1 + L * sqrt(2) * sin(a)],
+            [0, 0, 1, 0],
+            [0, 0, 0, 1],
+        ]
+    )
+    Js = sp.Matrix(
+        [  # (18), 6×3 (the transcription prints 4 entries in rows 1-3)
+            [0, 0, 0],
+            [0, 0, 0],
+            [1, 1, 1],
+            [0, L * s1, L * s1 + L * sqrt(2) * sin(a)],
+            [0, -L * c1, -L * c1 - L * sqrt(2) * cos(a)],
+            [0, 0, 0],
+        ]
+    )
+    Jb = sp.Matrix(
+        [  # (20)
+            [0, 0, 0],
+            [0, 0, 0],
+            [1, 1, 1],
+            [L * sin(t2 + t3) - L * sqrt(2) * cos(t3 + pi / 4), -L * sqrt(2) * cos(t3 + pi / 4), 0],
+            [L * cos(t2 + t3) + L * sqrt(2) * sin(t3 + pi / 4) + L, L * sqrt(2) * sin(t3 + pi / 4) + L, L],
+            [0, 0, 0],
+        ]
+    )
+    J = sp.Matrix(
+        [  # 2.4
+            [0, 0, 0],
+            [0, 0, 0],
+            [1, 1, 1],
+            [-L * s123 - L * s1 - L * sqrt(2) * sin(a), -L * s123 - L * sqrt(2) * sin(a), -L * s123],
+            [L * c123 + L * c1 + L * sqrt(2) * cos(a), L * c123 + L * sqrt(2) * cos(a), L * c123],
+            [0, 0, 0],
+        ]
+    )
     return M, S, T, Js, Jb, J
 
 
@@ -143,8 +166,9 @@ def test_section2_free_functions(planar):
 def test_section2_at_problem_5_3_configuration(planar):
     """Eq. (47): J_s at θ = (π/4, −π/4, π/4), exactly (rows ω_z, v_x, v_y)."""
     Js = planar.jacobian_space([pi / 4, -pi / 4, pi / 4])
-    expected = sp.Matrix([[1, 1, 1], [0, sqrt(2) * L / 2, L * (sqrt(2) + 2) / 2],
-                          [0, -sqrt(2) * L / 2, -L * (sqrt(2) + 2) / 2]])
+    expected = sp.Matrix(
+        [[1, 1, 1], [0, sqrt(2) * L / 2, L * (sqrt(2) + 2) / 2], [0, -sqrt(2) * L / 2, -L * (sqrt(2) + 2) / 2]]
+    )
     assert_sym_equal(Js[[2, 3, 4], :], expected, "eq. (47)")
     assert_no_floats(Js, "J_s at an exact configuration")
 
@@ -165,20 +189,44 @@ def _sec3_printed(t1, t2, t3, t4):
     H = L1 + L2
     M = sp.Matrix([[1, 0, 0, L2], [0, 1, 0, 0], [0, 0, 1, H], [0, 0, 0, 1]])  # (22)
     S = sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 1], [0, 0, 0, 1, 0, 0], [1, 0, 0, 0, H, 0]]).T  # (23)-(26)
-    T = sp.Matrix([  # (27)
-        [c1, -c4 * s1, s1 * s4, (L2 + t3) * c1],
-        [s1, c1 * c4, -c1 * s4, (L2 + t3) * s1],
-        [0, s4, c4, H + t2],
-        [0, 0, 0, 1]])
-    Js = sp.Matrix([  # (28)
-        [0, 0, 0, c1], [0, 0, 0, s1], [1, 0, 0, 0],
-        [0, 0, c1, -(H + t2) * s1], [0, 0, s1, (H + t2) * c1], [0, 1, 0, 0]])
-    Jb = sp.Matrix([  # (30)
-        [0, 0, 0, 1], [s4, 0, 0, 0], [c4, 0, 0, 0], [0, 0, 1, 0],
-        [(L2 + t3) * c4, s4, 0, 0], [-(L2 + t3) * s4, c4, 0, 0]])
-    J = sp.Matrix([  # (32)
-        [0, 0, 0, c1], [0, 0, 0, s1], [1, 0, 0, 0],
-        [-(L2 + t3) * s1, 0, c1, 0], [(L2 + t3) * c1, 0, s1, 0], [0, 1, 0, 0]])
+    T = sp.Matrix(
+        [  # (27)
+            [c1, -c4 * s1, s1 * s4, (L2 + t3) * c1],
+            [s1, c1 * c4, -c1 * s4, (L2 + t3) * s1],
+            [0, s4, c4, H + t2],
+            [0, 0, 0, 1],
+        ]
+    )
+    Js = sp.Matrix(
+        [  # (28)
+            [0, 0, 0, c1],
+            [0, 0, 0, s1],
+            [1, 0, 0, 0],
+            [0, 0, c1, -(H + t2) * s1],
+            [0, 0, s1, (H + t2) * c1],
+            [0, 1, 0, 0],
+        ]
+    )
+    Jb = sp.Matrix(
+        [  # (30)
+            [0, 0, 0, 1],
+            [s4, 0, 0, 0],
+            [c4, 0, 0, 0],
+            [0, 0, 1, 0],
+            [(L2 + t3) * c4, s4, 0, 0],
+            [-(L2 + t3) * s4, c4, 0, 0],
+        ]
+    )
+    J = sp.Matrix(
+        [  # (32)
+            [0, 0, 0, c1],
+            [0, 0, 0, s1],
+            [1, 0, 0, 0],
+            [-(L2 + t3) * s1, 0, c1, 0],
+            [(L2 + t3) * c1, 0, s1, 0],
+            [0, 1, 0, 0],
+        ]
+    )
     return M, S, T, Js, Jb, J
 
 
@@ -239,11 +287,16 @@ def test_section4_geometric_jacobian_eq33():
     s1, c1 = sin(t1), cos(t1)
     s12, c12 = sin(t1 + t2), cos(t1 + t2)
     s123, c123 = sin(t1 + t2 + t3), cos(t1 + t2 + t3)
-    J33 = sp.Matrix([
-        [0, 0, 0], [0, 0, 0], [1, 1, 1],
-        [-l3 * s123 - l2 * s12 - l1 * s1, -l3 * s123 - l2 * s12, -l3 * s123],
-        [l3 * c123 + l2 * c12 + l1 * c1, l3 * c123 + l2 * c12, l3 * c123],
-        [0, 0, 0]])
+    J33 = sp.Matrix(
+        [
+            [0, 0, 0],
+            [0, 0, 0],
+            [1, 1, 1],
+            [-l3 * s123 - l2 * s12 - l1 * s1, -l3 * s123 - l2 * s12, -l3 * s123],
+            [l3 * c123 + l2 * c12 + l1 * c1, l3 * c123 + l2 * c12, l3 * c123],
+            [0, 0, 0],
+        ]
+    )
     assert_sym_equal(r.jacobian_geometric(), J33, "eq. (33)")
     assert_sym_equal(kinlib.geometric_jacobian(r.M, r.screws, [t1, t2, t3]), J33, "eq. (33), free function")
     # and the tool position it differentiates
@@ -251,12 +304,15 @@ def test_section4_geometric_jacobian_eq33():
     assert_sym_equal(r.fk()[:3, 3], p, "planar 3R p(θ)")
 
 
-@pytest.mark.parametrize("theta, row, coeffs", [
-    # eqs. (39)-(41) with L1 = L2 = L3 = 1, the printed two-to-three-digit values
-    ([-pi / 8, pi / 4, pi / 8], 3, [-0.707, -1.09, -0.707]),
-    ([3 * pi / 4, -pi / 4, 0], 3, [-2.707, -2, -1]),
-    ([pi / 2, -pi / 8, -pi / 2], 4, [1.31, 1.31, 0.92]),
-])
+@pytest.mark.parametrize(
+    "theta, row, coeffs",
+    [
+        # eqs. (39)-(41) with L1 = L2 = L3 = 1, the printed two-to-three-digit values
+        ([-pi / 8, pi / 4, pi / 8], 3, [-0.707, -1.09, -0.707]),
+        ([3 * pi / 4, -pi / 4, 0], 3, [-2.707, -2, -1]),
+        ([pi / 2, -pi / 8, -pi / 2], 4, [1.31, 1.31, 0.92]),
+    ],
+)
 def test_section4_rates_eqs_39_41(theta, row, coeffs):
     J = robots.planar_3r(1, 1, 1).jacobian_geometric(theta)
     got = [float(v) for v in J[row, :]]
@@ -277,6 +333,7 @@ def test_planar_rpp_eq54():
 # --------------------------------------------------------------------------------------------
 def test_assert_sym_equal_helper():
     from helpers import _is_zero_exact
+
     a, b = sp.symbols("a b", real=True)
     assert _is_zero_exact(sin(a + b) - sin(a) * cos(b) - cos(a) * sin(b))
     assert _is_zero_exact(sin(a) ** 2 + cos(a) ** 2 - 1)

@@ -3,8 +3,10 @@
 Each property is checked against an independent computation: np.linalg.inv, np.cross, the group
 laws of SE(3), the book's identity T[S]T⁻¹ = [Ad_T S] (problem 1.2's hint).
 """
+
 from __future__ import annotations
 
+import modern_robotics as mr
 import numpy as np
 import pytest
 import sympy as sp
@@ -12,7 +14,6 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import kinlib
-
 from helpers import FAST, assert_no_floats, assert_sym_equal, random_arm, random_transform
 
 seeds = st.integers(min_value=0, max_value=2**32 - 1)
@@ -28,8 +29,12 @@ def _screw(seed, kind):
 
 def _is_se3(T, tol=TOL):
     R = T[:3, :3]
-    return (T.shape == (4, 4) and np.allclose(R.T @ R, np.eye(3), atol=tol) and abs(np.linalg.det(R) - 1) < tol
-            and np.array_equal(T[3], [0, 0, 0, 1]))
+    return (
+        T.shape == (4, 4)
+        and np.allclose(R.T @ R, np.eye(3), atol=tol)
+        and abs(np.linalg.det(R) - 1) < tol
+        and np.array_equal(T[3], [0, 0, 0, 1])
+    )
 
 
 @FAST
@@ -156,22 +161,35 @@ def test_exp6_symbolic_is_exact_and_matches_rodrigues():
     R = sp.simplify((W * th).exp())
     assert_sym_equal(T[:3, :3], R, "exp6 rotation vs Matrix.exp")
     assert_sym_equal(T[:3, 3], (sp.eye(3) - R) * q, "exp6 translation")
-    # at a number it equals the numeric backend
-    np.testing.assert_allclose(np.array(T.subs(th, 0.7), dtype=float),
-                               kinlib.exp6(np.array(S, dtype=float).ravel(), 0.7), atol=1e-12)
+    # at a number it equals modern_robotics' MatrixExp6 of the screw typed from ω and q
+    S_typed = np.concatenate(
+        [
+            np.array(w, dtype=float).ravel(),
+            -np.cross(np.array(w, dtype=float).ravel(), np.array(q, dtype=float).ravel()),
+        ]
+    )
+    np.testing.assert_allclose(
+        np.array(T.subs(th, 0.7), dtype=float), mr.MatrixExp6(mr.VecTose3(S_typed * 0.7)), atol=1e-12
+    )
 
 
 def test_symbolic_rigid_functions_exact():
     a = sp.Symbol("a", real=True)
     T = kinlib.exp6(sp.Matrix([0, 0, 1, 0, -1, 0]), a)
-    for name, X in [("trans_inv", kinlib.trans_inv(T)), ("adjoint", kinlib.adjoint(T)),
-                    ("exp3", kinlib.exp3(sp.Matrix([0, 1, 0]), sp.pi / 3)), ("skew", kinlib.skew(sp.Matrix([1, a, 2])))]:
+    for name, X in [
+        ("trans_inv", kinlib.trans_inv(T)),
+        ("adjoint", kinlib.adjoint(T)),
+        ("exp3", kinlib.exp3(sp.Matrix([0, 1, 0]), sp.pi / 3)),
+        ("skew", kinlib.skew(sp.Matrix([1, a, 2]))),
+    ]:
         assert isinstance(X, sp.MatrixBase), name
         assert_no_floats(X, name)
     assert_sym_equal(kinlib.trans_inv(T) * T, sp.eye(4), "trans_inv(T) T = I, symbolic")
-    assert_sym_equal(kinlib.exp3(sp.Matrix([0, 1, 0]), sp.pi / 3),
-                     sp.Matrix([[sp.Rational(1, 2), 0, sp.sqrt(3) / 2], [0, 1, 0], [-sp.sqrt(3) / 2, 0, sp.Rational(1, 2)]]),
-                     "exp3 about y by π/3")
+    assert_sym_equal(
+        kinlib.exp3(sp.Matrix([0, 1, 0]), sp.pi / 3),
+        sp.Matrix([[sp.Rational(1, 2), 0, sp.sqrt(3) / 2], [0, 1, 0], [-sp.sqrt(3) / 2, 0, sp.Rational(1, 2)]]),
+        "exp3 about y by π/3",
+    )
 
 
 def test_numeric_inputs_give_float_arrays():

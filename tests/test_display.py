@@ -1,4 +1,5 @@
 """simplify_for_display: exactly equal to its input, shorter, and in the textbook's angle-sum form."""
+
 import random
 
 import numpy as np
@@ -24,8 +25,10 @@ def _random_subs(chain, seed):
     return subs
 
 
-@pytest.mark.parametrize("make", [robots.planar_offset_3r, robots.spatial_rppr, robots.cart_pole,
-                                  robots.planar_3r, robots.planar_rpp, robots.ur5])
+@pytest.mark.parametrize(
+    "make",
+    [robots.planar_offset_3r, robots.spatial_rppr, robots.cart_pole, robots.planar_3r, robots.planar_rpp, robots.ur5],
+)
 @pytest.mark.parametrize("what", ["fk", "jacobian_space", "jacobian_body", "jacobian_geometric"])
 def test_equal_to_input(make, what):
     chain = make()
@@ -89,11 +92,11 @@ def test_phase_shifts_printed_form():
     assert sp.expand(D[0, 3] - L * (sp.cos(t1 + t2 + t3) + sp.cos(t1) + sp.sqrt(2) * sp.cos(t1 + t2 + sp.pi / 4))) == 0
     assert is_identically_zero(D - T)
     Jb = simplify_for_display(chain.jacobian_body(), phase_shifts=True)
-    assert Jb[3, 1] == -sp.sqrt(2) * L * sp.cos(t3 + sp.pi / 4)                 # eq. (20)
+    assert Jb[3, 1] == -sp.sqrt(2) * L * sp.cos(t3 + sp.pi / 4)  # eq. (20)
     for seed in range(2):
         s = _random_subs(chain, seed)
         assert np.allclose(_num(Jb, s), _num(chain.jacobian_body(), s), atol=1e-12, rtol=0)
-    assert not simplify_for_display(T).has(sp.sqrt(2))                        # default: no phase shifts
+    assert not simplify_for_display(T).has(sp.sqrt(2))  # default: no phase shifts
 
 
 # ------------------------------------------------------------------------------------------------
@@ -102,50 +105,60 @@ def test_phase_shifts_printed_form():
 x, y, z = sp.symbols("x y z", real=True)
 
 
-@pytest.mark.parametrize("expr", [
-    sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1,
-    sp.sin(x + y) - sp.sin(x) * sp.cos(y) - sp.cos(x) * sp.sin(y),
-    sp.cos(2 * x) - sp.cos(x) ** 4 + sp.sin(x) ** 4,
-    sp.sin(x) ** 2 - sp.sin(x) ** 4 - sp.sin(x) ** 2 * sp.cos(x) ** 2,
-    sp.sqrt(2) * sp.cos(x + sp.pi / 4) - sp.cos(x) + sp.sin(x),
-    1 / (z * (z + 1)) - 1 / z + 1 / (z + 1),
-    sp.tan(x) - sp.sin(x) / sp.cos(x),
-    sp.Integer(0),
-])
+@pytest.mark.parametrize(
+    "expr",
+    [
+        sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1,
+        sp.sin(x + y) - sp.sin(x) * sp.cos(y) - sp.cos(x) * sp.sin(y),
+        sp.cos(2 * x) - sp.cos(x) ** 4 + sp.sin(x) ** 4,
+        sp.sin(x) ** 2 - sp.sin(x) ** 4 - sp.sin(x) ** 2 * sp.cos(x) ** 2,
+        sp.sqrt(2) * sp.cos(x + sp.pi / 4) - sp.cos(x) + sp.sin(x),
+        1 / (z * (z + 1)) - 1 / z + 1 / (z + 1),
+        sp.tan(x) - sp.sin(x) / sp.cos(x),
+        sp.Integer(0),
+    ],
+)
 def test_identities_are_zero(expr):
     assert is_identically_zero(expr) is True
 
 
-@pytest.mark.parametrize("expr", [
-    sp.sin(x),
-    sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1 + sp.Rational(1, 10**12),   # numerically ~0, exactly not
-    sp.sin(x + y) - sp.sin(x) * sp.cos(y) + sp.cos(x) * sp.sin(y),
-    sp.sqrt(2) * sp.cos(x + sp.pi / 4) - sp.cos(x) - sp.sin(x),
-    z * sp.sin(x) ** 2 + z * sp.cos(x) ** 2,
-    sp.Integer(3),
-])
+@pytest.mark.parametrize(
+    "expr",
+    [
+        sp.sin(x),
+        sp.sin(x) ** 2 + sp.cos(x) ** 2 - 1 + sp.Rational(1, 10**12),  # numerically ~0, exactly not
+        sp.sin(x + y) - sp.sin(x) * sp.cos(y) + sp.cos(x) * sp.sin(y),
+        sp.sqrt(2) * sp.cos(x + sp.pi / 4) - sp.cos(x) - sp.sin(x),
+        z * sp.sin(x) ** 2 + z * sp.cos(x) ** 2,
+        sp.Integer(3),
+    ],
+)
 def test_nonzero_is_not_zero(expr):
     assert is_identically_zero(expr) is False
     # independent: the expression is nonzero at some point (exact rational evaluation, 50 digits)
-    vals = [sp.N(expr.subs({x: sp.Rational(a, 7), y: sp.Rational(b, 5), z: sp.Rational(3, 2)}), 50)
-            for a, b in [(1, 2), (3, -4), (-5, 1), (2, 9)]]
+    vals = [
+        sp.N(expr.subs({x: sp.Rational(a, 7), y: sp.Rational(b, 5), z: sp.Rational(3, 2)}), 50)
+        for a, b in [(1, 2), (3, -4), (-5, 1), (2, 9)]
+    ]
     assert any(abs(v) > 1e-40 for v in vals)
 
 
 def test_body_jacobian_is_adjoint_of_space_jacobian():
     """J_b = Ad_{T⁻¹} J_s exactly, for the symbolic robots (the difference is a large trig polynomial)."""
     import kinlib
+
     for chain in (robots.planar_offset_3r(), robots.spatial_rppr(), robots.ur5()):
         Js, Jb, T = chain.jacobian_space(), chain.jacobian_body(), chain.fk()
         gap = Jb - kinlib.adjoint(kinlib.trans_inv(T)) * Js
-        assert not all(e == 0 for e in gap)       # not trivially zero as written
+        assert not all(e == 0 for e in gap)  # not trivially zero as written
         assert is_identically_zero(gap)
-        assert not is_identically_zero(Jb - Js)   # J_b ≠ J_s: the test does not say yes to everything
+        assert not is_identically_zero(Jb - Js)  # J_b ≠ J_s: the test does not say yes to everything
 
 
 def test_time_functions_and_derivatives():
     """The 1.2 derivation: θ_i(t) and θ̇_i are variables too (chain rule for e^{[S]θ(t)})."""
     import kinlib
+
     t = sp.Symbol("t", real=True)
     q = sp.Function("theta1", real=True)(t)
     S = kinlib.screw_revolute(sp.Matrix([0, 1, 0]), sp.Matrix([1, 0, 2]))
@@ -159,7 +172,7 @@ def test_agrees_with_simplify_on_random_trig_polynomials():
     atoms = [sp.sin(x), sp.cos(x), sp.sin(y), sp.cos(y), z]
     for _ in range(25):
         e = sum(rng.randint(-2, 2) * sp.Mul(*rng.choices(atoms, k=rng.randint(0, 3))) for _ in range(4))
-        ident = e * (sp.sin(x) ** 2 + sp.cos(x) ** 2) - e          # ≡ 0
+        ident = e * (sp.sin(x) ** 2 + sp.cos(x) ** 2) - e  # ≡ 0
         assert is_identically_zero(ident)
         assert is_identically_zero(e) == (sp.simplify(e) == 0)
 
@@ -191,19 +204,25 @@ def _values_at(e, seed):
 
 def test_normal_form_is_canonical_reduced_and_equal_to_the_input():
     from kinlib.trigpoly import TrigRing
+
     a = sp.sin(x) ** 3 * sp.cos(y) + z * sp.cos(x + y) + sp.cos(2 * x)
-    b = (sp.sin(x) * (1 - sp.cos(x) ** 2) * sp.cos(y) + z * (sp.cos(x) * sp.cos(y) - sp.sin(x) * sp.sin(y))
-         + 2 * sp.cos(x) ** 2 - 1)                                   # the same function, written differently
+    b = (
+        sp.sin(x) * (1 - sp.cos(x) ** 2) * sp.cos(y)
+        + z * (sp.cos(x) * sp.cos(y) - sp.sin(x) * sp.sin(y))
+        + 2 * sp.cos(x) ** 2
+        - 1
+    )  # the same function, written differently
     R = TrigRing([a, b])
-    assert R.normal_form(a) == R.normal_form(b)                      # canonical
+    assert R.normal_form(a) == R.normal_form(b)  # canonical
     e = R.to_expr(R.normal_form(a))
     assert sp.Poly(e, sp.sin(x), sp.sin(y)).degree_list() <= (1, 1)  # degree ≤ 1 in every sine
-    for seed in range(3):                                            # independent: exact rational points
+    for seed in range(3):  # independent: exact rational points
         assert abs(_values_at(e - a, seed)) < 1e-25
 
 
 def test_normal_form_collects_and_has_two_modes():
     from kinlib.trigpoly import NotTrigPolynomial, TrigRing
+
     L = sp.Symbol("L", positive=True)
     e = L * sp.cos(x) + y * sp.cos(x) - z * sp.sin(x) ** 3 - z * sp.sin(x) * sp.cos(x) ** 2
     R = TrigRing([e])
@@ -218,5 +237,5 @@ def test_normal_form_collects_and_has_two_modes():
     R = TrigRing([f], opaque=True)
     out = R.to_expr(R.normal_form(f))
     assert out.has(sp.Float) and sp.nsimplify(out) == sp.sqrt(L) + sp.sin(x) / 2
-    with pytest.raises(NotTrigPolynomial):                           # sin inside a root: not a polynomial
+    with pytest.raises(NotTrigPolynomial):  # sin inside a root: not a polynomial
         TrigRing([sp.sqrt(sp.sin(x))], opaque=True)

@@ -4,8 +4,8 @@ against an independent 60-digit oracle (tests/exact_oracle.py: the product of ex
 Arms are random (revolute and prismatic, 2–6 joints, exact unit axes, numeric or symbolic lengths);
 configurations are rationals, integers, rational multiples of π, mixtures, and points on singular families.
 """
-from __future__ import annotations
 
+from __future__ import annotations
 
 import mpmath
 import pytest
@@ -16,8 +16,14 @@ from hypothesis import strategies as st
 import exact_oracle as O
 from kinlib import SerialChain, robots
 from kinlib.exact import (
-    ConditionalResultWarning, NumericFallbackWarning, Rank, column_space, evaluate_at, exact_is_zero,
-    left_null_space, rank_at,
+    ConditionalResultWarning,
+    NumericFallbackWarning,
+    Rank,
+    column_space,
+    evaluate_at,
+    exact_is_zero,
+    left_null_space,
+    rank_at,
 )
 from kinlib.singularities import task_rows
 
@@ -25,8 +31,16 @@ R = sp.Rational
 pi = sp.pi
 
 # exact unit vectors with small rational entries (so the chains stay exact)
-UNITS = [(1, 0, 0), (0, 1, 0), (0, 0, 1), (0, 0, -1), (R(3, 5), R(4, 5), 0), (0, R(3, 5), R(-4, 5)),
-         (R(2, 3), R(2, 3), R(1, 3)), (R(-4, 5), 0, R(3, 5))]
+UNITS = [
+    (1, 0, 0),
+    (0, 1, 0),
+    (0, 0, 1),
+    (0, 0, -1),
+    (R(3, 5), R(4, 5), 0),
+    (0, R(3, 5), R(-4, 5)),
+    (R(2, 3), R(2, 3), R(1, 3)),
+    (R(-4, 5), 0, R(3, 5)),
+]
 SETTINGS = dict(deadline=None, derandomize=True, suppress_health_check=[HealthCheck.too_slow])
 
 
@@ -54,11 +68,11 @@ def arms(draw, n_min=2, n_max=5):
 
 
 angle = st.one_of(
-    st.integers(-12, 12).map(sp.Integer),                                     # 10, -3, 0
-    st.tuples(st.integers(-9, 9), st.integers(1, 4)).map(lambda a: R(*a)),    # 1/2, -7/3
+    st.integers(-12, 12).map(sp.Integer),  # 10, -3, 0
+    st.tuples(st.integers(-9, 9), st.integers(1, 4)).map(lambda a: R(*a)),  # 1/2, -7/3
     st.tuples(st.integers(-8, 8), st.sampled_from([1, 2, 3, 4, 6])).map(lambda a: R(*a) * pi),  # kπ/6
-    st.tuples(st.integers(-3, 3), st.integers(-4, 4)).map(lambda a: a[0] + R(a[1], 4) * pi),    # 2 + π/2
-    st.sampled_from([sp.Integer(0), pi, -pi, pi / 2]),                        # the classic singular values
+    st.tuples(st.integers(-3, 3), st.integers(-4, 4)).map(lambda a: a[0] + R(a[1], 4) * pi),  # 2 + π/2
+    st.sampled_from([sp.Integer(0), pi, -pi, pi / 2]),  # the classic singular values
 )
 slide = st.tuples(st.integers(-6, 6), st.integers(1, 3)).map(lambda a: R(*a))
 
@@ -90,8 +104,10 @@ def test_rank_at_planar_rows_of_random_planar_arms(data):
     """Planar arms with task rows (ω_z, v_x, v_y) at rationals, integers and π multiples, and at stretched poses."""
     n = data.draw(st.integers(2, 4))
     kinds = "".join(data.draw(st.lists(st.sampled_from("RRRP"), min_size=n, max_size=n)))
-    axes = [(0, 0, 1) if k == "R" else data.draw(st.sampled_from([(1, 0, 0), (0, 1, 0), (R(3, 5), R(4, 5), 0)]))
-            for k in kinds]
+    axes = [
+        (0, 0, 1) if k == "R" else data.draw(st.sampled_from([(1, 0, 0), (0, 1, 0), (R(3, 5), R(4, 5), 0)]))
+        for k in kinds
+    ]
     points = [(data.draw(coord), data.draw(coord), 0) for _ in kinds]
     chain = chain_from(kinds, axes, points, (data.draw(coord), data.draw(coord), 0))
     q = config(data.draw, chain)
@@ -110,7 +126,7 @@ def _projector(B):
     if B.cols == 0:
         return mpmath.zeros(B.rows, B.rows)
     Q, _ = mpmath.qr(B)
-    Q = Q[:, :B.cols]
+    Q = Q[:, : B.cols]
     return Q * Q.T
 
 
@@ -148,16 +164,17 @@ def test_issue_reproductions_planar_2r():
     ch = SerialChain(M, [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -1, 0]])
     t1, t2 = ch.thetas
     J = task_rows(ch.jacobian_geometric(), ["vx", "vy"])
-    assert rank_at(J, {t1: 10, t2: 0}) == 1                  # stretched out at θ1 = 10
-    assert rank_at(J, {t1: R(1, 2), t2: R(1, 2)}) == 2       # was truncated to (0, 0)
+    assert rank_at(J, {t1: 10, t2: 0}) == 1  # stretched out at θ1 = 10
+    assert rank_at(J, {t1: R(1, 2), t2: R(1, 2)}) == 2  # was truncated to (0, 0)
     from fractions import Fraction
+
     assert rank_at(J, {t1: Fraction(1, 2), t2: Fraction(1, 2)}) == 2
     # floats select the numeric backend (no truncation either)
     r = rank_at(J, {t1: 0.5, t2: 0.5})
     assert r == 2 and not isinstance(r, Rank)
     N = left_null_space(J, {t1: 3, t2: 0})
     assert N.shape == (2, 1) and N[0] == 1
-    assert exact_is_zero(N[1] - sp.sin(3) / sp.cos(3))      # the radial direction (cos 3, sin 3)
+    assert exact_is_zero(N[1] - sp.sin(3) / sp.cos(3))  # the radial direction (cos 3, sin 3)
     C = column_space(J, {t1: 3, t2: 0})
     assert C.shape == (2, 1) and exact_is_zero(C[1] + sp.cos(3) / sp.sin(3))
     # evaluate_at keeps exact values (no "nice" guesses): sin 3 stays sin 3
@@ -177,7 +194,7 @@ def test_issue_reproduction_elbow_with_symbolic_lengths():
     L1, L2, H = sp.symbols("L1 L2 H", positive=True)
     ch = elbow_3r(L1, L2, H)
     Jp = task_rows(ch.jacobian_geometric(), "linear")
-    r = rank_at(Jp, (2, 1, 0), ch.thetas)                    # elbow stretched: rank 2 for all lengths
+    r = rank_at(Jp, (2, 1, 0), ch.thetas)  # elbow stretched: rank 2 for all lengths
     assert r == 2 and r.exact and not r.unless
     r3 = rank_at(Jp, (2, 1, 1), ch.thetas)
     assert r3 == 3
@@ -209,18 +226,22 @@ def _geometric_mp(chain, q):
 def test_symbolic_lengths_conditions_are_stated():
     L1, L2 = sp.symbols("L1 L2", positive=True)
     t1, t2 = sp.symbols("theta1 theta2", real=True)
-    J = sp.Matrix([[-L1 * sp.sin(t1) - L2 * sp.sin(t1 + t2), -L2 * sp.sin(t1 + t2)],
-                   [L1 * sp.cos(t1) + L2 * sp.cos(t1 + t2), L2 * sp.cos(t1 + t2)]])
-    assert rank_at(J, {t1: 2, t2: 1}).unless == ()           # L1 L2 sin 1 ≠ 0 for all positive lengths
-    folded = rank_at(J, {t1: 2, t2: pi})                     # folded back: rank 1 for all lengths (column 2)
+    J = sp.Matrix(
+        [
+            [-L1 * sp.sin(t1) - L2 * sp.sin(t1 + t2), -L2 * sp.sin(t1 + t2)],
+            [L1 * sp.cos(t1) + L2 * sp.cos(t1 + t2), L2 * sp.cos(t1 + t2)],
+        ]
+    )
+    assert rank_at(J, {t1: 2, t2: 1}).unless == ()  # L1 L2 sin 1 ≠ 0 for all positive lengths
+    folded = rank_at(J, {t1: 2, t2: pi})  # folded back: rank 1 for all lengths (column 2)
     assert folded == 1 and folded.unless == ()
     # a rank that does depend on the lengths: J = [[L1 − L2, L1 − L2]] (and the tool of a folded 2R, ṗ_x row only)
     D = sp.Matrix([[L1 - L2, 2 * (L1 - L2)], [0, 0]])
     r = rank_at(D)
     assert r == 1 and len(r.unless) == 1 and sp.expand(r.unless[0] ** 2 - (L1 - L2) ** 2) == 0
     assert "assuming" in repr(r)
-    assert rank_at(D.subs({L1: 1, L2: 1})) == 0               # and at L1 = L2 it is lower indeed
-    Jx = sp.Matrix([[J[0, 0]]])                              # ṗ_x of the first joint alone at θ = (2, π)
+    assert rank_at(D.subs({L1: 1, L2: 1})) == 0  # and at L1 = L2 it is lower indeed
+    Jx = sp.Matrix([[J[0, 0]]])  # ṗ_x of the first joint alone at θ = (2, π)
     rx = rank_at(Jx, {t1: 2, t2: pi})
     assert rx == 1 and rx.unless and rank_at(Jx.subs({L1: 1, L2: 1}), {t1: 2, t2: pi}) == 0
     with pytest.warns(ConditionalResultWarning):
@@ -241,8 +262,7 @@ def test_fallback_is_stated_and_agrees_with_the_oracle():
         assert O.max_abs(Jm.T * O.to_mp(N)) < mpmath.mpf(10) ** -25
     # symbolic lengths cannot go numeric: a clear error
     with pytest.raises(ValueError, match="substitute them"):
-        rank_at(task_rows(robots.planar_3r().jacobian_space(), "planar"), (sp.sqrt(2), 0, 1),
-                robots.planar_3r().thetas)
+        rank_at(task_rows(robots.planar_3r().jacobian_space(), "planar"), (sp.sqrt(2), 0, 1), robots.planar_3r().thetas)
 
 
 def test_far_apart_angles_on_a_6_joint_arm_fall_back_and_say_so():
@@ -257,8 +277,16 @@ def test_far_apart_angles_on_a_6_joint_arm_fall_back_and_say_so():
     assert r2 == 6 and r2.exact
 
 
-STANFORD = sp.Matrix([[0, 0, 1, 0, 0, 0], [1, 0, 0, 0, 1, 0], [0, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0],
-                      [1, 0, 0, 0, 1, 0], [0, 1, 0, -1, 0, 0]]).T
+STANFORD = sp.Matrix(
+    [
+        [0, 0, 1, 0, 0, 0],
+        [1, 0, 0, 0, 1, 0],
+        [0, 0, 0, 0, 1, 0],
+        [0, 1, 0, -1, 0, 0],
+        [1, 0, 0, 0, 1, 0],
+        [0, 1, 0, -1, 0, 0],
+    ]
+).T
 
 
 @pytest.mark.parametrize("q", [(1, 2, 3, 4, 5, 6), (1, 2, R(1, 3), 4, 0, 6), (2, -1, 3, 1, pi / 2, 10)])
@@ -273,7 +301,7 @@ def test_six_joint_arms_at_integer_angles(q):
         assert rank_at(Js, q, chain.thetas) == want
         assert left_null_space(Js, q, chain.thetas).shape == (6, 6 - want)
     u = robots.ur5()
-    assert rank_at(u.jacobian_geometric(), (R(1, 2), 10, 0, 1, 3, 2), u.thetas) == 5   # elbow: θ3 = 0
+    assert rank_at(u.jacobian_geometric(), (R(1, 2), 10, 0, 1, 3, 2), u.thetas) == 5  # elbow: θ3 = 0
 
 
 def test_exact_is_zero_identities_and_refusals():
@@ -281,28 +309,40 @@ def test_exact_is_zero_identities_and_refusals():
     assert exact_is_zero(sp.cos(R(1, 3)) ** 2 + sp.sin(R(1, 3)) ** 2 - 1)
     assert exact_is_zero(sp.sin(3 + pi / 2) - sp.cos(3))
     assert exact_is_zero(sp.sin(pi / 7) - sp.cos(5 * pi / 14))
-    assert not exact_is_zero(sp.sin(1) - R(841470984807896507, 10 ** 18))   # agrees to 18 digits, not equal
-    assert not exact_is_zero(sp.sin(R(1, 2)) * sp.sin(10) - sp.sin(R(21, 2)) + 10 ** -30)
+    assert not exact_is_zero(sp.sin(1) - R(841470984807896507, 10**18))  # agrees to 18 digits, not equal
+    assert not exact_is_zero(sp.sin(R(1, 2)) * sp.sin(10) - sp.sin(R(21, 2)) + 10**-30)
     with pytest.raises(ValueError, match="no exact zero test"):
         exact_is_zero(sp.sin(sp.sqrt(2)))
 
 
-@pytest.mark.parametrize("bad, exc, words", [
-    ({"theta1": 0}, TypeError, "keys must be SymPy symbols"),
-    (3, TypeError, "mapping"),
-    ({0: 1}, TypeError, "keys must be SymPy symbols"),
-])
+@pytest.mark.parametrize(
+    "bad, exc, words",
+    [
+        ({"theta1": 0}, TypeError, "keys must be SymPy symbols"),
+        (3, TypeError, "mapping"),
+        ({0: 1}, TypeError, "keys must be SymPy symbols"),
+    ],
+)
 def test_bad_subs(bad, exc, words):
     t1 = sp.Symbol("theta1", real=True)
     with pytest.raises(exc, match=words):
         rank_at(sp.Matrix([[sp.sin(t1)]]), bad)
 
 
-@pytest.mark.parametrize("value, exc, words", [
-    (1j, TypeError, "complex"), (sp.I, ValueError, "real and finite"), ("1.5", TypeError, "string"),
-    (True, TypeError, "bool"), (None, TypeError, "None"), (float("nan"), ValueError, "finite"),
-    (float("inf"), ValueError, "finite"), (sp.oo, ValueError, "finite"), (sp.Symbol("z"), ValueError, "real"),
-])
+@pytest.mark.parametrize(
+    "value, exc, words",
+    [
+        (1j, TypeError, "complex"),
+        (sp.I, ValueError, "real and finite"),
+        ("1.5", TypeError, "string"),
+        (True, TypeError, "bool"),
+        (None, TypeError, "None"),
+        (float("nan"), ValueError, "finite"),
+        (float("inf"), ValueError, "finite"),
+        (sp.oo, ValueError, "finite"),
+        (sp.Symbol("z"), ValueError, "real"),
+    ],
+)
 def test_bad_joint_values(value, exc, words):
     t1 = sp.Symbol("theta1", real=True)
     J = sp.Matrix([[sp.sin(t1), 1]])
@@ -311,11 +351,17 @@ def test_bad_joint_values(value, exc, words):
             f(J, {t1: value})
 
 
-@pytest.mark.parametrize("J, exc, words", [
-    ([[1, float("nan")]], ValueError, "finite"), ([[1, 1j]], TypeError, "complex"),
-    ("J", TypeError, "J must be a matrix"), ([[True, 1]], TypeError, "bool"), ([1, 2], ValueError, "matrix"),
-    (sp.Matrix([[sp.nan]]), ValueError, "finite"),
-])
+@pytest.mark.parametrize(
+    "J, exc, words",
+    [
+        ([[1, float("nan")]], ValueError, "finite"),
+        ([[1, 1j]], TypeError, "complex"),
+        ("J", TypeError, "J must be a matrix"),
+        ([[True, 1]], TypeError, "bool"),
+        ([1, 2], ValueError, "matrix"),
+        (sp.Matrix([[sp.nan]]), ValueError, "finite"),
+    ],
+)
 def test_bad_jacobians(J, exc, words):
     with pytest.raises(exc, match=words):
         rank_at(J)

@@ -10,14 +10,16 @@ the argument; it must never return (no NaN, no value derived from the real part 
 Every valid call is also made once, so a corruption that is refused is refused for being bad, not because
 the base call was already broken.
 """
+
 from __future__ import annotations
 
 import copy
 import importlib
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 import pytest
@@ -29,13 +31,28 @@ import kinlib
 from kinlib import robots
 
 # --- bad values ----------------------------------------------------------------------------------------
-X_PLAIN = sp.Symbol("x")                    # not declared real
-Z_COMPLEX = sp.Symbol("z", complex=True)    # declared complex
-BAD_PY = [1 + 2j, np.complex128(0.5j), 2j, "1.5", "a", "", True, False, np.True_, None,
-          math.nan, math.inf, -math.inf, np.float64("nan"), np.float32("inf")]
+X_PLAIN = sp.Symbol("x")  # not declared real
+Z_COMPLEX = sp.Symbol("z", complex=True)  # declared complex
+BAD_PY = [
+    1 + 2j,
+    np.complex128(0.5j),
+    2j,
+    "1.5",
+    "a",
+    "",
+    True,
+    False,
+    np.True_,
+    None,
+    math.nan,
+    math.inf,
+    -math.inf,
+    np.float64("nan"),
+    np.float32("inf"),
+]
 BAD_SYM = [sp.I, 1 + 2 * sp.I, sp.nan, sp.oo, -sp.oo, sp.zoo, X_PLAIN, Z_COMPLEX, sp.sqrt(-2), sp.sin(X_PLAIN)]
 BAD_SCALARS = BAD_PY + BAD_SYM
-BAD_WHOLE = [None, "abc", "1.5", True, 1j, sp.I, math.nan, 3.5, sp.Symbol("t", real=True)]   # for matrices/vectors
+BAD_WHOLE = [None, "abc", "1.5", True, 1j, sp.I, math.nan, 3.5, sp.Symbol("t", real=True)]  # for matrices/vectors
 
 t1, t2, t3 = sp.symbols("theta1:4", real=True)
 L = sp.Symbol("L", positive=True)
@@ -44,26 +61,30 @@ L = sp.Symbol("L", positive=True)
 @dataclass
 class Arg:
     """One argument: its name (as the messages say it), a valid value, wrong shapes, whole-value replacements."""
+
     name: str
     value: Any
-    shapes: list = field(default_factory=list)   # values of the wrong shape/length
-    whole: list | None = None                     # whole-argument bad values (default BAD_WHOLE)
-    entries: bool = True                          # corrupt single entries (containers, scalars)
-    msg: str | None = None                        # the name the message must contain (default: name)
-    ok: tuple = ()                                # bad scalars that are valid here (None as a default ...)
+    shapes: list = field(default_factory=list)  # values of the wrong shape/length
+    whole: list | None = None  # whole-argument bad values (default BAD_WHOLE)
+    entries: bool = True  # corrupt single entries (containers, scalars)
+    msg: str | None = None  # the name the message must contain (default: name)
+    ok: tuple = ()  # bad scalars that are valid here (None as a default ...)
 
     def __post_init__(self):
-        if self.whole is None:                    # whole-value replacements: scalars get them as entries
-            self.whole = [] if not isinstance(self.value, (list, tuple, np.ndarray, sp.MatrixBase, dict)) \
+        if self.whole is None:  # whole-value replacements: scalars get them as entries
+            self.whole = (
+                []
+                if not isinstance(self.value, (list, tuple, np.ndarray, sp.MatrixBase, dict))
                 else [w for w in BAD_WHOLE if not any(w is o for o in self.ok)]
+            )
 
 
 @dataclass
 class Case:
     label: str
-    fn: Callable | tuple                          # a callable, or (module, name) looked up at test time
+    fn: Callable | tuple  # a callable, or (module, name) looked up at test time
     args: list
-    kw: tuple = ()                                # names of the args passed by keyword (in order of args)
+    kw: tuple = ()  # names of the args passed by keyword (in order of args)
 
 
 def _resolve(fn):
@@ -112,7 +133,7 @@ def _set(v, path, bad):
         rows[head[0]][head[1]] = bad
         if isinstance(bad, sp.Expr):
             return sp.Matrix(rows)
-        return rows                               # a nested list holding the bad entry as it is (str, None, ...)
+        return rows  # a nested list holding the bad entry as it is (str, None, ...)
     if isinstance(v, np.ndarray):
         if isinstance(bad, (float, np.floating)) and v.dtype.kind == "f":
             out = v.copy()
@@ -154,7 +175,7 @@ def corrupted(draw, case: Case):
 
 # --- valid arguments ----------------------------------------------------------------------------------------
 Z = [0, 0, 1, 0, 0, 0]
-S2 = np.array([Z, [0, 0, 1, 0, -1, 0]], dtype=float).T          # planar 2R, unit links
+S2 = np.array([Z, [0, 0, 1, 0, -1, 0]], dtype=float).T  # planar 2R, unit links
 S2_SYM = sp.Matrix(S2.astype(int))
 M2 = np.eye(4)
 M2[0, 3] = 2.0
@@ -163,8 +184,9 @@ T_NUM = kinlib.fk_space(M2, S2, [0.3, -0.4])
 T_SYM = sp.Matrix([[0, -1, 0, 1], [1, 0, 0, 1], [0, 0, 1, 0], [0, 0, 0, 1]])
 J_NUM = kinlib.jacobian_space(S2, [0.3, -0.4])
 J_SYM = sp.Matrix(S2_SYM)
-J_TRIG = sp.Matrix([[-sp.sin(t1) - sp.sin(t1 + t2), -sp.sin(t1 + t2)],
-                    [sp.cos(t1) + sp.cos(t1 + t2), sp.cos(t1 + t2)]])  # planar 2R, rows ṗx, ṗy
+J_TRIG = sp.Matrix(
+    [[-sp.sin(t1) - sp.sin(t1 + t2), -sp.sin(t1 + t2)], [sp.cos(t1) + sp.cos(t1 + t2), sp.cos(t1 + t2)]]
+)  # planar 2R, rows ṗx, ṗy
 J2 = np.array([[1.0, 0.5], [0.2, 2.0]])
 J2_SYM = sp.Matrix([[1, sp.Rational(1, 2)], [sp.Rational(1, 5), 2]])
 
@@ -173,12 +195,12 @@ MAT44 = [np.eye(3), np.eye(5), np.zeros(4), [[1, 0, 0, 0]] * 3]
 VEC3 = [[0, 0], [0, 0, 1, 0], np.zeros((3, 2)), []]
 VEC6 = [[0, 0, 1, 0, 0], Z + [0], np.zeros((6, 2)), []]
 SCREWS = [np.zeros((5, 2)), [Z, [0, 0, 1, 0, -1]], [Z[:5]], [], np.zeros((6, 2, 1))]
-TH2 = [[0.1], [0.1, 0.2, 0.3], [[0.1, 0.2]] * 2, []]          # [2] is a valid batch for rates, twists, wrenches
+TH2 = [[0.1], [0.1, 0.2, 0.3], [[0.1, 0.2]] * 2, []]  # [2] is a valid batch for rates, twists, wrenches
 TH2_SYM = [[t1], [t1, t2, t3], []]
 JMAT = [np.zeros((2, 2, 2, 2)), np.zeros(3), [[1.0, 2.0], [3.0]], []]
 
 CHAIN = kinlib.SerialChain(M2, S2, name="planar_2r")
-CHAIN.jacobian_space(np.array([0.1, 0.2]))                       # code generated: the fast path is fuzzed too
+CHAIN.jacobian_space(np.array([0.1, 0.2]))  # code generated: the fast path is fuzzed too
 for _m in ("fk", "jacobian_body", "jacobian_geometric", "skeleton"):
     getattr(CHAIN, _m)(np.array([0.1, 0.2]))
 PCHAIN = robots.planar_offset_3r()
@@ -199,10 +221,16 @@ CASES = [
     # --- rigid ---------------------------------------------------------------------------------------------
     Case("skew", kinlib.skew, [A("w", [0.1, 0.2, 0.3], VEC3, ok=GENERIC_OK)]),
     Case("skew (sym)", kinlib.skew, [A("w", sp.Matrix([t1, 0, 1]), VEC3, ok=GENERIC_OK)]),
-    Case("unskew", kinlib.unskew, [A("W", kinlib.skew([0.1, 0.2, 0.3]), [np.zeros((2, 2)), np.zeros(3)], ok=GENERIC_OK)]),
+    Case(
+        "unskew", kinlib.unskew, [A("W", kinlib.skew([0.1, 0.2, 0.3]), [np.zeros((2, 2)), np.zeros(3)], ok=GENERIC_OK)]
+    ),
     Case("exp3", kinlib.exp3, [A("omega", [0, 0, 1.0], VEC3, ok=GENERIC_OK), A("theta", 0.3)]),
     Case("exp3 (sym)", kinlib.exp3, [A("omega", sp.Matrix([0, 0, 1]), VEC3, ok=GENERIC_OK), A("theta", t1)]),
-    Case("rp_to_trans", kinlib.rp_to_trans, [A("R", np.eye(3), [np.eye(4), np.zeros(3)], ok=GENERIC_OK), A("p", [1.0, 2, 3], VEC3, ok=GENERIC_OK)]),
+    Case(
+        "rp_to_trans",
+        kinlib.rp_to_trans,
+        [A("R", np.eye(3), [np.eye(4), np.zeros(3)], ok=GENERIC_OK), A("p", [1.0, 2, 3], VEC3, ok=GENERIC_OK)],
+    ),
     Case("trans_to_rp", kinlib.trans_to_rp, [A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
     Case("trans_inv", kinlib.trans_inv, [A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
     Case("trans_inv (sym)", kinlib.trans_inv, [A("T", T_SYM, MAT44, ok=GENERIC_OK)]),
@@ -212,8 +240,11 @@ CASES = [
     Case("check_se3", kinlib.check_se3, [A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
     # --- screws --------------------------------------------------------------------------------------------
     Case("screw_revolute", kinlib.screw_revolute, [A("omega", [0, 0, 1.0], VEC3), A("q", [1.0, 0, 0], VEC3)]),
-    Case("screw_revolute (sym)", kinlib.screw_revolute,
-         [A("omega", sp.Matrix([0, 0, 1]), VEC3), A("q", sp.Matrix([L, 0, 0]), VEC3)]),
+    Case(
+        "screw_revolute (sym)",
+        kinlib.screw_revolute,
+        [A("omega", sp.Matrix([0, 0, 1]), VEC3), A("q", sp.Matrix([L, 0, 0]), VEC3)],
+    ),
     Case("screw_prismatic", kinlib.screw_prismatic, [A("v", [1.0, 0, 0], VEC3)]),
     Case("screw_axis", kinlib.screw_axis, [A("q", [0, 1.0, 0], VEC3), A("s", [0, 0, 1.0], VEC3), A("h", 0.5)]),
     Case("bracket", kinlib.bracket, [A("V", [0.1, 0.2, 0.3, 1, 2, 3], VEC6, ok=GENERIC_OK)]),
@@ -226,86 +257,231 @@ CASES = [
     Case("jacobian_space", kinlib.jacobian_space, [A("Slist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)]),
     Case("jacobian_space (sym)", kinlib.jacobian_space, [A("Slist", S2_SYM, SCREWS), A("thetas", [t1, t2], TH2_SYM)]),
     Case("jacobian_body", kinlib.jacobian_body, [A("Blist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)]),
-    Case("geometric_jacobian", kinlib.geometric_jacobian,
-         [A("M", M2, MAT44), A("Slist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)]),
-    Case("space_to_body", kinlib.space_to_body, [A("Js", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
-    Case("space_to_body (sym)", kinlib.space_to_body, [A("Js", J_SYM, MAT6, ok=GENERIC_OK), A("T", T_SYM, MAT44, ok=GENERIC_OK)]),
-    Case("body_to_space", kinlib.body_to_space, [A("Jb", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
-    Case("body_to_geometric", kinlib.body_to_geometric, [A("Jb", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44[1:], ok=GENERIC_OK)]),
-    Case("geometric_to_body", kinlib.geometric_to_body, [A("J", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44[1:], ok=GENERIC_OK)]),
-    Case("space_to_geometric", kinlib.space_to_geometric, [A("Js", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
-    Case("geometric_to_space", kinlib.geometric_to_space, [A("J", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)]),
+    Case(
+        "geometric_jacobian",
+        kinlib.geometric_jacobian,
+        [A("M", M2, MAT44), A("Slist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)],
+    ),
+    Case(
+        "space_to_body",
+        kinlib.space_to_body,
+        [A("Js", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)],
+    ),
+    Case(
+        "space_to_body (sym)",
+        kinlib.space_to_body,
+        [A("Js", J_SYM, MAT6, ok=GENERIC_OK), A("T", T_SYM, MAT44, ok=GENERIC_OK)],
+    ),
+    Case(
+        "body_to_space",
+        kinlib.body_to_space,
+        [A("Jb", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)],
+    ),
+    Case(
+        "body_to_geometric",
+        kinlib.body_to_geometric,
+        [A("Jb", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44[1:], ok=GENERIC_OK)],
+    ),
+    Case(
+        "geometric_to_body",
+        kinlib.geometric_to_body,
+        [A("J", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44[1:], ok=GENERIC_OK)],
+    ),
+    Case(
+        "space_to_geometric",
+        kinlib.space_to_geometric,
+        [A("Js", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)],
+    ),
+    Case(
+        "geometric_to_space",
+        kinlib.geometric_to_space,
+        [A("J", J_NUM, MAT6, ok=GENERIC_OK), A("T", T_NUM, MAT44, ok=GENERIC_OK)],
+    ),
     Case("linear_first", kinlib.linear_first, [A("J", J_NUM, MAT6[:1] + MAT6[2:], ok=GENERIC_OK)]),
     Case("angular_first", kinlib.angular_first, [A("J", J_NUM, MAT6[:1] + MAT6[2:], ok=GENERIC_OK)]),
-    Case("position_jacobian", kinlib.position_jacobian,
-         [A("p", [t1 + L * sp.cos(t2), L * sp.sin(t2)], [[], "p"], ok=GENERIC_OK), A("thetas", [t1, t2], [[], [t1, t1]],
-                                                                   whole=[None, "ab", 3, True, [X_PLAIN, t2], [1.0, 2.0]])]),
+    Case(
+        "position_jacobian",
+        kinlib.position_jacobian,
+        [
+            A("p", [t1 + L * sp.cos(t2), L * sp.sin(t2)], [[], "p"], ok=GENERIC_OK),
+            A("thetas", [t1, t2], [[], [t1, t1]], whole=[None, "ab", 3, True, [X_PLAIN, t2], [1.0, 2.0]]),
+        ],
+    ),
     # --- chains ----------------------------------------------------------------------------------------------
     Case("fk_space", kinlib.fk_space, [A("M", M2, MAT44), A("Slist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)]),
-    Case("fk_space (sym)", kinlib.fk_space,
-         [A("M", M2_SYM, MAT44), A("Slist", S2_SYM, SCREWS), A("thetas", [t1, t2], TH2_SYM)]),
+    Case(
+        "fk_space (sym)",
+        kinlib.fk_space,
+        [A("M", M2_SYM, MAT44), A("Slist", S2_SYM, SCREWS), A("thetas", [t1, t2], TH2_SYM)],
+    ),
     Case("fk_body", kinlib.fk_body, [A("M", M2, MAT44), A("Blist", S2, SCREWS), A("thetas", [0.3, -0.4], TH2)]),
-    Case("SerialChain", kinlib.SerialChain,
-         [A("M", M2, MAT44), A("screws", [Z, [0, 0, 1, 0, -1, 0]], SCREWS),
-          A("thetas", (t1, t2), [(t1,), (t1, t2, t3), (t1, t1)], whole=[X_PLAIN, "ab", 3, True, [1.0, 2.0],
-                                                                         [X_PLAIN, t2], [t1, Z_COMPLEX]],
-            entries=False),
-          A("joint_points", [[0, 0, 0], [1.0, 0, 0]], [[[0, 0], [1, 0]], np.zeros((3, 3)), [[0, 0, 0]]],
-            whole=["abc", True, 1j, math.nan, 3.5]),
-          A("name", "arm", whole=[None, 3, True, ["a"]], entries=False)],
-         kw=("thetas", "joint_points", "name")),
+    Case(
+        "SerialChain",
+        kinlib.SerialChain,
+        [
+            A("M", M2, MAT44),
+            A("screws", [Z, [0, 0, 1, 0, -1, 0]], SCREWS),
+            A(
+                "thetas",
+                (t1, t2),
+                [(t1,), (t1, t2, t3), (t1, t1)],
+                whole=[X_PLAIN, "ab", 3, True, [1.0, 2.0], [X_PLAIN, t2], [t1, Z_COMPLEX]],
+                entries=False,
+            ),
+            A(
+                "joint_points",
+                [[0, 0, 0], [1.0, 0, 0]],
+                [[[0, 0], [1, 0]], np.zeros((3, 3)), [[0, 0, 0]]],
+                whole=["abc", True, 1j, math.nan, 3.5],
+            ),
+            A("name", "arm", whole=[None, 3, True, ["a"]], entries=False),
+        ],
+        kw=("thetas", "joint_points", "name"),
+    ),
     Case("SerialChain (sym)", kinlib.SerialChain, [A("M", M2_SYM, MAT44), A("screws", S2_SYM, SCREWS)]),
     Case("SerialChain.subs", lambda L: PCHAIN.subs(L=L), [A("L", 0.5, whole=[], msg="L")]),
-    *[Case(f"SerialChain.{m}", (lambda m: lambda q: getattr(CHAIN, m)(q))(m), [A("q", np.array([0.3, -0.4]), Q2, ok=(None,))])
-      for m in ("fk", "jacobian_space", "jacobian_body", "jacobian_geometric", "skeleton")],
+    *[
+        Case(
+            f"SerialChain.{m}",
+            (lambda m: lambda q: getattr(CHAIN, m)(q))(m),  # noqa: B023 (bound by the outer lambda)
+            [A("q", np.array([0.3, -0.4]), Q2, ok=(None,))],
+        )
+        for m in ("fk", "jacobian_space", "jacobian_body", "jacobian_geometric", "skeleton")
+    ],
     Case("SerialChain.fk (list)", lambda q: CHAIN.fk(q), [A("q", [0.3, -0.4], Q2, ok=(None,))]),
-    Case("SerialChain.jacobian_space (batch)", lambda q: CHAIN.jacobian_space(q),
-         [A("q", np.array([[0.3, -0.4], [1.0, 2.0], [0.0, 0.5]]), [np.zeros((3, 3))], ok=(None,))]),
-    Case("SerialChain.jacobian_body (sym q)", lambda q: CHAIN.jacobian_body(q), [A("q", [sp.pi / 4, t2], Q2, ok=(None,))]),
-    Case("SerialChain.fk (sym chain)", lambda q: PCHAIN.fk(q), [A("q", [sp.pi, 0, sp.Rational(1, 2)], Q2[:1], ok=(None,))]),
+    Case(
+        "SerialChain.jacobian_space (batch)",
+        lambda q: CHAIN.jacobian_space(q),
+        [A("q", np.array([[0.3, -0.4], [1.0, 2.0], [0.0, 0.5]]), [np.zeros((3, 3))], ok=(None,))],
+    ),
+    Case(
+        "SerialChain.jacobian_body (sym q)", lambda q: CHAIN.jacobian_body(q), [A("q", [sp.pi / 4, t2], Q2, ok=(None,))]
+    ),
+    Case(
+        "SerialChain.fk (sym chain)",
+        lambda q: PCHAIN.fk(q),
+        [A("q", [sp.pi, 0, sp.Rational(1, 2)], Q2[:1], ok=(None,))],
+    ),
     # --- robots ----------------------------------------------------------------------------------------------
-    Case("robots.length", robots.length, [A("L", 0.5, whole=[], ok=(None,)), A("name", "L", whole=[None, 3, True], entries=False)]),
+    Case(
+        "robots.length",
+        robots.length,
+        [A("L", 0.5, whole=[], ok=(None,)), A("name", "L", whole=[None, 3, True], entries=False)],
+    ),
     Case("robots.cart_pole", robots.cart_pole, [A("L", 1.0, whole=[], ok=(None,)), A("h", 0.5, whole=[], ok=(None,))]),
     Case("robots.planar_offset_3r", robots.planar_offset_3r, [A("L", 2, whole=[], ok=(None,))]),
-    Case("robots.spatial_rppr", robots.spatial_rppr, [A("L1", 1, whole=[], ok=(None,)), A("L2", 0.25, whole=[], ok=(None,))]),
-    Case("robots.planar_3r", robots.planar_3r, [A("L1", 1, whole=[], ok=(None,)), A("L2", 1, whole=[], ok=(None,)), A("L3", L, whole=[], ok=(None,))]),
+    Case(
+        "robots.spatial_rppr",
+        robots.spatial_rppr,
+        [A("L1", 1, whole=[], ok=(None,)), A("L2", 0.25, whole=[], ok=(None,))],
+    ),
+    Case(
+        "robots.planar_3r",
+        robots.planar_3r,
+        [A("L1", 1, whole=[], ok=(None,)), A("L2", 1, whole=[], ok=(None,)), A("L3", L, whole=[], ok=(None,))],
+    ),
     Case("robots.planar_rpp", robots.planar_rpp, [A("L", 0.1, whole=[], ok=(None,))]),
-    Case("robots.ur5", robots.ur5, [A("W1", 0.109, whole=[], ok=(None,)), A("L2", L, whole=[], ok=(None,))], kw=("W1", "L2")),
+    Case(
+        "robots.ur5",
+        robots.ur5,
+        [A("W1", 0.109, whole=[], ok=(None,)), A("L2", L, whole=[], ok=(None,))],
+        kw=("W1", "L2"),
+    ),
     # --- display ---------------------------------------------------------------------------------------------
-    Case("simplify_for_display", kinlib.simplify_for_display,
-         [A("M", sp.Matrix([[sp.sin(t1) ** 2 + sp.cos(t1) ** 2, 0.5]]), whole=[None, "abc", True, 1j, sp.I, math.nan],
-           ok=DISPLAY_OK)]),
-    Case("is_identically_zero", kinlib.is_identically_zero,
-         [A("M", sp.Matrix([[sp.sin(t1) ** 2 + sp.cos(t1) ** 2 - 1, 0]]), whole=[None, "abc", True, 1j, sp.I, math.nan],
-           ok=DISPLAY_OK)]),
+    Case(
+        "simplify_for_display",
+        kinlib.simplify_for_display,
+        [
+            A(
+                "M",
+                sp.Matrix([[sp.sin(t1) ** 2 + sp.cos(t1) ** 2, 0.5]]),
+                whole=[None, "abc", True, 1j, sp.I, math.nan],
+                ok=DISPLAY_OK,
+            )
+        ],
+    ),
+    Case(
+        "is_identically_zero",
+        kinlib.is_identically_zero,
+        [
+            A(
+                "M",
+                sp.Matrix([[sp.sin(t1) ** 2 + sp.cos(t1) ** 2 - 1, 0]]),
+                whole=[None, "abc", True, 1j, sp.I, math.nan],
+                ok=DISPLAY_OK,
+            )
+        ],
+    ),
     # --- singularities (owned by items 1–2) ------------------------------------------------------------------
-    Case("task_rows", ("kinlib.singularities", "task_rows"), [A("J", J_NUM, [np.zeros((2, 2, 2)), np.zeros(6)], ok=GENERIC_OK),
-          A("rows", ["vx", "vy"], [[], ["vx", "qq"], [7]], whole=[None, "abc", True, 1j, 3.5])]),
-    Case("singular_configurations", ("kinlib.singularities", "singular_configurations"),
-         [A("J", J_TRIG, JMAT[:2]), A("thetas", [t1, t2], [[t1], [t1, t2, t3], [t1, t1]], entries=False,
-                                      whole=[None, "ab", 3, [X_PLAIN, t2], [t1, Z_COMPLEX], [1.0, 2.0]])]),
+    Case(
+        "task_rows",
+        ("kinlib.singularities", "task_rows"),
+        [
+            A("J", J_NUM, [np.zeros((2, 2, 2)), np.zeros(6)], ok=GENERIC_OK),
+            A("rows", ["vx", "vy"], [[], ["vx", "qq"], [7]], whole=[None, "abc", True, 1j, 3.5]),
+        ],
+    ),
+    Case(
+        "singular_configurations",
+        ("kinlib.singularities", "singular_configurations"),
+        [
+            A("J", J_TRIG, JMAT[:2]),
+            A(
+                "thetas",
+                [t1, t2],
+                [[t1], [t1, t2, t3], [t1, t1]],
+                entries=False,
+                whole=[None, "ab", 3, [X_PLAIN, t2], [t1, Z_COMPLEX], [1.0, 2.0]],
+            ),
+        ],
+    ),
     Case("rank_at (numeric)", ("kinlib.singularities", "rank_at"), [A("J", J2, JMAT)]),
-    Case("rank_at", ("kinlib.singularities", "rank_at"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5, [1.0]], entries=False)]),
-    Case("rank_at (values)", lambda q: _resolve(("kinlib.singularities", "rank_at"))(J_TRIG, {t1: q[0], t2: q[1]}),
-         [A("subs", [sp.Rational(1, 2), 0], whole=[])]),
-    Case("column_space", ("kinlib.singularities", "column_space"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)]),
-    Case("left_null_space", ("kinlib.singularities", "left_null_space"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)]),
-    Case("left_null_space (values)",
-         lambda q: _resolve(("kinlib.singularities", "left_null_space"))(J_TRIG, {t1: q[0], t2: q[1]}),
-         [A("subs", [3, 0], whole=[])]),
-    Case("evaluate_at", ("kinlib.singularities", "evaluate_at"),
-         [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)]),
+    Case(
+        "rank_at",
+        ("kinlib.singularities", "rank_at"),
+        [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5, [1.0]], entries=False)],
+    ),
+    Case(
+        "rank_at (values)",
+        lambda q: _resolve(("kinlib.singularities", "rank_at"))(J_TRIG, {t1: q[0], t2: q[1]}),
+        [A("subs", [sp.Rational(1, 2), 0], whole=[])],
+    ),
+    Case(
+        "column_space",
+        ("kinlib.singularities", "column_space"),
+        [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)],
+    ),
+    Case(
+        "left_null_space",
+        ("kinlib.singularities", "left_null_space"),
+        [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)],
+    ),
+    Case(
+        "left_null_space (values)",
+        lambda q: _resolve(("kinlib.singularities", "left_null_space"))(J_TRIG, {t1: q[0], t2: q[1]}),
+        [A("subs", [3, 0], whole=[])],
+    ),
+    Case(
+        "evaluate_at",
+        ("kinlib.singularities", "evaluate_at"),
+        [A("J", J_TRIG, JMAT), A("subs", {t1: 1, t2: 0}, whole=["abc", True, 1j, 3.5], entries=False)],
+    ),
     # --- manipulability --------------------------------------------------------------------------------------
-    Case("manipulability", kinlib.manipulability, [A("J", J2, JMAT, ok=GENERIC_OK)]),
-    Case("manipulability (sym)", kinlib.manipulability, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)]),
+    Case("manipulability", kinlib.manipulability.manipulability, [A("J", J2, JMAT, ok=GENERIC_OK)]),
+    Case("manipulability (sym)", kinlib.manipulability.manipulability, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)]),
     Case("singular_values", ("kinlib.manipulability", "singular_values"), [A("J", J2, JMAT, ok=GENERIC_OK)]),
     Case("velocity_ellipsoid", kinlib.velocity_ellipsoid, [A("J", J2, JMAT, ok=GENERIC_OK)]),
     Case("twist_speed_form", kinlib.twist_speed_form, [A("J", J2, JMAT, ok=GENERIC_OK)]),
-    Case("twist_speed", ("kinlib.manipulability", "twist_speed"), [A("J", J2, JMAT, ok=GENERIC_OK), A("qdot", [1.0, 2.0], TH2[:2] + TH2[3:], ok=GENERIC_OK)]),
-    Case("strongest_joints", ("kinlib.manipulability", "strongest_joints"), [A("row", [1.0, -3.0, 2.0], [[], np.zeros((2, 2, 2))])]),
+    Case(
+        "twist_speed",
+        ("kinlib.manipulability", "twist_speed"),
+        [A("J", J2, JMAT, ok=GENERIC_OK), A("qdot", [1.0, 2.0], TH2[:2] + TH2[3:], ok=GENERIC_OK)],
+    ),
+    Case(
+        "strongest_joints",
+        ("kinlib.manipulability", "strongest_joints"),
+        [A("row", [1.0, -3.0, 2.0], [[], np.zeros((2, 2, 2))])],
+    ),
     Case("condition_number", kinlib.condition_number, [A("J", J2, JMAT, ok=GENERIC_OK)]),
     Case("condition_number (sym)", kinlib.condition_number, [A("J", J2_SYM, JMAT, ok=GENERIC_OK)]),
     Case("isotropy", kinlib.isotropy, [A("J", J2, JMAT, ok=GENERIC_OK)]),
@@ -313,10 +489,19 @@ CASES = [
     # --- velocity kinematics (item 7) ------------------------------------------------------------------------
     Case("pseudoinverse", ("kinlib.velocity", "pseudoinverse"), [A("J", J2, JMAT)]),
     Case("pseudoinverse (sym)", ("kinlib.velocity", "pseudoinverse"), [A("J", J2_SYM, JMAT)]),
-    Case("inverse_velocity", ("kinlib.velocity", "inverse_velocity"), [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:])]),
-    Case("damped_least_squares", ("kinlib.velocity", "damped_least_squares"),
-         [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:]), A("damping", 0.1)]),
-    Case("joint_torques", ("kinlib.velocity", "joint_torques"), [A("J", J2, JMAT), A("F", [1.0, 2.0], TH2[:2] + TH2[3:])]),
+    Case(
+        "inverse_velocity",
+        ("kinlib.velocity", "inverse_velocity"),
+        [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:])],
+    ),
+    Case(
+        "damped_least_squares",
+        ("kinlib.velocity", "damped_least_squares"),
+        [A("J", J2, JMAT), A("V", [1.0, 2.0], TH2[:2] + TH2[3:]), A("damping", 0.1)],
+    ),
+    Case(
+        "joint_torques", ("kinlib.velocity", "joint_torques"), [A("J", J2, JMAT), A("F", [1.0, 2.0], TH2[:2] + TH2[3:])]
+    ),
     Case("force_ellipsoid", ("kinlib.velocity", "force_ellipsoid"), [A("J", J2, JMAT)]),
 ]
 
@@ -335,8 +520,13 @@ def _named(msg: str, name: str) -> bool:
 
 
 @pytest.mark.parametrize("case", PARAMS)
-@settings(deadline=None, derandomize=True, max_examples=25, database=None,
-          suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much])
+@settings(
+    deadline=None,
+    derandomize=True,
+    max_examples=25,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much],
+)
 @given(data=st.data())
 def test_bad_input_is_refused(case, data):
     k, values, what = data.draw(corrupted(case), label="corruption")
@@ -346,7 +536,9 @@ def test_bad_input_is_refused(case, data):
     except (ValueError, TypeError) as err:
         msg = str(err)
         assert _named(msg, name), f"{case.label} with {what}: the message does not name {name!r}: {msg}"
-        assert "got" in msg or "no parameter" in msg, f"{case.label} with {what}: the message says not what was given: {msg}"
+        assert "got" in msg or "no parameter" in msg, (
+            f"{case.label} with {what}: the message says not what was given: {msg}"
+        )
         return
     # any other exception propagates (and fails the test): LinAlgError, ZeroDivisionError, NameError, ...
     pytest.fail(f"{case.label} with {what} returned {str(out)[:200]} instead of raising")
@@ -366,11 +558,18 @@ def test_chain_from_lists_equals_chain_from_sympy():
     screws = [[0.0, 0.0, 1.0, 0.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, -1.0, 0.0]]
     by_lists = kinlib.SerialChain(Ml.tolist(), screws)
     by_numpy = kinlib.SerialChain(Ml, np.array(screws).T)
-    by_screw_fns = kinlib.SerialChain(Ml, [kinlib.screw_revolute([0, 0, 1.0], [0, 0, 0]),
-                                           kinlib.screw_revolute(np.array([0.0, 0.0, 1.0]), [1.0, 0.0, 0.0])])
+    by_screw_fns = kinlib.SerialChain(
+        Ml,
+        [
+            kinlib.screw_revolute([0, 0, 1.0], [0, 0, 0]),
+            kinlib.screw_revolute(np.array([0.0, 0.0, 1.0]), [1.0, 0.0, 0.0]),
+        ],
+    )
     by_floats = kinlib.SerialChain(sp.Matrix(Ml).applyfunc(sp.Float), sp.Matrix(screws).T.applyfunc(sp.Float))
-    exact = kinlib.SerialChain(sp.Matrix([[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
-                               sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -1, 0]]).T)
+    exact = kinlib.SerialChain(
+        sp.Matrix([[1, 0, 0, 2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+        sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -1, 0]]).T,
+    )
     for c in (by_lists, by_numpy, by_screw_fns, by_floats):
         assert c.screws == exact.screws and c.M == exact.M and c.joint_points == exact.joint_points
         assert c.params == () and c.joint_types == "RR"
@@ -393,14 +592,18 @@ def test_typed_decimals_are_exact():
     assert list(c.screws[:, 0]) == [0, 0, 1, 0, sp.Rational(-1, 10), 0]
     assert list(c.screws[:, 1]) == [0, 0, 0, sp.Rational(3, 5), sp.Rational(4, 5), 0] and c.joint_types == "RP"
     # sp.Float inside expressions too: 0.5·L → L/2
-    c2 = kinlib.SerialChain(sp.Matrix([[1, 0, 0, sp.Float(0.5) * L], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
-                            [sp.Matrix([0, 0, 1, 0, -sp.Float(0.25) * L, 0])])
+    c2 = kinlib.SerialChain(
+        sp.Matrix([[1, 0, 0, sp.Float(0.5) * L], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]),
+        [sp.Matrix([0, 0, 1, 0, -sp.Float(0.25) * L, 0])],
+    )
     assert c2.M[0, 3] == L / 2 and c2.screws[4, 0] == -L / 4 and c2.params == (L,)
     # subs and robots.length: the typed decimal as well (was nsimplify)
     p = robots.planar_offset_3r()
     assert p.subs(L=0.1).M[:3, 3] == sp.Matrix([sp.Rational(3, 10), sp.Rational(1, 10), 0])
     assert p.subs({L: 0.1}).M == p.subs(L=sp.Rational(1, 10)).M
-    assert robots.length(0.425, "L1") == sp.Rational(17, 40) and robots.length(1 / 3, "L") == sp.Rational("0.3333333333333333")
+    assert robots.length(0.425, "L1") == sp.Rational(17, 40) and robots.length(1 / 3, "L") == sp.Rational(
+        "0.3333333333333333"
+    )
     assert robots.ur5(L1=0.425).M == robots.ur5().M
     # symbolic joint values: a float among them is the decimal typed
     assert c.fk([sp.pi, 0.5]) == c.fk([sp.pi, sp.Rational(1, 2)])
@@ -421,6 +624,7 @@ def test_float_axes_unit_only_to_rounding():
     """Axes typed (or computed) as floats that are unit only to rounding: accepted when | |ω|² − 1 | ≤ 1e-9,
     kept exactly as typed (never rounded to a 'nice' value); refused beyond, with a hint to type sp.sqrt(2)/2."""
     import modern_robotics as mr
+
     h = 0.7071067811865476
     c = kinlib.SerialChain(np.eye(4), [[h, h, 0, 0, 0, 0], [0, 0, 1, 0, -1.0, 0]])
     assert c.screws[0, 0] == sp.Rational("0.7071067811865476") and not c.screws[0, 0].has(sp.sqrt)
@@ -435,14 +639,16 @@ def test_float_axes_unit_only_to_rounding():
     # the exact result is the exact product of exponentials of the typed numbers: compare at 50 digits
     T = c2.fk([sp.Rational(7, 10)]).evalf(50)
     np.testing.assert_allclose(np.array(T, dtype=float), c2.fk(q), atol=1e-14)
-    for bad in ([0.70710678, 0.70710678, 0], [0.7071, 0.7071, 0]):       # |ω|² − 1 = −3e-9, −2e-5
-        with pytest.raises(ValueError, match=r"angular part ω of screws column 1 must be a unit vector.*sp\.sqrt\(2\)/2"):
+    for bad in ([0.70710678, 0.70710678, 0], [0.7071, 0.7071, 0]):  # |ω|² − 1 = −3e-9, −2e-5
+        with pytest.raises(
+            ValueError, match=r"angular part ω of screws column 1 must be a unit vector.*sp\.sqrt\(2\)/2"
+        ):
             kinlib.SerialChain(np.eye(4), [bad + [0, 0, 0]])
     # the rule is about the numbers, not the container: the same rationals typed in an sp.Matrix behave the same
     same = sp.Matrix([sp.Rational("0.7071067811865476")] * 2 + [0] * 4)
     assert kinlib.SerialChain(np.eye(4), [same]).screws[:, 0] == c.screws[:, 0]
     with pytest.raises(ValueError, match="must be a unit vector"):
-        kinlib.SerialChain(np.eye(4), [sp.Matrix([1, sp.Rational(1, 10**4), 0, 0, 0, 0])])   # |ω|² − 1 = 1e-8
+        kinlib.SerialChain(np.eye(4), [sp.Matrix([1, sp.Rational(1, 10**4), 0, 0, 0, 0])])  # |ω|² − 1 = 1e-8
     # an irrational axis must be exactly unit (no tolerance)
     with pytest.raises(ValueError, match="must be a unit vector"):
         kinlib.SerialChain(np.eye(4), [sp.Matrix([sp.sqrt(2) / 2, sp.sqrt(2) / 2 + sp.Rational(1, 10**3), 0, 0, 0, 0])])
@@ -452,8 +658,13 @@ def test_numeric_fast_path_refuses_nan_and_keeps_batches():
     """NaN/inf joint values are refused on the fast path (float array, code generated), singly and in batches."""
     c = robots.planar_offset_3r(1)
     ok = c.jacobian_space(np.array([0.1, 0.2, 0.3]))
-    for bad in (np.array([0.1, np.nan, 0.3]), np.array([np.inf, 0, 0]), np.array([[0.1, 0.2, 0.3], [0, -np.inf, 0]]),
-                [0.1, float("nan"), 0.3], (0.0, 0.0, float("-inf"))):
+    for bad in (
+        np.array([0.1, np.nan, 0.3]),
+        np.array([np.inf, 0, 0]),
+        np.array([[0.1, 0.2, 0.3], [0, -np.inf, 0]]),
+        [0.1, float("nan"), 0.3],
+        (0.0, 0.0, float("-inf")),
+    ):
         with pytest.raises(ValueError, match=r"q must hold 3 finite real joint values, got .* whose entry \[.*\] is"):
             c.jacobian_space(bad)
     # finite values whose float sum overflows still work (they take the checked path)

@@ -1,9 +1,10 @@
-"""The instructor checker (``python -m kinlib.grade``) on a fixture notebook and, when present, notebook 02.
+"""The instructor checker (``kinlib grade``, kinlib.course.grade) on a fixture notebook and, when present, notebook 02.
 
 One batch of submissions made from ``tests/fixtures/grade`` (the solution notebook, its workbook
 filled in right, filled in with mistakes, left untouched, and hostile ones) is graded once, two at a
 time; the tests read its rows and feedback.
 """
+
 from __future__ import annotations
 
 import copy
@@ -14,8 +15,9 @@ from pathlib import Path
 
 import pytest
 
-from kinlib import _grade_compare as C
-from kinlib import grade
+from kinlib.course import compare as C
+from kinlib.course import grade, schema
+from kinlib.course.cli import main
 
 FIX = Path(__file__).parent / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
@@ -86,8 +88,8 @@ MISTAKES_B = {
 }
 CHEAT = (
     "import builtins, kinlib, sympy\n"
-    "import kinlib.selfcheck\n"
-    "kinlib.selfcheck.check = lambda *a, **k: print('pass')\n"
+    "import kinlib.course.selfcheck\n"
+    "kinlib.course.selfcheck.check = lambda *a, **k: print('pass')\n"
     "sympy.simplify = lambda *a, **k: sympy.S.Zero\n"
     "sympy.Expr.evalf = lambda self, *a, **k: sympy.Float(0)\n"
     "sympy.MatrixBase.__eq__ = lambda a, b: True\n"
@@ -99,7 +101,7 @@ CHEAT = (
 @pytest.fixture(scope="module")
 def batch(tmp_path_factory):
     d = tmp_path_factory.mktemp("subs")
-    shutil.copy(REF, d / "alice_solution.ipynb")                     # the solution notebook itself
+    shutil.copy(REF, d / "alice_solution.ipynb")  # the solution notebook itself
     shutil.copy(WB, d / "untouched.ipynb")
     subs = {
         "bob_completed": completed(),
@@ -113,8 +115,9 @@ def batch(tmp_path_factory):
         "exits": completed(after=("1.2", "import os\nos._exit(1)")),
         "prints": completed(top=["import sys\nfor _ in range(100):\n    sys.stdout.write('x' * 100_000 + '\\n')"]),
         "deletes": completed({"1.2": "detJ = 1\ndel detJ"}, end=["%reset -f"]),
-        "ignores_sigint": completed(top=["import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\n"
-                                         "time.sleep(60)"]),
+        "ignores_sigint": completed(
+            top=["import signal, time\nsignal.signal(signal.SIGINT, signal.SIG_IGN)\ntime.sleep(60)"]
+        ),
     }
     for name, nb in subs.items():
         (d / f"{name}.ipynb").write_text(json.dumps(nb))
@@ -123,8 +126,16 @@ def batch(tmp_path_factory):
     del foreign["metadata"]["kinlib"]
     (d / "foreign.ipynb").write_text(json.dumps(foreign))
     out = tmp_path_factory.mktemp("grades")
-    summary = grade.grade_batch([d], out, jobs=2, timeout=60, cell_timeout=CELL_TIMEOUT,
-                                notebooks=FIX / "notebooks", cache=out / "cache", log=None)
+    summary = grade.grade_batch(
+        [d],
+        out,
+        jobs=2,
+        timeout=60,
+        cell_timeout=CELL_TIMEOUT,
+        notebooks=FIX / "notebooks",
+        cache=out / "cache",
+        log=None,
+    )
     rows = {}
     for r in summary["rows"]:
         rows.setdefault(Path(r["submission"]).stem, {})[r["part"]] = r
@@ -141,11 +152,27 @@ def _msg(batch, sub, part):
 
 # ---------------------------------------------------------------------------------------- the batch
 
+
 @pytest.mark.slow
 def test_every_submission_has_rows_and_the_batch_completed(batch):
-    assert set(batch["rows"]) == {"alice_solution", "untouched", "bob_completed", "carol_forms", "dan_transposed",
-                                  "erin_mistakes_a", "frank_mistakes_b", "loops", "raises_at_top", "cheats",
-                                  "exits", "prints", "deletes", "ignores_sigint", "garbage", "foreign"}
+    assert set(batch["rows"]) == {
+        "alice_solution",
+        "untouched",
+        "bob_completed",
+        "carol_forms",
+        "dan_transposed",
+        "erin_mistakes_a",
+        "frank_mistakes_b",
+        "loops",
+        "raises_at_top",
+        "cheats",
+        "exits",
+        "prints",
+        "deletes",
+        "ignores_sigint",
+        "garbage",
+        "foreign",
+    }
     with open(batch["out"] / "grades.csv") as f:
         rows = list(csv.DictReader(f))
     assert list(rows[0]) == ["submission", "notebook", "part", "status", "points", "message"]
@@ -155,7 +182,6 @@ def test_every_submission_has_rows_and_the_batch_completed(batch):
     assert len(feedback) == 16
 
 
-@pytest.mark.slow
 @pytest.mark.slow
 @pytest.mark.parametrize("sub", ["alice_solution", "bob_completed", "carol_forms"])
 def test_solutions_pass_every_part(batch, sub):
@@ -246,34 +272,49 @@ def test_points_come_from_the_question_cells(batch):
 
 
 @pytest.mark.slow
-def test_reruns_are_reproducible(batch, tmp_path):
+def test_reruns_are_reproducible(batch):
     refs = grade.load_references(FIX / "notebooks", batch["out"] / "cache")
     sub = next(p for p in (batch["out"].parent).glob("subs*/dan_transposed.ipynb"))
     again = grade.grade_submission(sub, refs, cell_timeout=CELL_TIMEOUT, display_name=str(sub))
     first = batch["rows"]["dan_transposed"]
-    assert [(r["part"], r["status"], r["message"]) for r in again["rows"]] == \
-           [(p, first[p]["status"], first[p]["message"]) for p in PARTS]
+    assert [(r["part"], r["status"], r["message"]) for r in again["rows"]] == [
+        (p, first[p]["status"], first[p]["message"]) for p in PARTS
+    ]
 
 
 # ---------------------------------------------------------------------------------------- no kernel needed
 
-def test_cli_usage_errors_and_exit_status(tmp_path, capsys):
+
+def test_cli_usage_errors_and_exit_status(tmp_path):
     with pytest.raises(SystemExit) as e:
-        grade.main(["nope/does-not-exist.ipynb", "--out", str(tmp_path)])
+        main(["grade", "nope/does-not-exist.ipynb", "--out", str(tmp_path)])
     assert e.value.code == 2
     with pytest.raises(SystemExit) as e:
-        grade.main([str(tmp_path), "--out", str(tmp_path), "--jobs", "0"])
+        main(["grade", str(tmp_path), "--out", str(tmp_path), "--jobs", "0"])
     assert e.value.code == 2
     bad = tmp_path / "x.ipynb"
     bad.write_text("{ not json")
-    assert grade.main([str(bad), "--out", str(tmp_path / "o"), "--notebooks", str(FIX / "notebooks"),
-                       "--cache", str(tmp_path / "c")]) == 0
+    assert (
+        main(
+            [
+                "grade",
+                str(bad),
+                "--out",
+                str(tmp_path / "o"),
+                "--notebooks",
+                str(FIX / "notebooks"),
+                "--cache",
+                str(tmp_path / "c"),
+            ]
+        )
+        == 0
+    )
     assert "error" in (tmp_path / "o" / "grades.csv").read_text()
 
 
 def test_parse_parts_reads_points_and_kinds():
-    parts = {p.part: p for p in grade.parse_parts(_load(REF))}
-    assert [p for p in parts] == PARTS
+    parts = {p.part: p for p in schema.parse_parts(_load(REF))}
+    assert list(parts) == PARTS
     assert parts["1.3"].kinds == {"moves": "subspace"} and parts["1.1"].kinds == {"Js": "expr"}
     assert parts["1.5"].points == 10 and parts["1.5"].answers == ["joint_x", "joint_y"]
 
@@ -291,13 +332,17 @@ def test_compare_expr_diagnoses():
     assert "entries (1,2)" in C.compare_expr(dict(S, values=_vals([[1, -2, 3, 4], [5, -6, 7, 8]])), R, "A")[1]
     assert "wrong shape" in C.compare_expr(dict(S, shape=[4, 1]), R, "A")[1]
     assert "not defined" in C.compare_expr({"tag": "missing"}, R, "A")[1]
-    deg = C.compare_expr(dict(S, shape=[], values=_vals([[45 * 180 / 3.141592653589793]])),
-                         {"shape": [], "symbols": [], "values": _vals([[45]])}, "a")
+    deg = C.compare_expr(
+        dict(S, shape=[], values=_vals([[45 * 180 / 3.141592653589793]])),
+        {"shape": [], "symbols": [], "values": _vals([[45]])},
+        "a",
+    )
     assert "degrees" in deg[1]
 
 
 def test_compare_set_and_choice():
     import math
+
     fam = [3 * math.pi / 4 + k * math.pi for k in range(-4, 4)]
     ref = {"conditions": [[[{"var": "theta2", "points": fam, "intervals": []}]]]}
     same = {"tag": "set", "conditions": [[[{"var": None, "points": [-math.pi / 4, 3 * math.pi / 4], "intervals": []}]]]}
@@ -308,10 +353,23 @@ def test_compare_set_and_choice():
     empty = {"tag": "set", "conditions": [[[{"var": None, "points": [], "intervals": []}]]]}
     assert C.compare_set(empty, empty_ref, "S") == (True, "")
     assert "no such configurations" in C.compare_set(same, empty_ref, "S")[1]
-    union = {"conditions": [[[{"var": "theta2", "points": [0.0], "intervals": []}],
-                             [{"var": "theta3", "points": [math.pi / 2], "intervals": []}]]]}
-    swapped = {"tag": "set", "conditions": [[[{"var": "theta3", "points": [math.pi / 2], "intervals": []}],
-                                             [{"var": "theta2", "points": [2 * math.pi], "intervals": []}]]]}
+    union = {
+        "conditions": [
+            [
+                [{"var": "theta2", "points": [0.0], "intervals": []}],
+                [{"var": "theta3", "points": [math.pi / 2], "intervals": []}],
+            ]
+        ]
+    }
+    swapped = {
+        "tag": "set",
+        "conditions": [
+            [
+                [{"var": "theta3", "points": [math.pi / 2], "intervals": []}],
+                [{"var": "theta2", "points": [2 * math.pi], "intervals": []}],
+            ]
+        ],
+    }
     assert C.compare_set(swapped, union, "S") == (True, "")
     assert C.compare_choice({"tag": "choice", "value": [2, 1]}, {"value": [1, 2]}, "j")[0]
     assert C.compare_choice({"tag": "choice", "value": 2}, {"value": [2]}, "j")[0]
@@ -319,6 +377,7 @@ def test_compare_set_and_choice():
 
 
 # ---------------------------------------------------------------------------------------- a real notebook
+
 
 def _stubbed(nb) -> dict:
     """A workbook as ``make handouts`` makes it, without running anything: stubs for the solution code cells
@@ -346,11 +405,17 @@ def test_real_notebook_02(tmp_path):
         pytest.skip("notebooks/02_planar_robot_jacobian.ipynb does not exist yet")
     snap = tmp_path / "notebooks"
     snap.mkdir()
-    shutil.copy(nb02, snap / nb02.name)              # one consistent version while others edit it
+    shutil.copy(nb02, snap / nb02.name)  # one consistent version while others edit it
     (tmp_path / "student_workbook.ipynb").write_text(json.dumps(_stubbed(_load(snap / nb02.name))))
     shutil.copy(snap / nb02.name, tmp_path / "renamed_solution.ipynb")
-    summary = grade.grade_batch([tmp_path / "student_workbook.ipynb", tmp_path / "renamed_solution.ipynb"],
-                                tmp_path / "out", jobs=2, notebooks=snap, cache=tmp_path / "cache", log=None)
+    summary = grade.grade_batch(
+        [tmp_path / "student_workbook.ipynb", tmp_path / "renamed_solution.ipynb"],
+        tmp_path / "out",
+        jobs=2,
+        notebooks=snap,
+        cache=tmp_path / "cache",
+        log=None,
+    )
     by = {}
     for r in summary["rows"]:
         by.setdefault(Path(r["submission"]).stem, []).append(r)

@@ -1,9 +1,10 @@
-"""``make handouts`` (kinlib.handouts) and the workbook self-checks (kinlib.selfcheck).
+"""``kinlib handouts`` (kinlib.course.handouts) and the workbook self-checks (kinlib.course.selfcheck).
 
 The end-to-end tests build the fixture notebook ``tests/fixtures/handouts/01_fixture_jacobians.ipynb``
 (every answer kind, a solution markdown cell, check cells, a figure, a widget, an animation, a cell that
 reads an answer) once per session. The npm packages are cached in build/vendor (fetched once).
 """
+
 from __future__ import annotations
 
 import ast
@@ -17,8 +18,11 @@ import pytest
 import sympy as sp
 from IPython.core.inputtransformer2 import TransformerManager
 
-from kinlib import handouts, robots, selfcheck
-from kinlib.selfcheck import fingerprint, verdict
+from kinlib import robots
+from kinlib.course import handouts, schema, selfcheck
+from kinlib.course.analysis import cell_names
+from kinlib.course.cli import main
+from kinlib.course.selfcheck import fingerprint, verdict
 
 ROOT = Path(__file__).resolve().parents[1]
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
@@ -28,6 +32,7 @@ STEM = "01_fixture_jacobians"
 
 # ---------------------------------------------------------------------------------------------------
 # selfcheck: fingerprints identify answers up to equivalence, and nothing else
+
 
 def _v(value, ref, kind="default", salt="1.1:x"):
     return verdict(value, fingerprint(ref, kind, salt=salt), salt=salt)[0]
@@ -77,12 +82,12 @@ def test_kinds_sets_subspaces_choices():
     assert _v(sp.solveset(sp.sin(th), th, sp.S.Reals), every_pi, "set") == "correct"
     assert _v(sp.FiniteSet(0), every_pi, "set") == "incorrect"
     assert _v({th: sp.FiniteSet(-sp.pi, 0)}, {th: every_pi}, "set") == "correct"
-    assert _v(sp.FiniteSet(0, sp.pi), {th: every_pi}, "set") == "incorrect"      # a dict was asked for
+    assert _v(sp.FiniteSet(0, sp.pi), {th: every_pi}, "set") == "incorrect"  # a dict was asked for
     A = sp.Matrix([[1, 0], [0, 1], [0, 0]])
     assert _v(sp.Matrix([[1, 1], [1, -1], [0, 0]]), A, "subspace") == "correct"
     assert _v([sp.Matrix([2, 0, 0]), sp.Matrix([0, 3, 0]), sp.Matrix([1, 1, 0])], A, "subspace") == "correct"
     assert _v(sp.Matrix([1, 0, 0]), A, "subspace") == "incorrect"
-    assert verdict(sp.Matrix([1, 0]), fingerprint(A, "subspace"))[0] == "incorrect"     # wrong ambient dim
+    assert verdict(sp.Matrix([1, 0]), fingerprint(A, "subspace"))[0] == "incorrect"  # wrong ambient dim
     assert _v((3, 1), (1, 3), "choice") == "correct"
     assert _v(3, (3,), "choice") == "correct"
     assert _v(2, 3, "choice") == "incorrect"
@@ -115,6 +120,7 @@ def test_check_prints_a_line_per_answer(capsys):
 # ---------------------------------------------------------------------------------------------------
 # the job, end to end on the fixture notebook
 
+
 @pytest.fixture(scope="module")
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("handouts") / "handouts"
@@ -129,16 +135,24 @@ def _solution_cells(nb):
 
 def test_writes_every_handout_and_the_index(built):
     out, entry, log = built
-    for rel in (f"solutions/{STEM}.html", f"problems/{STEM}.html", f"workbooks/{STEM}.ipynb", "index.html",
-                "assets/require.js", "assets/widgets/embed-amd.js", "assets/mathjax/MathJax.js",
-                "assets/mathjax/config/kinlib.js", "assets/font-awesome/css/font-awesome.min.css"):
+    for rel in (
+        f"solutions/{STEM}.html",
+        f"problems/{STEM}.html",
+        f"workbooks/{STEM}.ipynb",
+        "index.html",
+        "assets/require.js",
+        "assets/widgets/embed-amd.js",
+        "assets/mathjax/MathJax.js",
+        "assets/mathjax/config/kinlib.js",
+        "assets/font-awesome/css/font-awesome.min.css",
+    ):
         assert (out / rel).is_file(), rel
     index = (out / "index.html").read_text()
     for kind in ("problems", "solutions"):
         assert f'href="{kind}/{STEM}.html"' in index
     assert f'href="workbooks/{STEM}.ipynb"' in index
     assert "Fixture: Jacobians of a planar robot" in index
-    assert any(STEM in line and "done in" in line for line in log)      # progress: notebook and time
+    assert any(STEM in line and "done in" in line for line in log)  # progress: notebook and time
 
 
 def test_pages_load_nothing_from_the_network(built):
@@ -171,10 +185,10 @@ def test_problems_leak_no_solution(built):
     for c in executed.cells:
         tags = set(c.metadata.get("tags", []))
         if tags & {"solution", "check"}:
-            for line in c.source.splitlines():          # no line of a solution or check cell's source
+            for line in c.source.splitlines():  # no line of a solution or check cell's source
                 if len(line.strip()) >= 12:
                     assert line.strip() not in visible, line
-            for o in c.get("outputs", []):              # no output of theirs (answer values, check lines)
+            for o in c.get("outputs", []):  # no output of theirs (answer values, check lines)
                 for mime in ("text/latex", "text/plain"):
                     v = o.get("data", {}).get(mime)
                     if v and len(v) >= 12:
@@ -195,12 +209,14 @@ def test_problems_leak_no_solution(built):
 
 def html_escape(s):
     import html
+
     return html.escape(s, quote=False)
 
 
 def _visible(page: str) -> str:
     """The page's text with the tags (syntax highlighting) removed."""
     import html
+
     return html.unescape(re.sub(r"<[^>]+>", "", page))
 
 
@@ -210,9 +226,12 @@ def test_problem_widget_state_is_pruned(built):
     state = entry["problems"].metadata["widgets"][key]["state"]
     full = entry["executed"].metadata["widgets"][key]["state"]
     assert set(state) <= set(full) and state
-    shown = {o["data"]["application/vnd.jupyter.widget-view+json"]["model_id"]
-             for c in entry["problems"].cells for o in c.get("outputs", [])
-             if "application/vnd.jupyter.widget-view+json" in o.get("data", {})}
+    shown = {
+        o["data"]["application/vnd.jupyter.widget-view+json"]["model_id"]
+        for c in entry["problems"].cells
+        for o in c.get("outputs", [])
+        if "application/vnd.jupyter.widget-view+json" in o.get("data", {})
+    }
     assert shown <= set(state)
 
 
@@ -226,19 +245,20 @@ def test_workbook_is_a_valid_student_notebook(built):
     for c in wb.cells:
         if c.cell_type == "code":
             assert c.outputs == [] and c.execution_count is None
-            ast.parse(TransformerManager().transform_cell(c.source))      # every cell parses
+            ast.parse(TransformerManager().transform_cell(c.source))  # every cell parses
     source = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
     src_sol, wb_sol = _solution_cells(source), _solution_cells(wb)
     assert len(src_sol) == len(wb_sol)
     for a, b in zip(src_sol, wb_sol):
-        assert b.metadata.get("kinlib") == a.metadata.get("kinlib")      # metadata kept for the grader
+        assert b.metadata.get("kinlib") == a.metadata.get("kinlib")  # metadata kept for the grader
         if a.cell_type == "code":
             for name in a.metadata["kinlib"]["answers"]:
-                assert re.search(rf"^{name} = \.\.\.  # TODO: .*\(part {a.metadata['kinlib']['part']}\)$",
-                                 b.source, re.M), b.source
-    assert "the space Jacobian J_s(θ), a 6×3 Matrix" in text              # 'describe' metadata + auto
+                assert re.search(
+                    rf"^{name} = \.\.\.  # TODO: .*\(part {a.metadata['kinlib']['part']}\)$", b.source, re.M
+                ), b.source
+    assert "the space Jacobian J_s(θ), a 6×3 Matrix" in text  # 'describe' metadata + auto
     checks = [c for c in wb.cells if "selfcheck" in c.metadata.get("tags", [])]
-    assert len(checks) == 4                                           # 3 check cells + 1.2 without one
+    assert len(checks) == 4  # 3 check cells + 1.2 without one
     assert all("check(" in c.source for c in checks)
     assert not [c for c in wb.cells if "check" in c.metadata.get("tags", [])]
     assert "LEAK-NARRATIVE" not in text
@@ -296,8 +316,11 @@ def test_workbook_with_wrong_answers_fails(built, tmp_path):
     out, _, _ = built
     wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
     source = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
-    wrong = _paste_solutions(wb, source, edit=lambda s: s.replace("r.jacobian_space()", "r.jacobian_body()")
-                             .replace("fastest = 3", "fastest = 2"))
+    wrong = _paste_solutions(
+        wb,
+        source,
+        edit=lambda s: s.replace("r.jacobian_space()", "r.jacobian_body()").replace("fastest = 3", "fastest = 2"),
+    )
     lines = _selfcheck_lines(_run(wrong, tmp_path))
     assert any(ln.startswith("part 1.1 · Js: ✗") for ln in lines), lines
     assert any(ln.startswith("part 1.2 · fastest: ✗") for ln in lines), lines
@@ -307,13 +330,17 @@ def test_workbook_with_wrong_answers_fails(built, tmp_path):
 def test_a_failing_notebook_is_named_with_its_cell(tmp_path, capsys):
     nbs = tmp_path / "nbs"
     nbs.mkdir()
-    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("x = 1"),
-                                         nbformat.v4.new_markdown_cell("text"),
-                                         nbformat.v4.new_code_cell("y = x +\n")])
+    nb = nbformat.v4.new_notebook(
+        cells=[
+            nbformat.v4.new_code_cell("x = 1"),
+            nbformat.v4.new_markdown_cell("text"),
+            nbformat.v4.new_code_cell("y = x +\n"),
+        ]
+    )
     nb.cells[2].metadata["tags"] = ["solution"]
     nb.cells[2].metadata["kinlib"] = {"part": "9.9", "answers": ["y"]}
     nbformat.write(nb, nbs / "07_broken.ipynb")
-    code = handouts.main([str(nbs), "--out", str(tmp_path / "out"), "--vendor", str(VENDOR), "--jobs", "1"])
+    code = main(["handouts", str(nbs), "--out", str(tmp_path / "out"), "--vendor", str(VENDOR), "--jobs", "1"])
     err = capsys.readouterr().err
     assert code == 1
     assert "07_broken.ipynb" in err and "cell 2" in err and "part 9.9" in err and "SyntaxError" in err
@@ -321,16 +348,20 @@ def test_a_failing_notebook_is_named_with_its_cell(tmp_path, capsys):
 
 def test_answer_groups_of_the_fixture():
     nb = nbformat.read(FIXTURES / f"{STEM}.ipynb", as_version=4)
-    groups = handouts.answer_groups(nb)
+    groups = schema.answer_groups(nb)
     assert [[(p, n, k) for p, n, k, _ in g.answers] for g in groups] == [
-        [("1.1", "Js", "default")], [("1.2", "fastest", "choice")],
-        [("1.3", "detJ", "default"), ("1.3", "singular", "set")], [("1.4", "span", "subspace")]]
+        [("1.1", "Js", "expr")],
+        [("1.2", "fastest", "choice")],
+        [("1.3", "detJ", "expr"), ("1.3", "singular", "set")],
+        [("1.4", "span", "subspace")],
+    ]
     assert [g.check_cell is not None for g in groups] == [True, False, True, True]
 
 
 def test_names_read_before_bound():
-    free, bound = handouts._names("for name, pose in poses.items():\n    print(name)\nJ = J.subs(a)\n"
-                                  "f = lambda t: t + w\n%matplotlib inline\n")
+    free, bound = cell_names(
+        "for name, pose in poses.items():\n    print(name)\nJ = J.subs(a)\nf = lambda t: t + w\n%matplotlib inline\n"
+    )
     assert {"poses", "J", "a", "w"} <= free and not {"name", "pose", "t"} & free
     assert {"name", "pose", "J", "f"} <= bound
 
@@ -341,7 +372,7 @@ def test_real_notebooks_have_the_structure(path):
     nb = nbformat.read(path, as_version=4)
     meta = nb.metadata.get("kinlib", {})
     assert meta.get("notebook") == path.stem and meta.get("title")
-    for g in handouts.answer_groups(nb):
+    for g in schema.answer_groups(nb):
         for part, name, kind, _ in g.answers:
             assert part and name.isidentifier() and kind in selfcheck.KINDS, (part, name, kind)
 

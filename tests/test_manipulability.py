@@ -1,4 +1,5 @@
 """kinlib.manipulability against NumPy (det, SVD, cond) and modern_robotics Jacobians."""
+
 from __future__ import annotations
 
 import modern_robotics as mr
@@ -6,14 +7,18 @@ import numpy as np
 import pytest
 import sympy as sp
 
+from helpers import assert_sym_equal
 from kinlib import robots
 from kinlib.manipulability import (
-    condition_number, isotropy, manipulability, singular_values, twist_speed, twist_speed_form,
+    condition_number,
+    isotropy,
+    manipulability,
+    singular_values,
+    twist_speed,
+    twist_speed_form,
     velocity_ellipsoid,
 )
 from kinlib.singularities import evaluate_at, task_rows
-
-from helpers import assert_sym_equal
 
 pi = sp.pi
 
@@ -27,7 +32,8 @@ def test_numeric_manipulability_is_yoshikawa(rng, m, n):
     batch = rng.normal(size=(7, m, n))
     w = manipulability(batch)
     assert w.shape == (7,)
-    assert np.allclose(w, [manipulability(Jk) for Jk in batch])
+    G = batch @ np.swapaxes(batch, 1, 2) if n >= m else np.swapaxes(batch, 1, 2) @ batch
+    assert np.allclose(w, np.sqrt(np.linalg.det(G)), rtol=1e-10)
 
 
 def test_numeric_condition_and_isotropy(rng):
@@ -92,7 +98,8 @@ def test_velocity_ellipsoid_numeric(rng):
     batch = r.jacobian_geometric(rng.uniform(-3, 3, (5, 3)))
     lb, Ub = velocity_ellipsoid(batch)
     assert lb.shape == (5, 3) and Ub.shape == (5, 3, 3)
-    assert np.allclose(singular_values(batch[:, 3:, :]), lb)
+    assert np.allclose(np.linalg.svd(batch[:, 3:, :], compute_uv=False), lb)
+    assert np.allclose(singular_values(batch[:, 3:, :]), np.linalg.svd(batch[:, 3:, :], compute_uv=False))
 
 
 def test_twist_speed_form_problem_6_2(rng):
@@ -124,11 +131,19 @@ def test_symbolic_condition_number_of_a_constant_matrix():
     assert isotropy(sp.Matrix([[1, 1], [1, 1]])) == 0
 
 
-@pytest.mark.parametrize("bad, exc", [
-    ("J", TypeError), (None, TypeError), (3.0, TypeError), (np.zeros(3), ValueError),
-    (np.zeros((2, 0)), ValueError), (np.array([[np.nan, 1.0]]), ValueError), ([["a", "b"]], TypeError),
-    (np.zeros((2, 2, 2, 2)), ValueError),
-])
+@pytest.mark.parametrize(
+    "bad, exc",
+    [
+        ("J", TypeError),
+        (None, TypeError),
+        (3.0, TypeError),
+        (np.zeros(3), ValueError),
+        (np.zeros((2, 0)), ValueError),
+        (np.array([[np.nan, 1.0]]), ValueError),
+        ([["a", "b"]], TypeError),
+        (np.zeros((2, 2, 2, 2)), ValueError),
+    ],
+)
 def test_bad_input(bad, exc):
     for f in (manipulability, condition_number, isotropy):
         with pytest.raises(exc, match="J must"):
@@ -136,9 +151,9 @@ def test_bad_input(bad, exc):
 
 
 def test_bad_qdot_and_rows():
-    with pytest.raises(ValueError, match="qdot must hold 4"):
+    with pytest.raises(ValueError, match=r"qdot must .*\b4\b"):
         twist_speed(np.ones((6, 4)), np.ones(3))
     with pytest.raises(ValueError, match="qdot must be a vector of length 4"):
         twist_speed(sp.ones(6, 4), sp.symbols("a b c"))
-    with pytest.raises(ValueError, match="unknown row name"):
+    with pytest.raises(ValueError, match="unknown row"):
         velocity_ellipsoid(np.ones((6, 3)), rows=["vw"])

@@ -1,5 +1,6 @@
 """kinlib.plotting: drawings match the kinematics (checked against finite differences of T(θ), NumPy's SVD
 and the modern_robotics package), artists move in place, bad input is refused clearly."""
+
 import math
 import subprocess
 import sys
@@ -58,8 +59,10 @@ def line_points(line):
 
 # --- imports -------------------------------------------------------------------------------------
 def test_import_kinlib_does_not_import_plotting_or_widgets():
-    code = ("import sys, kinlib; bad = [m for m in ('kinlib.plotting', 'kinlib.widgets', 'matplotlib', "
-            "'ipywidgets') if m in sys.modules]; assert not bad, bad")
+    code = (
+        "import sys, kinlib; bad = [m for m in ('kinlib.plotting', 'kinlib.widgets', 'matplotlib', "
+        "'ipywidgets') if m in sys.modules]; assert not bad, bad"
+    )
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
@@ -105,8 +108,7 @@ def test_tool_frame_arrows_are_the_columns_of_R():
     q = [0.4, 0.3, -0.2, 0.9]
     art = P.draw_chain(chain, q)
     T = mr.FKinSpace(np.array(chain.M, float), np.array(chain.screws, float), np.array(q))
-    segs = art.frame_b.artist.get_segments() if hasattr(art.frame_b.artist, "get_segments") else None
-    segs = art.frame_b._segments(np.tile(T[:3, 3], (3, 1)), (T[:3, :3] * 0.22 * art.scale).T)[0]
+    segs = art.frame_b.segments(np.tile(T[:3, 3], (3, 1)), (T[:3, :3] * 0.22 * art.scale).T)[0]
     shafts = [np.subtract(*segs[3 * k][::-1]) for k in range(3)]  # tip − tail
     for k in range(3):
         np.testing.assert_allclose(shafts[k] / np.linalg.norm(shafts[k]), T[:3, k], atol=1e-12)
@@ -117,7 +119,7 @@ def test_joint_axes_follow_the_space_jacobian():
     q = [0.7, 0.2, 0.3, -0.4]
     art = P.draw_chain(chain, q)
     Js = mr.JacobianSpace(np.array(chain.screws, float), np.array(q))
-    segs = art._axis_segments(chain.skeleton(q), chain.jacobian_space(q))
+    segs = art.axis_segments(chain.skeleton(q), chain.jacobian_space(q))
     for i, (a, b) in enumerate(segs):
         d = (b - a) / np.linalg.norm(b - a)
         axis = Js[:3, i] if chain.joint_types[i] == "R" else Js[3:, i]
@@ -135,19 +137,29 @@ def test_planar_projection_and_axes_mismatch():
 
 def test_symbolic_parameters_need_numbers():
     r = robots.planar_offset_3r()
-    with pytest.raises(ValueError, match=r"symbolic parameters L.*subs\(L=1\)"):
+    with pytest.raises(ValueError, match=r"\bL\b"):  # the error names the symbolic parameter
         P.draw_chain(r, [0, 0, 0])
     art = P.draw_chain(r, [0.1, 0.2, 0.3], params={"L": 2})
     np.testing.assert_allclose(art.tool_position, tool_position(r.subs(L=2), [0.1, 0.2, 0.3]), atol=1e-12)
-    with pytest.raises(ValueError, match="no parameter 'H'"):
+    # the numeric chain is SerialChain.numeric's, cached on the chain: drawing twice substitutes once
+    assert P.draw_chain(r, [0, 0, 0], params={"L": 2}).chain is art.chain is r.numeric({"L": 2})
+    with pytest.raises(ValueError, match="H"):
         P.draw_chain(r, [0, 0, 0], params={"H": 1})
-    with pytest.raises(ValueError, match="must be a number"):
+    with pytest.raises((ValueError, TypeError)):
         P.draw_chain(r, [0, 0, 0], params={"L": sp.Symbol("a")})
 
 
-@pytest.mark.parametrize("q, err", [([0, 0], ValueError), ([0, 0, 0, 0], ValueError), ("abc", TypeError),
-                                    ([0, sp.Symbol("x"), 0], TypeError), ([0, np.nan, 0], ValueError),
-                                    (np.zeros((2, 3)), ValueError)])
+@pytest.mark.parametrize(
+    "q, err",
+    [
+        ([0, 0], ValueError),
+        ([0, 0, 0, 0], ValueError),
+        ("abc", TypeError),
+        ([0, sp.Symbol("x"), 0], TypeError),
+        ([0, np.nan, 0], ValueError),
+        (np.zeros((2, 3)), ValueError),
+    ],
+)
 def test_bad_configuration(q, err):
     with pytest.raises(err, match="q"):
         P.draw_chain(robots.planar_offset_3r(1), q)
@@ -179,9 +191,10 @@ def test_draw_home_annotates_screw_axes():
 
 def _label_pixels(art):
     art.ax.figure.canvas.draw()
-    texts = [t for t in art.labels + art.frame_texts]
+    texts = art.labels + art.frame_texts
     if hasattr(art.ax, "get_zlim"):  # a 3-D text's anchor, through matplotlib's own projection
         from mpl_toolkits.mplot3d import proj3d
+
         X = np.array([t.get_position_3d() for t in texts]).T
         x, y, _ = proj3d.proj_transform(X[0], X[1], X[2], art.ax.get_proj())
         return art.ax.transData.transform(np.column_stack([x, y])), texts
@@ -213,8 +226,9 @@ def test_3d_view_is_tight_and_equal_aspect(chains, name):
     lims = np.array([ax.get_xlim(), ax.get_ylim(), ax.get_zlim()])
     sides = lims[:, 1] - lims[:, 0]
     # equal scale on every axis: the drawn box has the proportions of the data box
-    np.testing.assert_allclose(np.array(ax.get_box_aspect()) / np.max(ax.get_box_aspect()), sides / sides.max(),
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        np.array(ax.get_box_aspect()) / np.max(ax.get_box_aspect()), sides / sides.max(), rtol=1e-9
+    )
     # the whole skeleton is inside, and the box is not much larger than the drawing (frames, axes, margin)
     sk = chain.skeleton(q)
     assert np.all(sk >= lims[:, :1] - 1e-12) and np.all(sk <= lims[:, 1:] + 1e-12)
@@ -329,16 +343,85 @@ def test_ellipsoid_in_3d():
     art.ax.figure.canvas.draw()
 
 
-def test_rows_names():
-    assert P.task_row_indices("planar") == (2, 3, 4)
-    assert P.task_row_indices(("vx", "py")) == (3, 4)
-    assert P.task_row_indices(None) == (0, 1, 2, 3, 4, 5)
-    with pytest.raises(ValueError, match="unknown row 'vw'"):
+# every row spec that plotting or singularities accepted before (one parser now: kinlib.taskspace)
+ROW_SPECS = [
+    ("planar", (2, 3, 4)),
+    ("angular", (0, 1, 2)),
+    ("linear", (3, 4, 5)),
+    ("position", (3, 4, 5)),
+    ("xy", (3, 4)),
+    ("all", (0, 1, 2, 3, 4, 5)),
+    ("PLANAR", (2, 3, 4)),
+    (("vx", "py"), (3, 4)),
+    (("px", "py", "pz"), (3, 4, 5)),
+    (("ωz", "vx", "vy"), (2, 3, 4)),
+    (("ω_z", "px", "py"), (2, 3, 4)),
+    ((-3, -2), (3, 4)),
+    ((-1, 0), (5, 0)),
+    ((4, "vx"), (4, 3)),
+    ("wz", (2,)),
+    (5, (5,)),
+    (np.array([3, 4]), (3, 4)),
+]
+
+
+@pytest.mark.parametrize("spec, idx", ROW_SPECS)
+def test_rows_the_union_of_the_old_specs(spec, idx):
+    assert P.task_row_indices(spec) == idx
+    assert P.ROW_NAMES == ("wx", "wy", "wz", "vx", "vy", "vz")
+
+
+def test_rows_through_the_plotting_api():
+    """The same rows by name, alias, preset or (negative) index give the same pictures."""
+    chain = robots.planar_offset_3r(1)
+    q, qdot = [0.3, -0.4, 0.8], [0.5, 1.0, -0.2]
+    art = P.draw_chain(chain, q)
+    ref = P.draw_velocity(art.ax, chain, q, qdot, rows=(3, 4)).velocity
+    for spec in ("xy", ("px", "py"), ("v_x", "p_y"), (-3, -2)):
+        np.testing.assert_allclose(P.draw_velocity(art.ax, chain, q, qdot, rows=spec).velocity, ref, atol=1e-15)
+    ref = P.plot_manipulability_curve(chain, 2, rows=(2, 3, 4), num=31).values
+    for spec in ("planar", ("ωz", "px", "py"), ("ω_z", "vx", "vy"), (-4, -3, -2), None):
+        np.testing.assert_allclose(P.plot_manipulability_curve(chain, 2, rows=spec, num=31).values, ref, atol=1e-15)
+    ur5 = robots.ur5()
+    m = P.plot_manipulability_map(ur5, (2, 3), rows="position", num=11)
+    np.testing.assert_allclose(
+        P.plot_manipulability_map(ur5, (2, 3), rows=("px", "py", "pz"), num=11).values, m.values, atol=1e-15
+    )
+    np.testing.assert_allclose(
+        P.plot_manipulability_map(ur5, (2, 3), rows=[-3, -2, -1], num=11).values, m.values, atol=1e-15
+    )
+    plt.close("all")
+
+
+def test_rows_refused():
+    with pytest.raises(ValueError, match=r"unknown row.*'vw'"):
         P.task_row_indices(("vx", "vw"))
     with pytest.raises(ValueError, match="repeat"):
         P.task_row_indices(("vx", 3))
-    with pytest.raises(ValueError, match="index 0-5"):
+    with pytest.raises(ValueError, match="repeat"):
+        P.task_row_indices(("vx", -3))
+    with pytest.raises(ValueError, match="range"):
         P.task_row_indices((7,))
+    with pytest.raises(TypeError, match="rows"):
+        P.task_row_indices((True,))
+    with pytest.raises(ValueError, match="rows"):
+        P.plot_manipulability_curve(robots.planar_3r(1, 1, 1), 1, rows="nope")
+
+
+def test_default_rows_are_the_task_space_of_the_arm():
+    """Planar ≥ 3 joints: (ω_z, ṗ_x, ṗ_y); planar ≤ 2: (ṗ_x, ṗ_y); spatial ≥ 6: all; spatial < 6: ṗ."""
+    for chain, rows in (
+        (robots.planar_3r(1, 1, 1), (2, 3, 4)),
+        (robots.planar_2r(1, 1), (3, 4)),
+        (robots.ur5(), (0, 1, 2, 3, 4, 5)),
+        (robots.spatial_rppr(1, 1), (3, 4, 5)),
+    ):
+        c = P.plot_manipulability_curve(chain, 2, num=5)
+        np.testing.assert_allclose(c.values, P.plot_manipulability_curve(chain, 2, rows=rows, num=5).values)
+    # the 2R arm's stretched-out singularity θ2 = 0 shows with its default rows (all six rows never lose rank 2)
+    c = P.plot_manipulability_curve(robots.planar_2r(1, 1), 2, lim=(-1, 1), num=21)
+    assert c.values[10] < 1e-12 and c.values.min() == c.values[10]
+    plt.close("all")
 
 
 # --- directions ----------------------------------------------------------------------------------
@@ -348,8 +431,7 @@ def test_draw_directions_problem_5_3():
     col = sp.Matrix([[1, 0], [0, sp.sqrt(2) / 2], [0, -sp.sqrt(2) / 2]])  # columns (ω_z, ṗ_x, ṗ_y)
     arts = P.draw_directions(ax, (1, 2), col[:, 1:], labels=["can move"], components=(1, 2))
     np.testing.assert_allclose(arts[0]._posA_posB, [(1, 2), (1 + s, 2 - s)], atol=1e-12)
-    arts = P.draw_directions(ax, (1, 2), [[0, 1, 1]], components=(1, 2), length=1.0, both_ways=True,
-                             linestyles=["--"])
+    arts = P.draw_directions(ax, (1, 2), [[0, 1, 1]], components=(1, 2), length=1.0, both_ways=True, linestyles=["--"])
     np.testing.assert_allclose(arts[0]._posA_posB, [(1 - s, 2 - s), (1 + s, 2 + s)], atol=1e-12)
     with pytest.raises(ValueError, match="2 entries"):
         P.draw_directions(ax, (0, 0), [[0, 1, 1]])
@@ -451,6 +533,84 @@ def test_animate_singularity_plays_in_a_static_page():
         P.animate_singularity(chain, np.zeros((5, 2)))
 
 
+def test_ellipse_outline_matches_an_independent_svd():
+    """Both ellipse drawings (EllipseArtist for a chain, draw_ellipse for given (σ, U)) draw the outline
+    c + U diag(σ) (cos t, sin t) with σ, U from NumPy's SVD of J_ṗ built from modern_robotics."""
+    chain = robots.planar_offset_3r(1)
+    q = np.array([0.5, -0.3, 1.1])
+    S = np.array(chain.screws, float)
+    p = tool_position(chain, q)
+    Js = mr.JacobianSpace(S, q)
+    Jp = Js[3:5] + np.array([[0, 0, -p[1]], [0, 0, p[0]]]) @ Js[:3]  # ṗ = v_s + ω_s × p
+    U, sig, _ = np.linalg.svd(Jp)
+    art = P.draw_chain(chain, q)
+    e = P.draw_velocity_ellipse(art.ax, chain, q, scale=0.5)
+    np.testing.assert_allclose(e.semi_axes, sig, atol=1e-12)
+    np.testing.assert_allclose(np.abs(e.directions.T @ U), np.eye(2), atol=1e-9)  # same axes up to sign
+    pts = line_points(e.curves[0])[:2] - p[:2, None]
+    local = U.T @ pts / (0.5 * sig[:, None])  # coordinates along the principal axes / semi-axes
+    np.testing.assert_allclose(np.sum(local**2, axis=0), 1.0, atol=1e-9)
+    # the principal axes drawn: ± 0.5 σ_i u_i about the tool
+    ends = np.array([np.asarray(s)[1] - p[:2] for s in e.axes.get_segments()])
+    np.testing.assert_allclose(np.abs(ends @ U), 0.5 * np.diag(sig), atol=1e-9)
+    # draw_ellipse with the same (σ, U) draws the very same points
+    arts = P.draw_ellipse(art.ax, p[:2], sig, U, scale=0.5)
+    np.testing.assert_allclose(np.abs(U.T @ (np.array(arts[0].get_data()) - p[:2, None])), np.abs(U.T @ pts), atol=1e-9)
+    # 3-D: the three principal ellipses of the UR5's ṗ ellipsoid
+    ur5 = robots.ur5()
+    q6 = q_of(ur5, 4)
+    Jv = np.column_stack([pdot_fd(ur5, q6, np.eye(6)[i]) for i in range(6)])
+    U3, s3, _ = np.linalg.svd(Jv)
+    e3 = P.draw_velocity_ellipse(P.draw_chain(ur5, q6).ax, ur5, q6)
+    np.testing.assert_allclose(e3.semi_axes, s3, atol=1e-6)
+    c3 = tool_position(ur5, q6)
+    for curve, (i, j) in zip(e3.curves, ((0, 1), (1, 2), (0, 2))):
+        local = U3.T @ (line_points(curve) - c3[:, None])
+        np.testing.assert_allclose((local[i] / s3[i]) ** 2 + (local[j] / s3[j]) ** 2, 1.0, atol=1e-5)
+    plt.close("all")
+
+
+def kinlib_owned(v) -> bool:
+    """v is a kinlib object, or a dict/list/tuple holding one (one level deep)."""
+
+    def own(x):
+        return type(x).__module__.startswith("kinlib")
+
+    if isinstance(v, dict):
+        return any(own(x) for x in list(v.values()) + list(v.keys()))
+    if isinstance(v, (list, tuple)):
+        return any(own(x) for x in v)
+    return own(v)
+
+
+def test_no_state_on_the_axes_and_released_with_the_figure():
+    import gc
+    import weakref
+
+    chain = robots.planar_offset_3r(1)
+    q = [0.3, 0.4, -0.2]
+    for planar in (True, False):
+        fig = plt.figure()
+        ax = fig.add_subplot(projection=None if planar else "3d")
+        art = P.draw_chain(chain, q, ax, planar=planar)
+        P.draw_velocity(ax, chain, q, [1, 0, 0], rows=None)
+        P.draw_joint_velocities(ax, chain, q)
+        P.draw_velocity_ellipse(ax, chain, q)
+        fig.canvas.draw()
+        # no attribute of the axes (or figure) is kinlib's: by name or by what it holds
+        for obj in (ax, fig):
+            assert not [k for k in vars(obj) if "kinlib" in k.lower()]
+            # (the artists drawn on the axes, ``_children``, include the invisible ViewState: that is the point)
+            assert not [k for k, v in vars(obj).items() if k != "_children" and kinlib_owned(v)]
+        # the view's state is an (invisible) artist of the axes, so it goes with the figure
+        ref = weakref.ref(ax)
+        del art, ax, obj
+        plt.close(fig)
+        del fig
+        gc.collect()
+        assert ref() is None
+
+
 def test_draw_ellipse_from_lengths_and_axes():
     fig, ax = plt.subplots()
     U = np.array([[math.cos(0.3), -math.sin(0.3)], [math.sin(0.3), math.cos(0.3)]])
@@ -460,7 +620,6 @@ def test_draw_ellipse_from_lengths_and_axes():
     np.testing.assert_allclose((local[:, 0] / 2.0) ** 2 + (local[:, 1] / 0.5) ** 2, 1.0, atol=1e-12)
     with pytest.raises(ValueError, match="axes"):
         P.draw_ellipse(ax, (0, 0), [1, 1, 1], np.eye(3))
-    from mpl_toolkits.mplot3d import Axes3D  # noqa: F401
     ax3 = plt.figure().add_subplot(projection="3d")
     assert len(P.draw_ellipse(ax3, (0, 0, 0), [1, 0.5, 0], np.eye(3))) == 4
 

@@ -13,6 +13,7 @@ computed result is pinned here and the notebook shows a visible note:
   ``1 1 1 1``) for a three-joint robot: the Jacobians are 6×3 with rows (0,0,0), (0,0,0), (1,1,1).
 Everything else printed in sections 1–3 agrees with the computation.
 """
+
 from __future__ import annotations
 
 import functools
@@ -30,7 +31,6 @@ import pytest  # noqa: E402
 import sympy as sp  # noqa: E402
 
 import kinlib  # noqa: E402
-
 from helpers import assert_sym_equal  # noqa: E402
 
 NB_DIR = pathlib.Path(__file__).resolve().parents[1] / "notebooks"
@@ -46,7 +46,7 @@ def _read(stem):
     return nbformat.read(NB_DIR / f"{stem}.ipynb", as_version=4)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def answers(stem):
     """The notebook's namespace after its setup, given and solution cells (no figures, widgets, checks)."""
     ns = {"display": lambda *a, **k: None}
@@ -124,8 +124,9 @@ def test_1_1_cart_pole():
     Lv, hv, q0, eps = 0.9, 0.4, np.array([0.2, 0.7]), 1e-6
     M = np.array([[1, 0, 0, Lv], [0, 1, 0, hv], [0, 0, 1, 0], [0, 0, 0, 1.0]])
     S = np.array([[0, 0, 0, 1, 0, 0], [0, 0, 1, hv, 0, 0]], dtype=float).T
-    fd = np.column_stack([(mr.FKinSpace(M, S, q0 + e) - mr.FKinSpace(M, S, q0 - e))[:2, 3] / (2 * eps)
-                          for e in np.eye(2) * eps])
+    fd = np.column_stack(
+        [(mr.FKinSpace(M, S, q0 + e) - mr.FKinSpace(M, S, q0 - e))[:2, 3] / (2 * eps) for e in np.eye(2) * eps]
+    )
     assert np.allclose(_num(ns["J"], {L: Lv, h: hv, th1: q0[0], th2: q0[1]}), fd, atol=1e-8)
 
 
@@ -162,11 +163,22 @@ def _planar_expected(L, t1, t2, t3):
     a, b = r2 * sin(t1 + t2 + pi / 4), r2 * cos(t1 + t2 + pi / 4)
     top = [[0, 0, 0], [0, 0, 0], [1, 1, 1]]
     Js = sp.Matrix(top + [[0, L * s1, L * s1 + L * a], [0, -L * c1, -L * c1 - L * b], [0, 0, 0]])
-    Jb = sp.Matrix(top + [[L * sin(t2 + t3) - L * r2 * cos(t3 + pi / 4), -L * r2 * cos(t3 + pi / 4), 0],
-                          [L * cos(t2 + t3) + L * r2 * sin(t3 + pi / 4) + L, L * r2 * sin(t3 + pi / 4) + L, L],
-                          [0, 0, 0]])
-    J = sp.Matrix(top + [[-L * s123 - L * s1 - L * a, -L * s123 - L * a, -L * s123],
-                         [L * c123 + L * c1 + L * b, L * c123 + L * b, L * c123], [0, 0, 0]])
+    Jb = sp.Matrix(
+        top
+        + [
+            [L * sin(t2 + t3) - L * r2 * cos(t3 + pi / 4), -L * r2 * cos(t3 + pi / 4), 0],
+            [L * cos(t2 + t3) + L * r2 * sin(t3 + pi / 4) + L, L * r2 * sin(t3 + pi / 4) + L, L],
+            [0, 0, 0],
+        ]
+    )
+    J = sp.Matrix(
+        top
+        + [
+            [-L * s123 - L * s1 - L * a, -L * s123 - L * a, -L * s123],
+            [L * c123 + L * c1 + L * b, L * c123 + L * b, L * c123],
+            [0, 0, 0],
+        ]
+    )
     return Js, Jb, J
 
 
@@ -175,7 +187,11 @@ def test_section_2_answers():
     ns = answers("02_planar_robot_jacobian")
     L, t1, t2, t3 = ns["L"], ns["th1"], ns["th2"], ns["th3"]
     assert ns["M"] == sp.Matrix([[1, 0, 0, 3 * L], [0, 1, 0, L], [0, 0, 1, 0], [0, 0, 0, 1]])
-    assert [list(ns[k]) for k in ("S1", "S2", "S3")] == [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0], [0, 0, 1, L, -2 * L, 0]]
+    assert [list(ns[k]) for k in ("S1", "S2", "S3")] == [
+        [0, 0, 1, 0, 0, 0],
+        [0, 0, 1, 0, -L, 0],
+        [0, 0, 1, L, -2 * L, 0],
+    ]
     Js, Jb, J = _planar_expected(L, t1, t2, t3)
     for name, expected in (("Js", Js), ("Jb", Jb), ("J", J)):
         assert ns[name].shape == (6, 3), f"{name} is 6×3 (the printed rows 1-3 have four entries)"
@@ -190,8 +206,10 @@ def test_section_2_answers():
     assert np.allclose(_num(ns["Js"], subs), mr.JacobianSpace(S, q))
     assert np.allclose(_num(ns["Jb"], subs), mr.JacobianBody(mr.Adjoint(mr.TransInv(M)) @ S, q))
     R = T[:3, :3]
-    assert np.allclose(_num(ns["J"], subs), np.block([[R, np.zeros((3, 3))], [np.zeros((3, 3)), R]]) @ mr.JacobianBody(
-        mr.Adjoint(mr.TransInv(M)) @ S, q))
+    assert np.allclose(
+        _num(ns["J"], subs),
+        np.block([[R, np.zeros((3, 3))], [np.zeros((3, 3)), R]]) @ mr.JacobianBody(mr.Adjoint(mr.TransInv(M)) @ S, q),
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -204,14 +222,60 @@ def test_section_3_answers():
     t1, t2, t3, t4 = ns["th1"], ns["th2"], ns["th3"], ns["th4"]
     c1, s1, c4, s4 = cos(t1), sin(t1), cos(t4), sin(t4)
     H = L1 + L2
-    assert_sym_equal(ns["T"], sp.Matrix([[c1, -c4 * s1, s1 * s4, (L2 + t3) * c1], [s1, c1 * c4, -c1 * s4, (L2 + t3) * s1],
-                                         [0, s4, c4, H + t2], [0, 0, 0, 1]]), "3.1 T")
-    assert_sym_equal(ns["Js"], sp.Matrix([[0, 0, 0, c1], [0, 0, 0, s1], [1, 0, 0, 0], [0, 0, c1, -(H + t2) * s1],
-                                          [0, 0, s1, (H + t2) * c1], [0, 1, 0, 0]]), "3.2 J_s")
-    assert_sym_equal(ns["Jb"], sp.Matrix([[0, 0, 0, 1], [s4, 0, 0, 0], [c4, 0, 0, 0], [0, 0, 1, 0],
-                                          [(L2 + t3) * c4, s4, 0, 0], [-(L2 + t3) * s4, c4, 0, 0]]), "3.3 J_b")
-    assert_sym_equal(ns["J"], sp.Matrix([[0, 0, 0, c1], [0, 0, 0, s1], [1, 0, 0, 0], [-(L2 + t3) * s1, 0, c1, 0],
-                                         [(L2 + t3) * c1, 0, s1, 0], [0, 1, 0, 0]]), "3.4 J")
+    assert_sym_equal(
+        ns["T"],
+        sp.Matrix(
+            [
+                [c1, -c4 * s1, s1 * s4, (L2 + t3) * c1],
+                [s1, c1 * c4, -c1 * s4, (L2 + t3) * s1],
+                [0, s4, c4, H + t2],
+                [0, 0, 0, 1],
+            ]
+        ),
+        "3.1 T",
+    )
+    assert_sym_equal(
+        ns["Js"],
+        sp.Matrix(
+            [
+                [0, 0, 0, c1],
+                [0, 0, 0, s1],
+                [1, 0, 0, 0],
+                [0, 0, c1, -(H + t2) * s1],
+                [0, 0, s1, (H + t2) * c1],
+                [0, 1, 0, 0],
+            ]
+        ),
+        "3.2 J_s",
+    )
+    assert_sym_equal(
+        ns["Jb"],
+        sp.Matrix(
+            [
+                [0, 0, 0, 1],
+                [s4, 0, 0, 0],
+                [c4, 0, 0, 0],
+                [0, 0, 1, 0],
+                [(L2 + t3) * c4, s4, 0, 0],
+                [-(L2 + t3) * s4, c4, 0, 0],
+            ]
+        ),
+        "3.3 J_b",
+    )
+    assert_sym_equal(
+        ns["J"],
+        sp.Matrix(
+            [
+                [0, 0, 0, c1],
+                [0, 0, 0, s1],
+                [1, 0, 0, 0],
+                [-(L2 + t3) * s1, 0, c1, 0],
+                [(L2 + t3) * c1, 0, s1, 0],
+                [0, 1, 0, 0],
+            ]
+        ),
+        "3.4 J",
+    )
     # independent: modern_robotics at L1 = 1, L2 = 0.6
     M = np.array([[1, 0, 0, 0.6], [0, 1, 0, 0], [0, 0, 1, 1.6], [0, 0, 0, 1.0]])
     S = np.array([[0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 1], [0, 0, 0, 1, 0, 0], [1, 0, 0, 0, 1.6, 0]], dtype=float).T

@@ -4,6 +4,7 @@ Where the printed solution disagrees with computation, the computed result is pi
 notebook shows both: 6.2's Jᵀ J (eq. 60) and V·V (eq. 61) miss a +1 in the (1, 1) entry. 5.1's printed
 "θ2 = 0.5 sin⁻¹(−1)" (eq. 44) is one branch of the family pinned below.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -12,7 +13,14 @@ import sympy as sp
 from kinlib import robots
 from kinlib.manipulability import manipulability, strongest_joints, twist_speed, twist_speed_form
 from kinlib.singularities import (
-    K, column_space, evaluate_at, left_null_space, rank_at, representatives, singular_configurations, task_rows,
+    K,
+    column_space,
+    evaluate_at,
+    left_null_space,
+    rank_at,
+    representatives,
+    singular_configurations,
+    task_rows,
 )
 
 pi = sp.pi
@@ -23,9 +31,11 @@ def test_4_1_contributions_and_choices():
     L1, L2, L3 = arm.params
     L = sp.Symbol("L", positive=True)
     Jp = task_rows(arm.jacobian_geometric(), ["vx", "vy"]).subs({L1: L, L2: L, L3: L}) / L
-    cases = {"a": ([-pi / 8, pi / 4, pi / 8], 0, [-0.70711, -1.08979, -0.70711], 2),
-             "b": ([3 * pi / 4, -pi / 4, 0], 0, [-2.70711, -2.0, -1.0], 1),
-             "c": ([pi / 2, -pi / 8, -pi / 2], 1, [1.30656, 1.30656, 0.92388], (1, 2))}
+    cases = {
+        "a": ([-pi / 8, pi / 4, pi / 8], 0, [-0.70711, -1.08979, -0.70711], 2),
+        "b": ([3 * pi / 4, -pi / 4, 0], 0, [-2.70711, -2.0, -1.0], 1),
+        "c": ([pi / 2, -pi / 8, -pi / 2], 1, [1.30656, 1.30656, 0.92388], (1, 2)),
+    }
     for q, row, numbers, choice in cases.values():
         vals = evaluate_at(Jp, q, arm.thetas)[row, :]
         assert np.allclose([float(v) for v in vals], numbers, atol=1e-5)
@@ -40,6 +50,7 @@ def test_strongest_joints_numeric_and_bad_input():
     assert strongest_joints(np.array([1.0, -1.0, 0.2])) == (1, 2)
     assert strongest_joints(sp.Matrix([[sp.sqrt(2), -sp.sqrt(2), 1]])) == (1, 2)
     import pytest
+
     with pytest.raises(ValueError, match="real numbers"):
         strongest_joints(sp.Matrix([[sp.Symbol("x"), 1]]))
     with pytest.raises(TypeError, match="row must be"):

@@ -1,4 +1,5 @@
 """The README's Python examples run as written (in order, one namespace), and say what they claim."""
+
 from __future__ import annotations
 
 import re

@@ -1,5 +1,6 @@
 """kinlib.widgets: the explorer and the configuration picker react to their controls and say the right
 thing about singular configurations (known independently: problem 5.1's θ2 = −π/4, the UR5 at home)."""
+
 import math
 
 import matplotlib
@@ -25,9 +26,23 @@ def tool_position(chain, q):
     return mr.FKinSpace(np.array(chain.M, float), np.array(chain.screws, float), np.asarray(q, float))[:3, 3]
 
 
-@pytest.mark.parametrize("make", [lambda: robots.cart_pole(1, 1), lambda: robots.planar_offset_3r(1),
-                                  lambda: robots.spatial_rppr(1, 1), lambda: robots.planar_3r(1, 1, 1),
-                                  lambda: robots.planar_rpp(1), lambda: robots.ur5()])
+def pdot_fd(chain, q, qdot, h=1e-6):
+    """ṗ by central differences of the modern_robotics forward kinematics."""
+    q, qdot = np.asarray(q, float), np.asarray(qdot, float)
+    return (tool_position(chain, q + h * qdot) - tool_position(chain, q - h * qdot)) / (2 * h)
+
+
+@pytest.mark.parametrize(
+    "make",
+    [
+        lambda: robots.cart_pole(1, 1),
+        lambda: robots.planar_offset_3r(1),
+        lambda: robots.spatial_rppr(1, 1),
+        lambda: robots.planar_3r(1, 1, 1),
+        lambda: robots.planar_rpp(1),
+        lambda: robots.ur5(),
+    ],
+)
 def test_explorer_builds_for_every_robot(make):
     chain = make()
     ex = widgets.explorer(chain)
@@ -75,8 +90,7 @@ def test_slider_step_reaches_the_singular_value(r3):
 def test_explorer_readout_matches_the_kinematics(r3):
     q, qdot = [0.2, -0.7, 0.5], [0.5, -1.0, 0.25]
     ex = widgets.explorer(r3, q=q, qdot=qdot)
-    h = 1e-6
-    pdot = (tool_position(r3, np.add(q, h * np.array(qdot))) - tool_position(r3, np.subtract(q, h * np.array(qdot)))) / (2 * h)
+    pdot = pdot_fd(r3, q, qdot)
     np.testing.assert_allclose(ex.velocity.velocity, pdot[:2], atol=1e-6)
     J = mr.JacobianSpace(np.array(r3.screws, float), np.array(q))[[2, 3, 4]]
     assert ex.info["det"] == pytest.approx(np.linalg.det(J), abs=1e-9)
@@ -87,7 +101,7 @@ def test_explorer_readout_matches_the_kinematics(r3):
     ex.rate_sliders[0].value = 2.0
     assert ex.velocity.artist is arrow
     qd = [2.0, -1.0, 0.25]
-    pdot = (tool_position(r3, np.add(q, h * np.array(qd))) - tool_position(r3, np.subtract(q, h * np.array(qd)))) / (2 * h)
+    pdot = pdot_fd(r3, q, qd)
     np.testing.assert_allclose(ex.velocity.velocity, pdot[:2], atol=1e-6)
 
 
@@ -101,8 +115,10 @@ def test_explorer_updates_artists_in_place(r3):
     assert len(ex.ax.get_children()) == children
     np.testing.assert_allclose(ex.q, [0, 0, -1.0])
     # the cached-background picture equals a full redraw of the same state
-    from PIL import Image
     import io
+
+    from PIL import Image
+
     fast = np.asarray(Image.open(io.BytesIO(ex.image.value)))
     for a in ex._blit.artists:
         a.set_animated(False)
@@ -120,7 +136,7 @@ def test_ur5_home_is_singular():
 
 
 def test_explorer_bad_input(r3):
-    with pytest.raises(ValueError, match="subs"):
+    with pytest.raises(ValueError, match=r"symbolic.*\bL\b"):  # names the parameter without a number
         widgets.explorer(robots.planar_offset_3r())
     with pytest.raises(ValueError, match="q must hold 3"):
         widgets.explorer(r3, q=[0, 0])
@@ -135,9 +151,11 @@ def test_explorer_bad_input(r3):
     assert (ex.sliders[1].min, ex.sliders[1].max) == (-1, 1)
 
 
-CONFIGS = {"θ = (−π/8, π/4, π/8)": [-math.pi / 8, math.pi / 4, math.pi / 8],
-           "θ = (3π/4, −π/4, 0)": [3 * math.pi / 4, -math.pi / 4, 0],
-           "θ = (π/2, −π/8, −π/2)": [math.pi / 2, -math.pi / 8, -math.pi / 2]}
+CONFIGS = {
+    "θ = (−π/8, π/4, π/8)": [-math.pi / 8, math.pi / 4, math.pi / 8],
+    "θ = (3π/4, −π/4, 0)": [3 * math.pi / 4, -math.pi / 4, 0],
+    "θ = (π/2, −π/8, −π/2)": [math.pi / 2, -math.pi / 8, -math.pi / 2],
+}
 
 
 def test_config_picker_problem_4_1():
@@ -187,3 +205,46 @@ def test_importing_widgets_leaves_pyplot_figures_alone(r3):
     widgets.explorer(r3)
     widgets.config_picker(robots.planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]})
     assert len(plt.get_fignums()) == n  # no extra static copy under the inline backend
+
+
+# --- the task space of the arm (kinlib.taskspace.default_task_rows) --------------------------------
+def test_2r_explorer_sees_the_stretched_out_singularity():
+    """A student's 2R arm: its task space is (ṗ_x, ṗ_y); at θ2 = 0 (stretched out) they lose rank.
+    (All six rows of J have rank 2 everywhere, so testing them called this configuration regular.)"""
+    chain = robots.planar_2r(1, 1)
+    ex = widgets.explorer(chain, q=[0.4, 0.0])
+    assert ex.rows == (3, 4)
+    assert ex.state == "singular" and "SINGULAR configuration" in ex.status.value
+    assert ex.info["rank"] == 1 and ex.info["full_rank"] == 2
+    # independently: det of the ṗ rows from modern_robotics' forward kinematics is L1 L2 sin θ2
+    assert ex.info["det"] == pytest.approx(math.sin(0.0), abs=1e-12)
+    ex.update([0.4, 1.0])
+    assert ex.state == "regular" and "singular" not in ex.status.value.lower()
+    assert ex.info["det"] == pytest.approx(math.sin(1.0), abs=1e-9)
+    ex.sliders[1].value = 0.0  # a slider move back to the stretched-out arm
+    assert ex.state == "singular"
+    assert "task rows of J: (ṗ_x, ṗ_y)" in ex.readout.value
+
+
+def test_default_rows_follow_the_arm():
+    assert widgets.explorer(robots.planar_offset_3r(1)).rows == (2, 3, 4)  # planar, 3 joints
+    assert widgets.explorer(robots.cart_pole(1, 1)).rows == (3, 4)  # planar, 2 joints
+    assert widgets.explorer(robots.spatial_rppr(1, 1)).rows == (3, 4, 5)  # spatial, 4 joints
+    assert widgets.explorer(robots.ur5(), rate_sliders=False).rows == tuple(range(6))
+    assert widgets.explorer(robots.planar_2r(1, 1), rows="planar").rows == (2, 3, 4)  # asked for: as given
+
+
+def test_classify_is_rank_below_min_m_n():
+    rng = np.random.default_rng(5)
+    for m, n in ((2, 3), (3, 3), (6, 4), (3, 2)):
+        A = rng.normal(size=(m, n))
+        assert widgets.classify(A)["state"] != "singular"
+        U, s, Vt = np.linalg.svd(A, full_matrices=False)
+        s[-1] = 0.0  # one rank less than min(m, n)
+        info = widgets.classify((U * s) @ Vt)
+        assert info["state"] == "singular" and info["rank"] == min(m, n) - 1 == info["full_rank"] - 1
+        assert info["manipulability"] == pytest.approx(0.0, abs=1e-12)
+        assert (info["det"] is None) == (m != n)
+    # a tall J (n < m) of full column rank is regular: w = √det(JᵀJ) > 0
+    info = widgets.classify(np.vstack([np.eye(2), np.zeros((4, 2))]))
+    assert info["state"] == "regular" and info["manipulability"] == pytest.approx(1.0)

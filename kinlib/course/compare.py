@@ -1,17 +1,30 @@
 """Instructor side of the checker: compare the JSON a student kernel sent with the reference's.
 
 Everything here works on plain JSON data (numbers, strings, lists) produced by
-:mod:`kinlib._grade_probe`; nothing from a submission is evaluated. Each comparison returns
+:mod:`kinlib.course.probe`; nothing from a submission is evaluated. Each comparison returns
 ``(ok, message)``; messages name the mistake when it is recognizable (wrong shape, transposed,
 wrong sign, columns swapped, [v; ω] instead of [ω; v], degrees instead of radians, a missing or
 extra variable) without printing the reference answer.
 """
+
 from __future__ import annotations
 
 import math
 from fractions import Fraction
 
 import numpy as np
+
+__all__ = [
+    "compare",
+    "compare_expr",
+    "compare_subspace",
+    "compare_set",
+    "compare_choice",
+    "COMPARE",
+    "NOT_ANSWERED",
+    "RTOL",
+    "ATOL",
+]
 
 RTOL, ATOL = 1e-6, 1e-8
 
@@ -89,7 +102,14 @@ def _entries(idx, shape):
 
 
 def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
-    """Matrices and expressions as functions of the symbols: same shape, same values at the points."""
+    """Matrices and expressions as functions of the symbols: same shape, same values at the points.
+
+    >>> ref = {"shape": [1, 2], "symbols": [], "values": [[[1.0, 0.0], [2.0, 0.0]]]}
+    >>> compare_expr(dict(ref, tag="matrix"), ref, "v")
+    (True, '')
+    >>> compare_expr(dict(ref, tag="matrix", shape=[2, 1]), ref, "v")
+    (False, 'v is transposed: yours is 2×1, expected 1×2')
+    """
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
@@ -109,8 +129,10 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
         rshape = sshape
     if sshape != rshape:
         if len(sshape) == 2 and sshape[::-1] == rshape:
-            return False, (f"{name} is transposed: yours is {_fmt_shape(sshape)}, expected "
-                           f"{_fmt_shape(rshape)}" + (" (one column per joint)" if rshape[0] == 6 else ""))
+            return False, (
+                f"{name} is transposed: yours is {_fmt_shape(sshape)}, expected "
+                f"{_fmt_shape(rshape)}" + (" (one column per joint)" if rshape[0] == 6 else "")
+            )
         return False, f"{name} has the wrong shape: yours is {_fmt_shape(sshape)}, expected {_fmt_shape(rshape)}"
     if stu.get("undefined"):
         return False, f"{name} contains undefined functions {', '.join(stu['undefined'])}"
@@ -137,8 +159,10 @@ def _diagnose(S, R, shape, stu) -> str:
     if r == c and r > 1 and _close(S3, np.swapaxes(R3, 1, 2)):
         return "is transposed"
     if r == 6 and _close(S3, np.concatenate([R3[:, 3:], R3[:, :3]], axis=1)):
-        return ("has the rows in [v; ω] order: the textbook stacks angular first, [ω; v] "
-                "(rows 1–3 angular, rows 4–6 linear)")
+        return (
+            "has the rows in [v; ω] order: the textbook stacks angular first, [ω; v] "
+            "(rows 1–3 angular, rows 4–6 linear)"
+        )
     if c > 1:
         perm = _match(S3, R3, axis=2)
         if perm is not None and perm != list(range(c)):
@@ -160,12 +184,13 @@ def _diagnose(S, R, shape, stu) -> str:
         if abs(abs(ratio) - 180 / math.pi) < 1e-6 * 180 / math.pi or abs(abs(ratio) - math.pi / 180) < 1e-9:
             return "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)"
         if abs(ratio - 1) < 1e-2:
-            return (f"is {ratio:.6g} times the answer: rounded decimals? Use exact values "
-                    "(sp.sqrt(2), sp.pi, sp.Rational(1, 3))")
+            return (
+                f"is {ratio:.6g} times the answer: rounded decimals? Use exact values "
+                "(sp.sqrt(2), sp.pi, sp.Rational(1, 3))"
+            )
         return f"is off by a constant factor ({ratio:.6g} times the answer)"
     if stu.get("degrees"):
-        return ("looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, "
-                "write sp.pi/4")
+        return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
     if S.shape[1] > 1:
         return f"differs in entries {_entries(bad, shape)}"
     return "has the wrong value"
@@ -199,6 +224,7 @@ def _const_ratio(S, R):
 
 # ----------------------------------------------------------------------------- subspaces
 
+
 def _rank(A, tol=1e-7):
     if A.size == 0:
         return 0
@@ -207,7 +233,12 @@ def _rank(A, tol=1e-7):
 
 
 def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
-    """A subspace by its span: rank [A B] = rank A = rank B at every point."""
+    """A subspace by its span: rank [A B] = rank A = rank B at every point.
+
+    >>> ref = {"shape": [2, 1], "symbols": [], "values": [[[1.0, 0.0], [0.0, 0.0]]]}
+    >>> compare_subspace(dict(ref, tag="matrix", values=[[[3.0, 0.0], [0.0, 0.0]]]), ref, "s")
+    (True, '')
+    """
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
@@ -219,8 +250,9 @@ def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
         return False, f"{name} could not be evaluated at some values of the symbols"
     if sshape[0] != rshape[0]:
         if sshape[1] == rshape[0]:
-            return False, (f"{name} gives the vectors as rows ({_fmt_shape(sshape)}): put one vector "
-                           f"per column ({rshape[0]} rows)")
+            return False, (
+                f"{name} gives the vectors as rows ({_fmt_shape(sshape)}): put one vector per column ({rshape[0]} rows)"
+            )
         return False, f"{name} has vectors of length {sshape[0]}; expected {rshape[0]}"
     notes = _symbol_notes(stu, ref)
     for p in range(S.shape[0]):
@@ -230,17 +262,22 @@ def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
         if ra != rb:
             what = "too small" if ra < rb else "too large"
             dep = f" ({sshape[1]} columns, {ra} independent)" if sshape[1] != ra else ""
-            return False, (f"{name} spans a {ra}-dimensional space{dep}; the answer is {rb}-dimensional "
-                           f"({what})" + (f"; {notes[0]}" if notes else ""))
+            return False, (
+                f"{name} spans a {ra}-dimensional space{dep}; the answer is {rb}-dimensional "
+                f"({what})" + (f"; {notes[0]}" if notes else "")
+            )
         if rab != rb:
-            return False, (f"{name} spans a {ra}-dimensional space of the right dimension but not the "
-                           "right one (some of your directions are not in the answer's span)"
-                           + (f"; {'; '.join(notes)}" if notes else ""))
+            return False, (
+                f"{name} spans a {ra}-dimensional space of the right dimension but not the "
+                "right one (some of your directions are not in the answer's span)"
+                + (f"; {'; '.join(notes)}" if notes else "")
+            )
     extra = "" if sshape[1] == rshape[1] else f"same span (you gave {sshape[1]} columns)"
     return True, extra
 
 
 # ----------------------------------------------------------------------------- sets of configurations
+
 
 def _wrap(x):
     y = math.remainder(x, 2 * math.pi)
@@ -263,8 +300,7 @@ def _same(a, b):
 
 
 def _canon_intervals(ivs):
-    return sorted([float(a) if a is not None else -math.inf, float(b) if b is not None else math.inf]
-                  for a, b in ivs)
+    return sorted([float(a) if a is not None else -math.inf, float(b) if b is not None else math.inf] for a, b in ivs)
 
 
 def _empty(c):
@@ -307,13 +343,20 @@ def _cond_match(s, r, periodic):
 
 
 def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple[bool, str]:
-    """Sets of configurations as sets: the same conditions, each with the same members (angles modulo 2π)."""
+    """Sets of configurations as sets: the same conditions, each with the same members (angles modulo 2π).
+
+    >>> ref = {"conditions": [[[{"var": "theta1", "points": [0.0], "intervals": []}]]]}
+    >>> stu = {"tag": "set", "conditions": [[[{"var": None, "points": [6.283185307179586], "intervals": []}]]]}
+    >>> compare_set(stu, ref, "S")
+    (True, '')
+    """
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
     if stu.get("tag") != "set":
-        return False, (f"{name} is a {stu.get('type')}; expected a SymPy Set, a dict {{symbol: Set}} or a list "
-                       "of those")
+        return False, (
+            f"{name} is a {stu.get('type')}; expected a SymPy Set, a dict {{symbol: Set}} or a list of those"
+        )
     for sp_, rp in zip(stu["conditions"], ref["conditions"]):
         ref_vars = {c.get("var") for cond in rp for c in cond if c.get("var") is not None}
         rc, sc = _conds(rp, ref_vars), _conds(sp_, ref_vars)
@@ -342,8 +385,10 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
         for r in rc:
             hit = next((s for s in unmatched if _cond_match(s, r, periodic)[0]), None)
             if hit is None:
-                return False, (f"{name}: {len(sc)} condition(s) given, {len(rc)} expected, and not all of them "
-                               f"match (conditions on {', '.join(sorted(map(str, r)))})")
+                return False, (
+                    f"{name}: {len(sc)} condition(s) given, {len(rc)} expected, and not all of them "
+                    f"match (conditions on {', '.join(sorted(map(str, r)))})"
+                )
             unmatched.remove(hit)
         if unmatched:
             return False, f"{name} has {len(unmatched)} condition(s) more than the answer"
@@ -354,6 +399,7 @@ def _compare_component(s, r, periodic):
     if "tuples" in r or "tuples" in s:
         if "tuples" not in s or "tuples" not in r:
             return False, "expected a set of configurations (tuples)"
+
         def canon(ts):
             out = []
             for t in ts:
@@ -361,6 +407,7 @@ def _compare_component(s, r, periodic):
                 if not any(len(t) == len(u) and all(abs(a - b) < 1e-6 for a, b in zip(t, u)) for u in out):
                     out.append(t)
             return sorted(out)
+
         a, b = canon(s["tuples"]), canon(r["tuples"])
         if len(a) == len(b) and all(len(x) == len(y) and _same(x, y) for x, y in zip(a, b)):
             return True, ""
@@ -381,12 +428,15 @@ def _compare_component(s, r, periodic):
     wrong = [x for x in sp_ if not any(abs(x - y) < 1e-6 for y in rp)]
     where = " (compared modulo 2π)" if periodic else ""
     if wrong:
-        return False, (f"{', '.join(_pi_multiple(x) for x in wrong[:4])} "
-                       f"{'is' if len(wrong) == 1 else 'are'} not in the set{where}")
+        return False, (
+            f"{', '.join(_pi_multiple(x) for x in wrong[:4])} "
+            f"{'is' if len(wrong) == 1 else 'are'} not in the set{where}"
+        )
     return False, f"{len(missing)} value(s) of the set are missing{where}"
 
 
 # ----------------------------------------------------------------------------- choices
+
 
 def _canon_choice(x):
     if isinstance(x, list):
@@ -401,7 +451,13 @@ def _hashable(x):
 
 
 def compare_choice(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
-    """Choices (joint numbers, 1-based; ties as tuples) compared as sets."""
+    """Choices (joint numbers, 1-based; ties as tuples) compared as sets.
+
+    >>> compare_choice({"tag": "choice", "value": [2, 1]}, {"value": [1, 2]}, "j")
+    (True, '')
+    >>> compare_choice({"tag": "choice", "value": [1]}, {"value": [1, 2]}, "j")[1]
+    'j: partly right, but more than one choice is correct (a tie counts: give a tuple)'
+    """
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
@@ -425,6 +481,12 @@ COMPARE = {"expr": compare_expr, "subspace": compare_subspace, "set": compare_se
 
 
 def compare(kind: str, stu: dict, ref: dict, name: str) -> tuple[bool, str]:
+    """``(ok, message)`` for the student's description ``stu`` of answer ``name`` against the reference's
+    (other kinds compare as ``expr``); never raises.
+
+    >>> compare("choice", {"tag": "ellipsis"}, {"value": 1}, "j")
+    (False, 'j is still `...`: not answered yet')
+    """
     try:
         return COMPARE.get(kind, compare_expr)(stu, ref, name)
     except Exception as exc:  # noqa: BLE001  malformed data from a kernel must not stop the batch

@@ -1,25 +1,28 @@
 """Self-checks for student workbooks: is an answer right, without revealing it.
 
-At build time (``python -m kinlib.handouts``) each reference answer is turned into a *fingerprint*:
+At build time (``kinlib handouts``) each reference answer is turned into a *fingerprint*:
 the answer evaluated at fixed sample values of its symbols (the same values for a symbol of the same
 name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA-256). The workbook
 holds only the fingerprint; the student's answer is fingerprinted the same way when the self-check
 cell runs, so a right answer in any equivalent form (simplified or not, floats or exact) passes::
 
-    from kinlib.selfcheck import check
+    from kinlib.course.selfcheck import check
     check("2.2", Js="matrix|6x3|3f0c1b9e5a7d2c44")
 
-Kinds of answer (``kinds`` in the solution cell's ``kinlib`` metadata):
+Kinds of answer (``kinds`` in the solution cell's ``kinlib`` metadata; the forms each accepts are
+those of :mod:`kinlib.course.answers`, the normaliser the instructor checker uses too):
 
 - default / ``"expr"``: a SymPy Matrix, expression or number, compared as a function of its symbols;
-- ``"choice"``: an int, string or tuple of them (joint numbers 1-based; order ignored);
-- ``"set"``: a SymPy Set (or Python set/list of values, or a dict {symbol: Set}), compared through its
-  points in [-2π, 2π] taken modulo 2π (angles), intervals by their end points;
+- ``"choice"``: an int, string or tuple of them (joint numbers 1-based; order and repeats ignored);
+- ``"set"``: a SymPy Set (or Python set/list of values, a number, a dict {symbol: Set} or a list of
+  those dicts), compared through its points in [-2π, 2π] taken modulo 2π (angles), intervals by their
+  end points;
 - ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector.
 
-In a workbook, ``%load_ext kinlib.selfcheck`` adds the cell magic ``%%needs NAME...``: the cell runs
+In a workbook, ``%load_ext kinlib.course.selfcheck`` adds the cell magic ``%%needs NAME...``: the cell runs
 only once the names it uses from the student's answers are filled in, and says so otherwise.
 """
+
 from __future__ import annotations
 
 import hashlib
@@ -30,33 +33,87 @@ import sys
 import numpy as np
 import sympy as sp
 
-__all__ = ["check", "fingerprint", "describe_answer", "Unanswered", "CannotCheck", "KINDS",
-           "sample_value", "load_ipython_extension"]
+from . import answers
+from .schema import KINDS
 
-KINDS = ("default", "expr", "choice", "set", "subspace")
-SAMPLE_POINTS = 3          # configurations at which an answer's symbols are sampled
-_DIGITS = 8                # significant digits kept of every sampled value
-_ZERO = 1e-10              # |x| below this counts as 0
-_PROJ_DECIMALS = 6         # decimals kept of a subspace's projector
+__all__ = [
+    "check",
+    "verdict",
+    "fingerprint",
+    "describe_answer",
+    "emit_fingerprints",
+    "Unanswered",
+    "CannotCheck",
+    "WrongForm",
+    "KINDS",
+    "FINGERPRINT_MARK",
+    "last_results",
+    "sample_value",
+    "load_ipython_extension",
+]
+
+FINGERPRINT_MARK = "KINLIB-SELFCHECK "  # starts the line emit_fingerprints prints (read by the handouts)
+SAMPLE_POINTS = 3  # configurations at which an answer's symbols are sampled
+_DIGITS = 8  # significant digits kept of every sampled value
+_ZERO = 1e-10  # |x| below this counts as 0
+_PROJ_DECIMALS = 6  # decimals kept of a subspace's projector
 
 
 class Unanswered(Exception):
-    """The answer variable is missing or still ``...``."""
+    """The answer variable is missing or still ``...``.
+
+    :func:`fingerprint` raises it; :func:`check` says "not answered yet" instead:
+
+    >>> fingerprint(...)
+    Traceback (most recent call last):
+        ...
+    kinlib.course.selfcheck.Unanswered: the value is missing or ...
+    >>> check("1.1", _namespace={}, J=fingerprint(sp.eye(2), salt="1.1:J"))
+    part 1.1 · J: … not answered yet: replace the ... in `J = ...` above with your answer (a 2×2 matrix)
+    """
 
 
 class CannotCheck(Exception):
-    """The answer is of a form the self-check cannot fingerprint (message says why)."""
+    """The answer is of a form the self-check cannot fingerprint (message says why).
+
+    :func:`fingerprint` raises it, e.g. for an undefined function that does not evaluate to a number;
+    :func:`verdict` (and so :func:`check`, with "?") reports it as an error:
+
+    >>> f = sp.Function("f")(sp.Symbol("t"))
+    >>> fingerprint(f)
+    Traceback (most recent call last):
+        ...
+    kinlib.course.selfcheck.CannotCheck: it does not evaluate to a number (Cannot convert expression to float)
+    >>> verdict(f, fingerprint(sp.Symbol("t")))
+    ('error', 'cannot check it automatically: it does not evaluate to a number (Cannot convert expression to float)')
+    """
 
 
 class WrongForm(Exception):
-    """The answer has the wrong type or shape (message says what was expected)."""
+    """The answer has the wrong type or shape (message says what was expected).
+
+    :func:`fingerprint` raises it; :func:`check` reports it as a wrong form:
+
+    >>> fingerprint([[1, 2], [3]])  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    kinlib.course.selfcheck.WrongForm: it should be a SymPy Matrix, expression or number, yours is a list of ...
+    >>> check("1.1", _namespace={"J": sp.eye(3)}, J=fingerprint(sp.eye(2), salt="1.1:J"))
+    part 1.1 · J: ✗ wrong form: it should be a 2×2 matrix, yours is a 3×3 matrix
+    """
 
 
 # ---------------------------------------------------------------------------------------------------
 # Sample values: a fixed exact rational in [0.2, 1.3] per (symbol name, sample index).
 
+
 def sample_value(name: str, k: int) -> sp.Rational:
-    """The value given to every symbol called ``name`` at sample configuration ``k``."""
+    """The value given to every symbol called ``name`` at sample configuration ``k``.
+
+    >>> v = sample_value("theta1", 0)
+    >>> v == sample_value("theta1", 0) and sp.Rational(1, 5) <= v <= sp.Rational(13, 10)
+    True
+    """
     h = hashlib.sha256(f"kinlib-selfcheck:{name}:{k}".encode()).digest()
     u = int.from_bytes(h[:4], "big") % 1_100_000
     return sp.Rational(200_000 + u, 1_000_000)
@@ -107,45 +164,34 @@ def _evaluate_mpmath(x, pt: dict):
     f = sp.lambdify(syms, entries, modules="mpmath", cse=True)
     with mpmath.workdps(30):
         vals = f(*[mpmath.mpf(pt[s].p) / pt[s].q for s in syms])
-        out = [sp.Float(v, 30) if isinstance(v, mpmath.mpf)
-               else sp.Float(mpmath.re(v), 30) + sp.I * sp.Float(mpmath.im(v), 30) if isinstance(v, mpmath.mpc)
-               else sp.sympify(v).evalf(30) for v in vals]
+        out = [
+            sp.Float(v, 30)
+            if isinstance(v, mpmath.mpf)
+            else sp.Float(mpmath.re(v), 30) + sp.I * sp.Float(mpmath.im(v), 30)
+            if isinstance(v, mpmath.mpc)
+            else sp.sympify(v).evalf(30)
+            for v in vals
+        ]
     return sp.Matrix(x.rows, x.cols, out) if isinstance(x, sp.MatrixBase) else out[0]
 
 
 # ---------------------------------------------------------------------------------------------------
 # Canonical forms, one per kind.
 
-def _is_unanswered(value) -> bool:
-    return value is Ellipsis or value is None
+_FORM_WORDS = {
+    "array": "an array with more than 2 dimensions",
+    "empty": "an empty list",
+    "ragged": "a list of vectors of different lengths",
+}
 
 
-def _as_sympy_value(value):
-    """Matrices, arrays, lists of numbers -> SymPy Matrix; numbers/expressions -> SymPy."""
-    if isinstance(value, sp.MatrixBase):
-        return sp.Matrix(value)
-    if isinstance(value, np.ndarray):
-        if value.ndim == 0:
-            return sp.sympify(value.item())
-        if value.ndim > 2:
-            raise WrongForm(f"it should be a matrix or a number, yours is an array of shape {value.shape}")
-        return sp.Matrix(value.tolist())
-    if isinstance(value, (list, tuple)):
-        try:
-            return sp.Matrix(value)
-        except Exception:
-            raise WrongForm(f"it should be a SymPy Matrix, expression or number; yours is a "
-                            f"{type(value).__name__} that is not a matrix") from None
-    if isinstance(value, (str, bytes, dict, set)):
-        raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is a {type(value).__name__}")
-    try:
-        v = sp.sympify(value, strict=True)
-    except (sp.SympifyError, TypeError):
-        raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is a "
-                        f"{type(value).__name__}") from None
-    if isinstance(v, sp.MatrixBase):
-        return sp.Matrix(v)
-    return v
+def _as_sympy_value(value, vectors: bool = False):
+    """The answer as a SymPy Matrix or expression (:func:`kinlib.course.answers.to_sympy`), or WrongForm."""
+    tag, v = answers.to_sympy(value, vectors=vectors)
+    if v is not None:
+        return v
+    what = _FORM_WORDS.get(tag, f"a {type(value).__name__}")
+    raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is {what}")
 
 
 def _shape_of(v) -> str:
@@ -153,9 +199,9 @@ def _shape_of(v) -> str:
 
 
 def _canon_default(value, shape: str | None = None):
-    if isinstance(value, (bool, np.bool_, sp.logic.boolalg.BooleanAtom)):     # a yes/no answer
+    if answers.is_bool(value):  # a yes/no answer
         return "bool", "", [str(bool(value))]
-    if isinstance(value, dict) or shape == "dict":        # e.g. {configuration name: row of J}
+    if isinstance(value, dict) or shape == "dict":  # e.g. {configuration name: row of J}
         if not isinstance(value, dict):
             raise WrongForm(f"it should be a dict, yours is a {type(value).__name__}")
         items = sorted(value.items(), key=lambda kv: str(kv[0]))
@@ -163,7 +209,7 @@ def _canon_default(value, shape: str | None = None):
     v = _as_sympy_value(value)
     if isinstance(v, sp.MatrixBase):
         mine = _shape_of(v)
-        if shape == "" and v.shape == (1, 1):      # a 1x1 Matrix for a scalar answer
+        if shape == "" and v.shape == (1, 1):  # a 1x1 Matrix for a scalar answer
             v, mine = v[0, 0], ""
         elif shape not in (None, mine):
             raise WrongForm(f"it should be {_shape_words(shape)}, yours is {_shape_words(mine)}")
@@ -178,40 +224,29 @@ def _canon_default(value, shape: str | None = None):
     return "scalar", "", pts
 
 
-def _choice_item(x):
-    if isinstance(x, (bool, np.bool_)):
-        return f"b:{bool(x)}"
+def _choice_canon(x):
+    """A choice value (:func:`kinlib.course.answers.choice_value`) as sorted tagged strings (ties nested)."""
+    if isinstance(x, list):
+        if all(not isinstance(e, list) for e in x):
+            return sorted({_choice_item(e) for e in x})
+        return ["T", [_choice_canon(e) for e in x]]
+    return [_choice_item(x)]
+
+
+def _choice_item(x) -> str:
+    if isinstance(x, bool):
+        return f"b:{x}"
     if isinstance(x, str):
-        return "s:" + " ".join(x.strip().lower().split())
-    try:
-        xi = sp.sympify(x, strict=True)
-    except (sp.SympifyError, TypeError):
-        raise WrongForm(f"choices are numbers or strings, yours holds a {type(x).__name__}") from None
-    if isinstance(xi, sp.Integer) or (xi.is_number and xi == int(xi)):
-        return f"i:{int(xi)}"
-    if xi.is_number:
-        return "n:" + _fmt(xi)
-    raise WrongForm(f"choices are numbers or strings, yours holds {xi}")
+        return "s:" + x
+    if isinstance(x, int):
+        return f"i:{x}"
+    if isinstance(x, float):
+        return "n:" + _fmt(x)
+    raise WrongForm(f"choices are numbers or strings, yours holds a {x['other'].rsplit('.', 1)[-1]}")
 
 
-def _canon_choice(value, shape=None):
-    if isinstance(value, (list, tuple, set, frozenset, sp.FiniteSet, sp.Tuple)):
-        items = sorted(_choice_item(x) for x in value)
-    elif isinstance(value, np.ndarray):
-        items = sorted(_choice_item(x) for x in value.ravel().tolist())
-    else:
-        items = [_choice_item(value)]
-    return "choice", "", items
-
-
-def _to_set(value):
-    if isinstance(value, sp.Set):
-        return value
-    if isinstance(value, (set, frozenset, list, tuple)):
-        return sp.FiniteSet(*[sp.sympify(v) for v in value])
-    if isinstance(value, (int, float, sp.Expr)):
-        return sp.FiniteSet(value)
-    raise WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
+def _canon_choice(value):
+    return "choice", "", _choice_canon(answers.choice_value(value))
 
 
 def _angle_point(p, k):
@@ -230,7 +265,10 @@ def _angle_point(p, k):
 
 
 def _canon_one_set(s, k):
-    s = _to_set(s)
+    try:
+        s = answers.to_set(s)
+    except TypeError as e:
+        raise WrongForm(str(e).replace("a set should be", "it should be")) from None
     pt = _point(s, k)
     if pt:
         s = s.subs(pt)
@@ -245,8 +283,10 @@ def _canon_one_set(s, k):
         if isinstance(part, sp.FiniteSet):
             out.update(_angle_point(p, k) for p in part)
         elif isinstance(part, sp.Interval):
-            out.add(f"I{'(' if part.left_open else '['}{_fmt(part.start.evalf(30))},"
-                    f"{_fmt(part.end.evalf(30))}{')' if part.right_open else ']'}")
+            out.add(
+                f"I{'(' if part.left_open else '['}{_fmt(part.start.evalf(30))},"
+                f"{_fmt(part.end.evalf(30))}{')' if part.right_open else ']'}"
+            )
         elif part is sp.S.EmptySet:
             pass
         else:
@@ -254,20 +294,29 @@ def _canon_one_set(s, k):
     return sorted(out)
 
 
-def _canon_set(value, shape=None):
-    if isinstance(value, dict):
-        out = []
-        for key in sorted(value, key=str):
-            out.append([str(key)] + [_canon_one_set(value[key], k) for k in range(SAMPLE_POINTS)])
-        return "set", "dict", out
-    return "set", "", [_canon_one_set(value, k) for k in range(SAMPLE_POINTS)]
+def _canon_condition(cond: list) -> list:
+    return [
+        [str(key)] + [_canon_one_set(s, k) for k in range(SAMPLE_POINTS)]
+        for key, s in sorted(cond, key=lambda kv: str(kv[0]))
+    ]
+
+
+def _canon_set(value):
+    """A dict {symbol: Set} is shape "dict", a list of several such dicts (a union) "union", the rest ""."""
+    conds = answers.set_conditions(value)
+    if conds is None:
+        raise WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
+    if len(conds) == 1 and conds[0] and conds[0][0][0] is None:
+        return "set", "", [_canon_one_set(conds[0][0][1], k) for k in range(SAMPLE_POINTS)]
+    if not conds:
+        return "set", "", [_canon_one_set(sp.S.EmptySet, k) for k in range(SAMPLE_POINTS)]
+    if len(conds) == 1:
+        return "set", "dict", _canon_condition(conds[0])
+    return "set", "union", sorted((_canon_condition(c) for c in conds), key=json.dumps)
 
 
 def _canon_subspace(value, shape=None):
-    if isinstance(value, (list, tuple)) and value and all(
-            isinstance(c, (sp.MatrixBase, np.ndarray, list, tuple)) for c in value):
-        value = sp.Matrix.hstack(*[sp.Matrix(c) for c in value])   # a list of spanning vectors
-    v = _as_sympy_value(value)
+    v = _as_sympy_value(value, vectors=True)  # a list of spanning vectors: side by side
     if not isinstance(v, sp.MatrixBase):
         raise WrongForm("it should be a Matrix whose columns span the subspace")
     m = str(v.shape[0])
@@ -294,8 +343,13 @@ def _canon_subspace(value, shape=None):
     return "subspace", m, pts
 
 
-_CANON = {"default": _canon_default, "expr": _canon_default, "choice": _canon_choice,
-          "set": _canon_set, "subspace": _canon_subspace}
+_CANON = {
+    "default": _canon_default,
+    "expr": _canon_default,
+    "choice": _canon_choice,
+    "set": _canon_set,
+    "subspace": _canon_subspace,
+}
 
 
 def _shape_words(shape: str) -> str:
@@ -315,30 +369,39 @@ def _hash(kind, canon, salt: str = "") -> str:
 def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     """The spec string of ``value``: ``"<form>|<shape>|<hash>"`` (no information about the value itself).
 
-    ``form`` is matrix/scalar/choice/set/subspace; ``shape`` is ``"6x3"`` for a matrix, the ambient
-    dimension for a subspace, ``"dict"`` for a dict of sets. ``salt`` (the workbooks use
-    ``"part:name"``) makes equal answers to different questions hash differently.
+    ``form`` is matrix/scalar/bool/choice/set/subspace; ``shape`` is ``"6x3"`` for a matrix, the ambient
+    dimension for a subspace, ``"dict"`` for a dict of sets (``"union"`` for a list of them). ``salt``
+    (the workbooks use ``"part:name"``) makes equal answers to different questions hash differently.
+
+    >>> fingerprint(sp.Matrix([[1, 2, 3]]), salt="1.1:v")[:11]
+    'matrix|1x3|'
+    >>> fingerprint((2, 1), "choice") == fingerprint([1, 2, 2], "choice")
+    True
     """
     if kind not in _CANON:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    if _is_unanswered(value):
+    if answers.is_unanswered(value):
         raise Unanswered("the value is missing or ...")
     form, shape, canon = _CANON[kind](value)
     return f"{form}|{shape}|{_hash(form, canon, salt)}"
 
 
 def describe_answer(value, kind: str = "default") -> str:
-    """A short description of the form of an answer (for the workbook's stub), e.g. 'a 6×3 Matrix'."""
+    """A short description of the form of an answer (for the workbook's stub), e.g. 'a 6×3 Matrix'.
+
+    >>> describe_answer(sp.zeros(6, 3)), describe_answer(3, "choice"), describe_answer({sp.Symbol("t"): {0}}, "set")
+    ('a 6×3 Matrix', 'a joint number or a tuple of joint numbers (1-based)', 'a dict {symbol: SymPy Set}')
+    """
     if kind == "choice":
         return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"
     if kind == "set":
         return "a dict {symbol: SymPy Set}" if isinstance(value, dict) else "a SymPy Set"
-    if isinstance(value, (bool, np.bool_, sp.logic.boolalg.BooleanAtom)):
+    if answers.is_bool(value):
         return "True or False"
     if kind == "subspace":
         try:
-            return f"a Matrix whose columns span the subspace ({sp.Matrix(value).shape[0]}-vectors)"
-        except Exception:
+            return f"a Matrix whose columns span the subspace ({_as_sympy_value(value, True).shape[0]}-vectors)"
+        except Exception:  # noqa: BLE001
             return "a Matrix whose columns span the subspace"
     try:
         v = None if isinstance(value, dict) else _as_sympy_value(value)
@@ -356,6 +419,7 @@ def describe_answer(value, kind: str = "default") -> str:
 # ---------------------------------------------------------------------------------------------------
 # The student's side.
 
+
 def _parse_spec(spec: str):
     try:
         form, shape, digest = spec.split("|")
@@ -364,16 +428,27 @@ def _parse_spec(spec: str):
     return form, shape, digest
 
 
-_FORM_KIND = {"matrix": "default", "scalar": "default", "bool": "default", "choice": "choice", "set": "set",
-              "subspace": "subspace"}
+_FORM_KIND = {
+    "matrix": "default",
+    "scalar": "default",
+    "bool": "default",
+    "choice": "choice",
+    "set": "set",
+    "subspace": "subspace",
+}
 
 last_results: dict = {}
 
 
 def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
-    """``(status, message)`` for an answer against a spec; status is correct/incorrect/unanswered/error."""
+    """``(status, message)`` for an answer against a spec; status is correct/incorrect/unanswered/error.
+
+    >>> spec = fingerprint(sp.Rational(1, 2), salt="1.1:x")
+    >>> verdict(0.5, spec, salt="1.1:x"), verdict(..., spec, salt="1.1:x")[0]
+    (('correct', 'correct'), 'unanswered')
+    """
     form, shape, digest = _parse_spec(spec)
-    if _is_unanswered(value):
+    if answers.is_unanswered(value):
         return "unanswered", "not answered yet"
     if form == "none":
         return "error", "this answer has no automatic self-check: compare it with the worked solution"
@@ -388,7 +463,9 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
         else:
             mine_form, mine_shape, canon = _CANON[kind](value)
             if kind == "set" and mine_shape != shape:
-                want = "a dict {symbol: Set}" if shape == "dict" else "a single Set"
+                want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(
+                    shape, "a single Set"
+                )
                 raise WrongForm(f"it should be {want}")
     except WrongForm as e:
         return "incorrect", f"wrong form: {e}"
@@ -414,6 +491,9 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
 
     ``specs`` maps variable names to fingerprints made at build time; the variables are looked up
     in the caller's globals (the notebook), so a missing variable reads as "not answered yet".
+
+    >>> check("1.1", _namespace={"x": 0.5}, x=fingerprint(sp.Rational(1, 2), salt="1.1:x"))
+    part 1.1 · x: ✓ correct
     """
     ns = _namespace if _namespace is not None else sys._getframe(1).f_globals
     results = {}
@@ -424,47 +504,71 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
         mark = {"correct": "✓", "incorrect": "✗", "unanswered": "…", "error": "?"}[status]
         if status == "unanswered":
             form, shape, _ = _parse_spec(spec)
-            what = _shape_words(shape) if form in ("matrix", "scalar") else (
-                "see the question" if form == "none" else "True or False" if form == "bool" else f"a {form}")
+            what = (
+                _shape_words(shape)
+                if form in ("matrix", "scalar")
+                else ("see the question" if form == "none" else "True or False" if form == "bool" else f"a {form}")
+            )
             message = f"not answered yet: replace the ... in `{name} = ...` above with your answer ({what})"
         print(f"part {part} · {name}: {mark} {message}")
     last_results[part] = results
 
 
 # ---------------------------------------------------------------------------------------------------
-# Build side: used by kinlib.handouts inside the kernel, right after a part's solution cells ran.
+# Build side: used by kinlib.course.handouts inside the kernel, right after a part's solution cells ran.
 
-def _emit(answers: dict, ns: dict) -> None:
-    """Print one JSON line {name: {"spec", "describe"} | {"error"}} for answers {name: (kind, part)}."""
+
+def emit_fingerprints(specs: dict, ns: dict) -> None:
+    """Print one line, ``FINGERPRINT_MARK`` and the JSON {name: {"spec", "describe"} | {"error"}}, for
+    the answers ``specs`` = {name: (kind, part)} found in the namespace ``ns``.
+
+    >>> emit_fingerprints({"n": ("choice", "1.2")}, {})
+    KINLIB-SELFCHECK {"n": {"error": "the solution cells did not define n"}}
+    """
     out = {}
-    for name, (kind, part) in answers.items():
+    for name, (kind, part) in specs.items():
         if name not in ns:
             out[name] = {"error": f"the solution cells did not define {name}"}
             continue
         try:
-            out[name] = {"spec": fingerprint(ns[name], kind, salt=f"{part}:{name}"),
-                         "describe": describe_answer(ns[name], kind)}
+            out[name] = {
+                "spec": fingerprint(ns[name], kind, salt=f"{part}:{name}"),
+                "describe": describe_answer(ns[name], kind),
+            }
         except Exception as e:
             out[name] = {"error": f"{type(e).__name__}: {e}"}
-    print("KINLIB-SELFCHECK " + json.dumps(out))
+    print(FINGERPRINT_MARK + json.dumps(out))
 
 
 # ---------------------------------------------------------------------------------------------------
 # The %%needs cell magic.
 
+
 def _needs(line: str, cell: str):
     from IPython import get_ipython
+
     ip = get_ipython()
     names = line.split("#", 1)[0].split()
-    missing = [n for n in names if _is_unanswered(ip.user_ns.get(n))]
+    missing = [n for n in names if answers.is_unanswered(ip.user_ns.get(n))]
     if missing:
-        print(f"(skipped: this cell uses {', '.join(missing)} from your answers above; "
-              f"fill {'them' if len(missing) > 1 else 'it'} in, then run this cell again)")
+        print(
+            f"(skipped: this cell uses {', '.join(missing)} from your answers above; "
+            f"fill {'them' if len(missing) > 1 else 'it'} in, then run this cell again)"
+        )
         return None
     ip.run_cell(cell)
     return None
 
 
 def load_ipython_extension(ip) -> None:
-    """``%load_ext kinlib.selfcheck``: registers the ``%%needs NAME...`` cell magic."""
+    """``%load_ext kinlib.course.selfcheck``: registers the ``%%needs NAME...`` cell magic.
+
+    IPython calls it with the shell; any object with ``register_magic_function`` does here:
+
+    >>> class Shell:
+    ...     def register_magic_function(self, func, magic_kind, magic_name):
+    ...         print(magic_kind, magic_name)
+    >>> load_ipython_extension(Shell())
+    cell needs
+    """
     ip.register_magic_function(_needs, magic_kind="cell", magic_name="needs")

@@ -1,0 +1,7 @@
+"""``python -m kinlib.course``: the ``kinlib`` command (:mod:`kinlib.course.cli`)."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,397 @@
+"""One isolated IPython kernel per submission, driven through jupyter_client, with time and size limits.
+
+The kernel is a fresh ``python -c ... ipykernel`` process in its own session (process group), with the
+scratch directory as its working directory, a unix-socket (ipc) connection, no history database,
+``MPLBACKEND=Agg`` and resource limits (address space, file size, no core dumps). Each cell runs with
+a per-cell time limit; past it the kernel gets SIGINT, and if it does not come back within a grace
+period the whole process group is killed. Outputs are never stored: only their size is counted (so a
+submission printing megabytes costs nothing but the time it spends printing), and errors are kept as
+(ename, evalue, cell index), truncated.
+
+:class:`NotebookRun` runs a whole notebook's code cells in such kernels (restarting past a cell that
+kills one), with the checker's probe (:mod:`kinlib.course.probe` and :mod:`kinlib.course.answers`, sent
+as source text) loaded in a private module first.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import queue
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from jupyter_client import BlockingKernelClient
+from jupyter_client.connect import write_connection_file
+
+from .schema import cell_source, is_plain_selfcheck
+
+__all__ = [
+    "CellResult",
+    "Kernel",
+    "NotebookRun",
+    "PROBE_SOURCE",
+    "ANSWERS_SOURCE",
+    "GUARD_SOURCE",
+    "MAX_RESTARTS",
+    "MAX_RESULT_BYTES",
+]
+
+# the checker's code for the kernel, sent as text (see kinlib.course.probe)
+PROBE_SOURCE = (Path(__file__).parent / "probe.py").read_text()
+ANSWERS_SOURCE = (Path(__file__).parent / "answers.py").read_text()
+GUARD_SOURCE = (Path(__file__).parent / "guard.py").read_text()
+MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
+MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
+
+_LAUNCH = (
+    "import resource, sys\n"
+    "def _lim(r, v):\n"
+    "    try:\n"
+    "        resource.setrlimit(r, (v, v))\n"
+    "    except (ValueError, OSError):\n"
+    "        pass\n"
+    "_lim(resource.RLIMIT_AS, {mem})\n"
+    "_lim(resource.RLIMIT_FSIZE, {fsize})\n"
+    "_lim(resource.RLIMIT_CORE, 0)\n"
+    "sys.path[:] = [p for p in sys.path if p not in ('', '.')]\n"
+    "from ipykernel import kernelapp as app\n"
+    "app.launch_new_instance()\n"
+)
+
+
+@dataclass
+class CellResult:
+    """What happened when one cell ran: status ok | error | timeout | died | skipped.
+
+    >>> CellResult(0, "ok")
+    CellResult(index=0, status='ok', ename='', evalue='', seconds=0.0, output_bytes=0, note='')
+    >>> CellResult(4, "timeout", note="stopped after the 60 s limit for one cell").summary()
+    'stopped after the 60 s limit for one cell'
+    """
+
+    index: int
+    status: str
+    ename: str = ""
+    evalue: str = ""
+    seconds: float = 0.0
+    output_bytes: int = 0
+    note: str = ""
+
+    def summary(self) -> str:
+        """One line for a person: "ran", "raised E: v", or the note.
+
+        >>> CellResult(3, "error", ename="NameError", evalue="name 'J' is not defined").summary()
+        "raised NameError: name 'J' is not defined"
+        """
+        if self.status == "ok":
+            return "ran"
+        if self.status == "error":
+            return f"raised {self.ename}: {self.evalue}".strip()
+        return self.note or self.status
+
+
+@dataclass
+class Kernel:
+    """A kernel process plus a blocking client; ``run(code)`` executes with limits.
+
+    Until :meth:`start` there is no process, and ``run`` says so instead of raising:
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     k = Kernel(cwd=d, conn_dir=d)
+    ...     k.alive(), k.run("1 + 1", timeout=5).summary()
+    (False, 'the kernel was not running')
+
+    ``start`` launches an IPython kernel (seconds; tests/test_grade.py exercises it), hence not run here:
+
+    >>> k = Kernel(cwd=".", conn_dir="/tmp")  # doctest: +SKIP
+    >>> k.start()  # doctest: +SKIP
+    >>> k.run("x = 1 / 0", timeout=10, index=0).summary()  # doctest: +SKIP
+    'raised ZeroDivisionError: division by zero'
+    >>> k.kill()  # doctest: +SKIP
+    """
+
+    cwd: str
+    conn_dir: str
+    mem_bytes: int = 3 * 2**30
+    fsize_bytes: int = 200 * 2**20
+    startup_timeout: float = 60.0
+    grace: float = 3.0
+    proc: subprocess.Popen | None = None
+    kc: BlockingKernelClient | None = None
+    dead_reason: str = ""
+
+    def start(self) -> None:
+        """Launch the kernel process and wait until it answers (RuntimeError if it does not start)."""
+        Kernel._counter = getattr(Kernel, "_counter", 0) + 1
+        base = os.path.join(self.conn_dir, f"k{os.getpid()}-{Kernel._counter}")
+        fn, _ = write_connection_file(fname=base + ".json", transport="ipc", ip=base)
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
+        env.update(
+            MPLBACKEND="Agg",
+            JPY_PARENT_PID=str(os.getpid()),
+            PYTHONDONTWRITEBYTECODE="1",
+            PYDEVD_DISABLE_FILE_VALIDATION="1",
+        )
+        code = _LAUNCH.format(mem=int(self.mem_bytes), fsize=int(self.fsize_bytes))
+        self.proc = subprocess.Popen(
+            [
+                sys.executable,
+                "-c",
+                code,
+                "-f",
+                fn,
+                "--HistoryManager.enabled=False",
+                "--IPKernelApp.log_level=ERROR",
+                "--Application.log_level=ERROR",
+            ],
+            cwd=self.cwd,
+            env=env,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.DEVNULL,
+            start_new_session=True,
+        )
+        self.kc = BlockingKernelClient(connection_file=fn)
+        self.kc.load_connection_file()
+        self.kc.start_channels()
+        try:
+            self.kc.wait_for_ready(timeout=self.startup_timeout)
+        except RuntimeError as exc:
+            self.kill()
+            raise RuntimeError(f"the kernel did not start: {exc}") from None
+
+    def alive(self) -> bool:
+        """Whether the kernel process is running."""
+        return self.proc is not None and self.proc.poll() is None
+
+    def kill(self) -> None:
+        """Stop the client and kill the kernel's whole process group."""
+        if self.kc is not None:
+            try:
+                self.kc.stop_channels()
+            except Exception:  # noqa: BLE001
+                pass
+            self.kc = None
+        if self.proc is not None:
+            try:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+            try:
+                self.proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                pass
+
+    def _interrupt(self) -> None:
+        try:
+            os.kill(self.proc.pid, signal.SIGINT)
+        except ProcessLookupError:
+            pass
+
+    def run(self, code: str, timeout: float, index: int = -1, silent: bool = False) -> CellResult:
+        """Execute ``code``; never raises for anything the code does."""
+        t0 = time.monotonic()
+        res = CellResult(index, "ok")
+        if not self.alive() or self.kc is None:
+            res.status, res.note = "died", "the kernel was not running"
+            return res
+        msg_id = self.kc.execute(code, silent=silent, store_history=not silent, allow_stdin=False, stop_on_error=False)
+        deadline = t0 + timeout
+        interrupted_at = None
+        idle = replied = False
+        replied_at = None
+        while not (idle and replied):
+            now = time.monotonic()
+            if replied_at is not None and now > replied_at + 2.0:
+                break  # the reply is in; an idle status lost in an output flood must not hang us
+            if interrupted_at is None and now > deadline:
+                self._interrupt()
+                interrupted_at = now
+                res.status, res.note = "timeout", f"stopped after the {timeout:g} s limit for one cell"
+            if interrupted_at is not None and now > interrupted_at + self.grace:
+                self.kill()
+                self.dead_reason = f"killed after ignoring the {timeout:g} s limit for one cell"
+                res.status, res.note = "timeout", self.dead_reason
+                break
+            if not self.alive():
+                # the process is gone: drain nothing more, report
+                self.dead_reason = "the kernel died (the code exited Python or crashed)"
+                res.status, res.note = "died", self.dead_reason
+                break
+            msg = None
+            if not idle:
+                try:
+                    msg = self.kc.get_iopub_msg(timeout=0.1 if replied else 0.05)
+                except queue.Empty:
+                    msg = None
+            if msg is not None and msg.get("parent_header", {}).get("msg_id") == msg_id:
+                mt, c = msg["msg_type"], msg["content"]
+                if mt == "status" and c.get("execution_state") == "idle":
+                    idle = True
+                elif mt == "stream":
+                    res.output_bytes += len(c.get("text", ""))
+                elif mt in ("display_data", "execute_result", "update_display_data"):
+                    res.output_bytes += sum(len(str(v)) for v in c.get("data", {}).values())
+                elif mt == "error" and res.status == "ok":
+                    res.status, res.ename, res.evalue = (
+                        "error",
+                        str(c.get("ename", ""))[:200],
+                        str(c.get("evalue", ""))[:500],
+                    )
+            if not replied:
+                try:
+                    reply = self.kc.get_shell_msg(timeout=0.1 if idle else 0)
+                except queue.Empty:
+                    reply = None
+                if reply is not None and reply.get("parent_header", {}).get("msg_id") == msg_id:
+                    replied, replied_at = True, time.monotonic()
+                    c = reply["content"]
+                    if c.get("status") == "error" and res.status == "ok":
+                        res.status, res.ename, res.evalue = (
+                            "error",
+                            str(c.get("ename", ""))[:200],
+                            str(c.get("evalue", ""))[:500],
+                        )
+                    elif c.get("status") == "aborted" and res.status == "ok":
+                        res.status, res.note = "error", "aborted"
+        if res.status == "timeout" and interrupted_at is not None and self.alive():
+            res.ename = "TimeoutError"
+        res.seconds = time.monotonic() - t0
+        return res
+
+
+class NotebookRun:
+    """A submission (or reference) notebook executed cell by cell in a fresh kernel, with restarts.
+
+    Nothing starts until :meth:`execute`; before it, :meth:`call` answers without a kernel:
+
+    >>> NotebookRun([], cwd=".", tmp=".", cell_timeout=5, total_timeout=30).call("restore_saved(PATH)", 5)
+    (None, 'the kernel was not running')
+
+    ``execute`` starts a kernel (and a fresh one past a cell that kills it; seconds, exercised by
+    tests/test_grade.py), hence not run here:
+
+    >>> cells = [{"cell_type": "code", "source": "J = 2 * 3"},
+    ...          {"cell_type": "code", "source": "import os; os._exit(1)"}]
+    >>> run = NotebookRun(cells, cwd=".", tmp="/tmp", cell_timeout=10, total_timeout=60).execute()  # doctest: +SKIP
+    >>> [run.results[i].status for i in range(2)], run.restarts  # doctest: +SKIP
+    (['ok', 'died'], 1)
+    >>> run.call("probe_answer(globals(), 'J', 'choice', [], 0, PATH)", 10)  # doctest: +SKIP
+    ({'tag': 'choice', 'type': 'int', 'value': 6}, '')
+    >>> run.close()  # doctest: +SKIP
+    """
+
+    def __init__(
+        self,
+        cells: list,
+        cwd: str,
+        tmp: str,
+        cell_timeout: float,
+        total_timeout: float,
+        stash_after: dict | None = None,
+        snapshot: bool = True,
+    ):
+        self.cells = cells
+        self.cwd, self.tmp = cwd, tmp
+        self.cell_timeout, self.total = cell_timeout, total_timeout
+        self.stash_after = stash_after or {}
+        self.snapshot = snapshot
+        self.nonce = "_kinlib_grade_" + os.urandom(8).hex()
+        self.kernel = None
+        self.results: dict = {}
+        self.restarts = 0
+        self.t0 = time.monotonic()
+
+    def _start(self):
+        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp)
+        self.kernel.start()
+        code = (
+            f"def __kg_setup():\n"
+            f"    import sys, types\n"
+            f"    a = types.ModuleType({self.nonce + '_answers'!r})\n"
+            f"    exec(compile({ANSWERS_SOURCE!r}, '<kinlib-grade-answers>', 'exec'), a.__dict__)\n"
+            f"    m = types.ModuleType({self.nonce!r})\n"
+            f"    g = types.ModuleType({self.nonce + '_guard'!r})\n"
+            f"    exec(compile({GUARD_SOURCE!r}, '<kinlib-grade-guard>', 'exec'), g.__dict__)\n"
+            f"    m.answers, m.guard = a, g\n"
+            f"    exec(compile({PROBE_SOURCE!r}, '<kinlib-grade-probe>', 'exec'), m.__dict__)\n"
+            f"    sys.modules[{self.nonce!r}] = m\n"
+            f"    m.SNAP = g.snapshot() if {self.snapshot!r} else None\n"
+            f"__kg_setup(); del __kg_setup\n"
+        )
+        r = self.kernel.run(code, timeout=60, silent=True)
+        if r.status != "ok":
+            raise RuntimeError(f"could not start the checker's probe in the kernel: {r.summary()}")
+
+    def _m(self) -> str:
+        return f"__import__('sys').modules[{self.nonce!r}]"
+
+    def execute(self):
+        """Run all cells; returns self (results: index -> CellResult)."""
+        skip: set = set()
+        while True:
+            self._start()
+            died_at = None
+            for i, cell in enumerate(self.cells):
+                if i in skip:
+                    continue
+                left = self.total - (time.monotonic() - self.t0)
+                if left <= 0:
+                    self.results[i] = CellResult(i, "skipped", note="not run: the total time limit was reached")
+                    continue
+                src = cell_source(cell)
+                if not src.strip() or is_plain_selfcheck(cell):
+                    self.results[i] = CellResult(
+                        i, "ok", note="self-check not run by the checker" if src.strip() else ""
+                    )
+                else:
+                    r = self.kernel.run(src, timeout=min(self.cell_timeout, left), index=i)
+                    self.results[i] = r
+                    if r.status in ("died", "timeout") and not self.kernel.alive():
+                        died_at = i
+                        break
+                if i in self.stash_after and self.kernel.alive():
+                    self.kernel.run(f"{self._m()}.stash(globals(), {self.stash_after[i]!r})", timeout=10, silent=True)
+            if died_at is None:
+                return self
+            skip.add(died_at)
+            self.kernel.kill()
+            if self.restarts >= MAX_RESTARTS or self.total - (time.monotonic() - self.t0) <= 1:
+                for j in range(died_at + 1, len(self.cells)):
+                    self.results.setdefault(j, CellResult(j, "skipped", note="not run: the kernel had died"))
+                self.kernel = None
+                return self
+            self.restarts += 1
+            # rerun from the top in a fresh kernel without the cell(s) that killed it
+            for j in list(self.results):
+                if j not in skip:
+                    del self.results[j]
+
+    def call(self, expr: str, timeout: float) -> tuple[dict | None, str]:
+        """Run ``probe.<expr with PATH>`` in the kernel; return (JSON result, error text)."""
+        if self.kernel is None or not self.kernel.alive():
+            return None, "the kernel was not running"
+        path = os.path.join(self.tmp, "r-" + os.urandom(8).hex() + ".json")
+        r = self.kernel.run(f"{self._m()}.{expr.replace('PATH', repr(path))}", timeout=timeout, silent=True)
+        if r.status != "ok":
+            return None, r.summary()
+        try:
+            with open(path, "rb") as f:
+                data = f.read(MAX_RESULT_BYTES + 1)
+            if len(data) > MAX_RESULT_BYTES:
+                return None, "the answer is too large to read"
+            return json.loads(data), ""
+        except (OSError, ValueError) as exc:
+            return None, f"no readable result ({type(exc).__name__})"
+
+    def close(self):
+        """Kill the kernel, if one is running."""
+        if self.kernel is not None:
+            self.kernel.kill()
+            self.kernel = None

@@ -1,0 +1,405 @@
+"""The notebook schema: the one place that reads cell tags, ``kinlib`` metadata and points.
+
+The solution notebooks in ``notebooks/`` follow one structure, read here for both the handouts
+(:mod:`kinlib.course.handouts`) and the checker (:mod:`kinlib.course.grade`):
+
+* **notebook metadata** ``metadata.kinlib``: ``notebook`` (the id a submission is recognised by, students
+  rename files), ``title``, ``sections``;
+* **cell tags** (``metadata.tags``): ``question`` (a markdown cell opening a graded part; "(N points)" in
+  its text gives the points), ``solution`` (code cells computing the answers, markdown cells explaining
+  them), ``check`` (cells testing the answers: removed from problems and workbooks), ``selfcheck``
+  (the workbook's self-check cells, written by ``kinlib handouts``);
+* **cell metadata** ``metadata.kinlib`` of a ``solution`` code cell: ``part`` ("2.1"), ``answers``
+  (the variable names graded), ``kinds`` ({name: "expr" | "set" | "subspace" | "choice"}; "default"
+  is "expr"), ``describe`` ({name: words for the workbook's stub}), ``points`` (overrides the
+  question's points for that part).
+
+Cells may be nbformat ``NotebookNode`` objects or the plain dicts of ``json.load``; anything malformed
+(tags that are not a list, metadata that is not a dict) reads as absent rather than raising.
+"""
+
+from __future__ import annotations
+
+import ast
+import re
+from dataclasses import dataclass, field
+
+__all__ = [
+    "QUESTION",
+    "SOLUTION",
+    "CHECK",
+    "SELFCHECK",
+    "ANSWER_TAGS",
+    "KINDS",
+    "SELFCHECK_MODULES",
+    "cell_tags",
+    "cell_source",
+    "cell_meta",
+    "cell_part",
+    "cell_answers",
+    "answer_kind",
+    "notebook_meta",
+    "notebook_id",
+    "notebook_title",
+    "notebook_sections",
+    "points_in",
+    "Group",
+    "answer_groups",
+    "Part",
+    "parse_parts",
+    "stash_points",
+    "is_plain_selfcheck",
+]
+
+QUESTION, SOLUTION, CHECK, SELFCHECK = "question", "solution", "check", "selfcheck"
+ANSWER_TAGS = frozenset({SOLUTION, CHECK})
+KINDS = ("default", "expr", "choice", "set", "subspace")
+# the module a workbook's self-check cells import ``check`` from: today's, and the one of workbooks
+# handed out before the course tooling moved into kinlib.course
+SELFCHECK_MODULES = ("kinlib.course.selfcheck", "kinlib.selfcheck")
+_POINTS_RE = [re.compile(r"\((\d+(?:\.\d+)?)\s*points?\)", re.I), re.compile(r"(\d+(?:\.\d+)?)\s*points?\b", re.I)]
+
+
+# ----------------------------------------------------------------------------------------- one cell
+
+
+def _metadata(obj) -> dict:
+    md = obj.get("metadata") if isinstance(obj, dict) else None
+    return md if isinstance(md, dict) else {}
+
+
+def cell_tags(cell) -> list[str]:
+    """The cell's tags as strings (``[]`` when absent or not a list).
+
+    >>> cell_tags({"metadata": {"tags": ["solution", 3]}})
+    ['solution', '3']
+    >>> cell_tags({"metadata": {"tags": "solution"}}), cell_tags({})
+    ([], [])
+    """
+    tags = _metadata(cell).get("tags") or []
+    return [str(t) for t in tags] if isinstance(tags, (list, tuple)) else []
+
+
+def cell_source(cell) -> str:
+    """The cell's source as one string (nbformat files may store it as a list of lines).
+
+    >>> cell_source({"source": ["x = 1\\n", "y = 2"]})
+    'x = 1\\ny = 2'
+    """
+    s = cell.get("source", "") if isinstance(cell, dict) else ""
+    return "".join(s) if isinstance(s, list) else str(s)
+
+
+def cell_meta(cell) -> dict:
+    """The cell's ``kinlib`` metadata (a copy; ``{}`` when absent or not a dict).
+
+    >>> cell_meta({"metadata": {"kinlib": {"part": "1.1", "answers": ["J"]}}})
+    {'part': '1.1', 'answers': ['J']}
+    >>> cell_meta({"metadata": {"kinlib": None}})
+    {}
+    """
+    meta = _metadata(cell).get("kinlib")
+    return dict(meta) if isinstance(meta, dict) else {}
+
+
+def cell_part(meta: dict, default: str = "") -> str:
+    """The part id of a cell's ``kinlib`` metadata as a string, or ``default`` when it has none.
+
+    >>> cell_part({"part": 2.1}), cell_part({}), cell_part({}, "q3")
+    ('2.1', '', 'q3')
+    """
+    part = meta.get("part")
+    return str(part) if part is not None and str(part) else default
+
+
+def cell_answers(meta: dict) -> list[str]:
+    """The answer variable names of a ``solution`` cell's ``kinlib`` metadata, in order, without
+    repeats (names that are not strings are ignored: they cannot be variables).
+
+    >>> cell_answers({"answers": ["J", "detJ", "J", 3]})
+    ['J', 'detJ']
+    """
+    names = meta.get("answers") or []
+    out: list[str] = []
+    for n in names if isinstance(names, (list, tuple)) else []:
+        if isinstance(n, str) and n not in out:
+            out.append(n)
+    return out
+
+
+def answer_kind(meta: dict, name: str) -> str:
+    """The kind of answer ``name``: ``kinds[name]`` of the cell's ``kinlib`` metadata, with "default",
+    ``None`` and a missing entry all read as "expr". Other values are returned as given (the self-check
+    then says it cannot check them; the checker compares them as expressions).
+
+    >>> answer_kind({"kinds": {"S": "set", "J": "default"}}, "S"), answer_kind({"kinds": {"J": "default"}}, "J")
+    ('set', 'expr')
+    >>> answer_kind({}, "J")
+    'expr'
+    """
+    kinds = meta.get("kinds")
+    kind = kinds.get(name) if isinstance(kinds, dict) else None
+    return "expr" if kind in (None, "default") else str(kind)
+
+
+# ----------------------------------------------------------------------------------------- the notebook
+
+
+def notebook_meta(nb) -> dict:
+    """The notebook's ``kinlib`` metadata (``{}`` when absent or not a dict).
+
+    >>> notebook_meta({"metadata": {"kinlib": {"notebook": "02_planar"}}})
+    {'notebook': '02_planar'}
+    """
+    meta = _metadata(nb).get("kinlib")
+    return dict(meta) if isinstance(meta, dict) else {}
+
+
+def notebook_id(nb) -> str | None:
+    """``metadata.kinlib.notebook``, the id a submission is recognised by; ``None`` if missing or empty.
+
+    >>> notebook_id({"metadata": {"kinlib": {"notebook": "02_planar"}}}), notebook_id({"cells": []})
+    ('02_planar', None)
+    """
+    nid = notebook_meta(nb).get("notebook")
+    return nid if isinstance(nid, str) and nid else None
+
+
+def notebook_title(nb, default: str) -> str:
+    """``metadata.kinlib.title``, or ``default`` when it is missing or empty.
+
+    >>> notebook_title({"metadata": {"kinlib": {"title": "Singularities"}}}, "x"), notebook_title({}, "05 sing")
+    ('Singularities', '05 sing')
+    """
+    title = notebook_meta(nb).get("title")
+    return str(title) if title else default
+
+
+def notebook_sections(nb) -> list[str]:
+    """``metadata.kinlib.sections`` as strings.
+
+    >>> notebook_sections({"metadata": {"kinlib": {"sections": [5.1, "5.2"]}}})
+    ['5.1', '5.2']
+    """
+    sections = notebook_meta(nb).get("sections") or []
+    return [str(s) for s in sections] if isinstance(sections, (list, tuple)) else []
+
+
+def points_in(text: str) -> float | None:
+    """The points a question cell's text announces: "(N points)" first, else "N points"; ``None`` if none.
+
+    >>> points_in("**1.5 (10 points).** Which joint ..."), points_in("worth 2.5 point"), points_in("no score")
+    (10.0, 2.5, None)
+    """
+    for rx in _POINTS_RE:
+        m = rx.search(text)
+        if m:
+            return float(m.group(1))
+    return None
+
+
+def _cells(nb) -> list:
+    cells = nb.get("cells") if isinstance(nb, dict) else None
+    return [c for c in cells if isinstance(c, dict)] if isinstance(cells, list) else []
+
+
+def _is(cell, cell_type: str) -> bool:
+    return cell.get("cell_type") == cell_type
+
+
+# ----------------------------------------------------------------------------------------- answer groups (handouts)
+
+
+@dataclass
+class Group:
+    """The answers checked together: solution cells up to a check cell (or the next question).
+
+    :func:`answer_groups` makes them; each answer is (part, name, kind, cell index):
+
+    >>> Group()
+    Group(answers=[], check_cell=None, last_solution=-1)
+    >>> Group(answers=[("1.1", "J", "expr", 1)], check_cell=2, last_solution=1).answers[0][1]
+    'J'
+    """
+
+    answers: list = field(default_factory=list)  # (part, name, kind, cell index)
+    check_cell: int | None = None  # index of the check cell, if any
+    last_solution: int = -1
+
+
+def answer_groups(nb) -> list[Group]:
+    """Group the answer variables of ``solution`` code cells by the ``check`` cell that follows them
+    (a ``question`` cell closes a group too). Raises ValueError for a cell tagged both solution and check.
+
+    >>> nb = {"cells": [{"cell_type": "markdown", "metadata": {"tags": ["question"]}},
+    ...                 {"cell_type": "code", "metadata": {"tags": ["solution"],
+    ...                  "kinlib": {"part": "1.1", "answers": ["J"], "kinds": {"J": "default"}}}},
+    ...                 {"cell_type": "code", "metadata": {"tags": ["check"]}}]}
+    >>> [(g.answers, g.check_cell, g.last_solution) for g in answer_groups(nb)]
+    [([('1.1', 'J', 'expr', 1)], 2, 1)]
+    """
+    groups, pending = [], Group()
+
+    def close(check=None):
+        nonlocal pending
+        if pending.answers or check is not None:
+            pending.check_cell = check
+            groups.append(pending)
+        pending = Group()
+
+    for i, cell in enumerate(_cells(nb)):
+        tags = cell_tags(cell)
+        if SOLUTION in tags and CHECK in tags:
+            raise ValueError(f"cell {i} is tagged both 'solution' and 'check'")
+        if QUESTION in tags:
+            close()
+        if SOLUTION in tags and _is(cell, "code"):
+            meta = cell_meta(cell)
+            for name in cell_answers(meta):
+                pending.answers = [a for a in pending.answers if a[1] != name]
+                pending.answers.append((cell_part(meta), name, answer_kind(meta, name), i))
+            pending.last_solution = i
+        if CHECK in tags:
+            close(check=i)
+    close()
+    return groups
+
+
+# ----------------------------------------------------------------------------------------- graded parts (checker)
+
+
+@dataclass
+class Part:
+    """A graded part: its id, points, answer names and kinds, and its solution cells (code cell indices).
+
+    :func:`parse_parts` makes them from a solution notebook:
+
+    >>> Part("2.1", 5.0, ["J"], {"J": "expr"})
+    Part(part='2.1', points=5.0, answers=['J'], kinds={'J': 'expr'}, cells=[])
+    """
+
+    part: str
+    points: float
+    answers: list
+    kinds: dict
+    cells: list = field(default_factory=list)
+
+
+def parse_parts(nb) -> list[Part]:
+    """Graded parts of a solution notebook, in order.
+
+    A part is made of the ``solution`` code cells with ``answers`` of one ``part`` id (a cell without one
+    belongs to "q<N>", its question's number). Points: ``points`` of the cell's metadata if given, else
+    the "(N points)" of the question cell above, split evenly between the parts sharing that question.
+
+    >>> q = {"cell_type": "markdown", "metadata": {"tags": ["question"]}, "source": "**1 (6 points).**"}
+    >>> def sol(part, *names):
+    ...     return {"cell_type": "code", "metadata": {"tags": ["solution"],
+    ...             "kinlib": {"part": part, "answers": list(names)}}}
+    >>> [(p.part, p.points, p.answers, p.cells) for p in parse_parts({"cells": [q, sol("1a", "x"), sol("1b", "y")]})]
+    [('1a', 3.0, ['x'], [0]), ('1b', 3.0, ['y'], [1])]
+    """
+    parts: dict[str, Part] = {}
+    question_of: dict[str, int] = {}
+    q_idx, q_points = -1, None
+    code_idx = -1
+    explicit: dict[str, float] = {}
+    for cell in _cells(nb):
+        tags = cell_tags(cell)
+        if _is(cell, "code"):
+            code_idx += 1
+        if _is(cell, "markdown") and QUESTION in tags:
+            q_idx += 1
+            q_points = points_in(cell_source(cell))
+            continue
+        meta = cell_meta(cell)
+        names = cell_answers(meta)
+        if not _is(cell, "code") or SOLUTION not in tags or not names:
+            continue
+        pid = cell_part(meta, f"q{q_idx + 1}")
+        p = parts.setdefault(pid, Part(pid, q_points if q_points is not None else 0.0, [], {}))
+        for name in names:
+            if name not in p.answers:
+                p.answers.append(name)
+            p.kinds[name] = answer_kind(meta, name)
+        p.cells.append(code_idx)
+        question_of.setdefault(pid, q_idx)
+        if "points" in meta:
+            explicit[pid] = float(meta["points"])
+    # several parts under one question cell share its points
+    shared: dict[int, list] = {}
+    for pid, q in question_of.items():
+        if pid not in explicit:
+            shared.setdefault(q, []).append(pid)
+    for pids in shared.values():
+        for pid in pids:
+            parts[pid].points = round(parts[pid].points / len(pids), 3)
+    for pid, pts in explicit.items():
+        parts[pid].points = pts
+    return list(parts.values())
+
+
+def stash_points(nb) -> dict:
+    """{code cell index: answer names} to keep when a part ends (before the next ``question`` cell).
+
+    An answer is the value its variable has at the end of its part: the solution cell plus any cells
+    a student added below it, up to the next question. Later cells that reuse the name (or ``del`` it)
+    do not change it. Answers of the last part are read at the end of the notebook (not listed here).
+
+    >>> cells = [{"cell_type": "code", "metadata": {"tags": ["solution"], "kinlib": {"answers": ["J"]}}},
+    ...          {"cell_type": "code", "metadata": {}},
+    ...          {"cell_type": "markdown", "metadata": {"tags": ["question"]}}]
+    >>> stash_points({"cells": cells})
+    {1: ['J']}
+    """
+    out: dict = {}
+    pending: list = []
+    code_idx = -1
+    for cell in _cells(nb):
+        if _is(cell, "markdown") and QUESTION in cell_tags(cell):
+            if pending and code_idx >= 0:
+                out.setdefault(code_idx, []).extend(n for n in pending if n not in out.get(code_idx, []))
+            pending = []
+        if _is(cell, "code"):
+            code_idx += 1
+            if SOLUTION in cell_tags(cell):
+                pending += cell_answers(cell_meta(cell))
+    return out
+
+
+def is_plain_selfcheck(cell) -> bool:
+    """A workbook self-check cell as ``kinlib handouts`` writes it: tagged ``selfcheck``, holding only
+    ``from kinlib.course.selfcheck import check`` (or the pre-``kinlib.course`` ``kinlib.selfcheck``) and
+    ``check(...)`` calls with constant arguments. It cannot change an answer.
+
+    >>> src = 'from kinlib.course.selfcheck import check\\ncheck("1.1", J="matrix|6x3|0123456789abcdef")'
+    >>> is_plain_selfcheck({"metadata": {"tags": ["selfcheck"]}, "source": src})
+    True
+    >>> is_plain_selfcheck({"metadata": {"tags": ["selfcheck"]}, "source": src + "\\nJ = 0"})
+    False
+    """
+    if SELFCHECK not in cell_tags(cell):
+        return False
+    try:
+        tree = ast.parse(cell_source(cell))
+    except SyntaxError:
+        return False
+    for node in tree.body:
+        if (
+            isinstance(node, ast.ImportFrom)
+            and node.module in SELFCHECK_MODULES
+            and [a.name for a in node.names] == ["check"]
+            and all(a.asname is None for a in node.names)
+        ):
+            continue
+        if (
+            isinstance(node, ast.Expr)
+            and isinstance(node.value, ast.Call)
+            and isinstance(node.value.func, ast.Name)
+            and node.value.func.id == "check"
+            and all(isinstance(a, ast.Constant) for a in node.value.args)
+            and all(isinstance(k.value, ast.Constant) for k in node.value.keywords)
+        ):
+            continue
+        return False
+    return True
