@@ -1,7 +1,9 @@
-"""Exact zero tests and a fast display form for product-of-exponentials expressions.
+"""Display forms of exact results, and the matrix identity test built on kinlib's one zero test.
 
 ``is_identically_zero(M)`` decides whether every entry of M is 0 for *all* values of its symbols
-(an identity such as sin²θ + cos²θ − 1, or J_b − Ad_{T⁻¹} J_s), exactly and fast: see its docstring.
+(an identity such as sin²θ + cos²θ − 1, or J_b − Ad_{T⁻¹} J_s), exactly and fast, entry by entry through
+:func:`kinlib.exactfield.decide_zero`: see its docstring. ``readable``, ``readable_fold`` and
+``readable_ratio`` write exact numbers (a configuration's sines and cosines) in a readable, equal form.
 
 ``simplify_for_display(M)`` works entry by entry:
 

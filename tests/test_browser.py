@@ -246,7 +246,7 @@ def _animation_pages(sites):
 def test_an_animation_plays_without_a_kernel(sites, browser):
     pages = _animation_pages(sites)
     assert any(site == "fixture" for site, _ in pages)
-    for _site, path in pages:
+    for _kind, path in pages:
         page, watch = _open(browser, path)
         try:
             img = page.locator("img[id^='_anim_img']").first

@@ -610,3 +610,21 @@ def test_public_api_has_examples():
         "(tests/test_doctests.py runs them):\n  "
         + "\n  ".join(f"{m} ({len(v)}): {', '.join(v)}" for m, v in missing.items())
     )
+
+
+def test_no_name_shadows_its_module():
+    """`import kinlib.manipulability as m` gives the module (a function named like its module once hid it)."""
+    import importlib
+    import types
+
+    import kinlib
+
+    for name in MODULES:
+        if name.count(".") != 1 or name.rsplit(".", 1)[1].startswith("_"):
+            continue
+        module = importlib.import_module(name)
+        attr = getattr(kinlib, name.rsplit(".", 1)[1])
+        assert isinstance(attr, types.ModuleType) and attr is module, f"kinlib.{name.rsplit('.', 1)[1]} is {attr!r}"
+    import kinlib.manipulability as m
+
+    assert callable(m.isotropy) and callable(m.manipulability)
