@@ -156,3 +156,25 @@ def test_python_dash_m_kinlib_course():
         [sys.executable, "-m", "kinlib.course", "grade"], capture_output=True, text=True, cwd=ROOT, timeout=120
     )
     assert r.returncode == 2 and len(r.stderr.strip().splitlines()) == 1
+
+
+@pytest.mark.parametrize("command", [["handouts", "notebooks"], ["grade", "subs", "--out", "o"]])
+def test_without_the_course_extra_the_command_says_what_to_install(command, capsys, monkeypatch):
+    """`pip install kinlib` (no [course]) still installs the console script: it must say what is missing."""
+    import builtins
+
+    real_import = builtins.__import__
+
+    def no_nbformat(name, *args, **kwargs):
+        if name.split(".")[0] in ("nbformat", "nbclient", "nbconvert", "jupyter_client") or (
+            name in ("handouts", "grade") and args and (args[0] or {}).get("__package__") == "kinlib.course"
+        ):
+            raise ModuleNotFoundError(f"No module named {name!r}", name="nbformat")
+        return real_import(name, *args, **kwargs)
+
+    for mod in ("kinlib.course.handouts", "kinlib.course.grade"):
+        monkeypatch.delitem(sys.modules, mod, raising=False)
+    monkeypatch.setattr(builtins, "__import__", no_nbformat)
+    assert main(command) == 2
+    err = capsys.readouterr().err
+    assert "missing nbformat" in err and "pip install 'kinlib[course]'" in err and err.count("\n") == 1
