@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed
 NOTEBOOKS := $(sort $(wildcard notebooks/[0-9][0-9]_*.ipynb))
 PYTEST_ARGS ?=
 
-.PHONY: all setup lint format test test-fast lab handouts grade bench lock chromium clean
+.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium bubblewrap clean
 
 all: test
 
@@ -39,19 +39,38 @@ chromium:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; }
 
+# Debian's bubblewrap: the sandbox every student kernel runs in (kinlib.course.sandbox); `kinlib grade`
+# refuses to grade without it unless given --no-sandbox.
+bubblewrap:
+	@command -v bwrap >/dev/null 2>&1 || { \
+	  echo "installing Debian's bubblewrap for the grader's sandbox"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq bubblewrap >/dev/null; }
+
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
-test: $(STAMP) lint chromium
+test: $(STAMP) lint chromium bubblewrap
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
 	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider $(PYTEST_ARGS)
 
 # Quick loop while developing: no browser, no notebooks, no slow tests, no lint (`make lint` for that).
-test-fast: $(STAMP)
+test-fast: $(STAMP) bubblewrap
 	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(PYTEST_ARGS)
 
 # JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
+# The course notebooks are trusted first (JupyterLab draws saved widgets only in trusted notebooks; otherwise
+# it shows their text or static image), and lab-settings/overrides.json is used (widget state saved with
+# the notebook, so a saved notebook reopens with its pictures).
 LAB_ARGS ?=
 lab: $(STAMP)
-	$(VENV)/bin/jupyter lab --notebook-dir=notebooks $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
+	@$(VENV)/bin/jupyter trust $(NOTEBOOKS) >/dev/null
+	$(VENV)/bin/jupyter lab --notebook-dir=notebooks --LabApp.app_settings_dir=$(CURDIR)/lab-settings \
+	    $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
+
+# Execute notebooks in place (fresh kernel each, outputs + widget state, stable ids): after editing a
+# notebook, `make notebooks` (all) or `make notebooks NB=notebooks/05_singularities_planar.ipynb`.
+NB ?= $(NOTEBOOKS)
+notebooks: $(STAMP)
+	$(VENV)/bin/kinlib execute $(NB)
 
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
 handouts: $(STAMP)
@@ -61,11 +80,11 @@ handouts: $(STAMP)
 SUBMISSIONS ?= submissions
 OUT ?= build/grades
 JOBS ?= 2
-grade: $(STAMP)
+grade: $(STAMP) bubblewrap
 	$(VENV)/bin/kinlib grade $(SUBMISSIONS) --out $(OUT) --jobs $(JOBS)
 
 # Benchmark against modern-robotics (and Pinocchio, installed here as an optional extra).
-bench: $(STAMP)
+bench: $(STAMP) bubblewrap chromium
 	@$(PY) -c "import pinocchio" 2>/dev/null || $(PIP) install --quiet -e '.[bench]' \
 	    || echo "pin (Pinocchio) could not be installed: the table will say so"
 	$(PY) bench/bench.py --out build/bench.md

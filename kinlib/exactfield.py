@@ -21,6 +21,7 @@ certified numerics of :mod:`kinlib.exact`.
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import Any
 
@@ -84,6 +85,16 @@ def _re_im_power(m: int) -> tuple:
         else:
             im[k] = c if k % 4 == 1 else -c
     return re, im
+
+
+@functools.lru_cache(maxsize=4096)
+def _field_constant(K, c: sp.Expr):
+    """The constant ``c`` as an element of the number field ``K`` (exact; SymPy's ``to_number_field``).
+
+    Cached: finding the element means minimal polynomials and a field isomorphism (milliseconds each), and the
+    same few constants (cos and sin of the configuration's multiples of π, √2, …) recur in every field built
+    for a notebook. Both K and c are immutable, so the cache cannot change an answer."""
+    return K.convert(c) if c.is_Rational else K.from_sympy(c)
 
 
 class ExactField:
@@ -219,7 +230,7 @@ class ExactField:
         return out
 
     def _kconst(self, c):
-        return self.ring(self.K.convert(c) if c.is_Rational else self.K.from_sympy(c))
+        return self.ring(_field_constant(self.K, c))
 
     def to_ratio(self, x) -> tuple[sp.Expr, sp.Expr]:
         """A field element back as SymPy (numerator, denominator), polynomials in sin g, cos g, the constants

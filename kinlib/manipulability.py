@@ -6,7 +6,8 @@ For J (m×n, the rows of the task space: pick them with :func:`kinlib.taskspace.
   than task dimensions (n < m); = σ1 σ2 ⋯ σk, the product of the singular values; 0 exactly at a singularity.
 * condition number  κ = σ_max / σ_min ≥ 1 (∞ at a singularity);  isotropy = 1/κ ∈ [0, 1], 1 when the
   velocity ellipsoid is a sphere (a circle in the plane).
-* velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1}: semi-axes σ_i along the left singular vectors u_i.
+* velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1}: semi-axes σ_i along the left singular vectors u_i; with rows held
+  at zero (``hold=``, e.g. the orientation ω_z), the ellipsoid of J_r N (N: a basis of null(J_hold)).
 * problem 6.2's speed view: V·V = θ̇ᵀ (Jᵀ J) θ̇.
 
 SymPy input gives exact SymPy results (``simplify=True`` for a display form); numbers give floats, and a
@@ -24,7 +25,7 @@ from ._backend import as_vector, describe, exact_jacobian, is_symbolic, numeric_
 from .exact import exact_det
 from .exactfield import decide_zero
 from .singularities import trig_simplify
-from .taskspace import task_rows
+from .taskspace import task_row_indices, task_rows
 from .trigpoly import TrigRing, angles_in
 
 __all__ = [
@@ -247,8 +248,8 @@ def isotropy(J: Any):
     return sp.factor_terms(parts[2] / parts[1])
 
 
-def velocity_ellipsoid(J: Any, rows: Any = None):
-    """The velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1}: (semi-axis lengths σ_i, unit directions u_i as columns).
+def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None):
+    """The velocity ellipsoid {J_r θ̇ : ‖θ̇‖ ≤ 1}: (semi-axis lengths σ_i, unit directions u_i as columns).
 
     ``rows``: pick task rows first (see :func:`~kinlib.taskspace.task_rows`); by default a 6-row J
     uses its linear rows ("linear" = vx vy vz, the tool velocity ṗ for the geometric Jacobian), any other J
@@ -256,8 +257,19 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
     batch gives (N, k), (N, m, k)). SymPy J: exact eigen-decomposition of J Jᵀ (lengths √λ, orthonormal
     directions), for small or evaluated J.
 
+    ``hold``: task rows kept at zero (e.g. ``("wz",)``: the tool's orientation held). The ellipsoid is then
+    {J_r θ̇ : J_h θ̇ = 0, ‖θ̇‖ ≤ 1} = {J_r N z : ‖z‖ ≤ 1} with N an orthonormal basis of null(J_h) (d columns):
+    semi-axes the singular values of J_r N, directions its left singular vectors, k = min(m, d). Since
+    rank [J_h; J_r] = rank J_h + rank(J_r N), a semi-axis is 0 (the ellipse collapses to a segment) exactly
+    where the rows [J_h; J_r] lose rank while J_h keeps its rank. ``rows`` must be named with ``hold``
+    and the two must not share a row. Numeric: N from the SVD of J_h (its rank: singular values above
+    max(shape)·ε·σ_max, NumPy's matrix_rank rule); one J at a time (no batch). SymPy: exact, from the
+    Gram matrix J_r P J_rᵀ with P = B (Bᵀ B)⁻¹ Bᵀ the projector onto null(J_h) (B = SymPy's nullspace
+    basis, so no square roots enter before the eigenvalues); with free symbols the null space is the
+    generic one (valid where J_h keeps its generic rank).
+
     >>> import numpy as np, sympy as sp
-    >>> from kinlib.robots import planar_2r
+    >>> from kinlib.robots import planar_2r, planar_offset_3r
     >>> lengths, dirs = velocity_ellipsoid(planar_2r(1, 1).jacobian_geometric([0.0, np.pi / 2]))   # rows vx vy vz
     >>> lengths.round(3).tolist(), dirs.shape   # σ1, σ2; u1, u2 as columns
     ([1.618, 0.618], (3, 2))
@@ -265,7 +277,16 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
     ([2, 1], Matrix([
     [1, 0],
     [0, 1]]))
+    >>> J = planar_offset_3r(1).jacobian_geometric([np.pi / 6, -np.pi / 4, -np.pi / 3])   # θ2 = −π/4: singular
+    >>> velocity_ellipsoid(J, rows=("vx", "vy"))[0].round(2).tolist()   # ṗ with all three joints: still fat
+    [2.79, 1.03]
+    >>> (velocity_ellipsoid(J, rows=("vx", "vy"), hold=("wz",))[0].round(2) + 0.0).tolist()   # ω_z held: a segment
+    [1.72, 0.0]
+    >>> velocity_ellipsoid(sp.Matrix([[1, 1, 1], [0, 0, 1], [0, -1, 0]]), rows=[1, 2], hold=[0])[0]   # exact
+    [1, sqrt(3)/3]
     """
+    if hold is not None:
+        return _held_ellipsoid(J, rows, hold)
     if rows is None:
         shape = J.shape if hasattr(J, "shape") else np.shape(np.asarray(J, dtype=object))
         rows = "linear" if len(shape) >= 2 and shape[-2] == 6 else None
@@ -276,10 +297,21 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
         U, s, _ = np.linalg.svd(A, full_matrices=False)
         return s, U
     M = exact_jacobian(J)
-    G = M * M.T
+    return _exact_axes(M * M.T, min(M.rows, M.cols))
+
+
+def _exact_axes(G: sp.Matrix, k: int):
+    """Exact (lengths √λ, orthonormal directions) of the k largest eigenvalues of the Gram matrix G."""
     G = trig_simplify(G) if angles_in(list(G)) else G.applyfunc(sp.simplify)
     pairs = []
-    for lam, _mult, vecs in G.eigenvects(simplify=True):
+    try:
+        eig = G.eigenvects(simplify=True)
+    except NotImplementedError:
+        raise ValueError(
+            "J: SymPy cannot find exact eigenvectors of this Gram matrix (J with free joint symbols is too "
+            "big): give J at a configuration (exact values, no free joint symbols) or numbers"
+        ) from None
+    for lam, _mult, vecs in eig:
         lam = sp.simplify(lam)
         ortho = sp.GramSchmidt(vecs, orthonormal=True)
         for v in ortho:
@@ -292,10 +324,51 @@ def velocity_ellipsoid(J: Any, rows: Any = None):
             return 0.0
 
     pairs.sort(key=key)
-    k = min(M.rows, M.cols)
-    pairs = pairs[:k] if M.cols < M.rows else pairs
+    pairs = pairs[:k]
     lengths = [sp.sqrt(lam) for lam, _ in pairs]
+    if not pairs:
+        return lengths, sp.zeros(G.rows, 0)
     return lengths, sp.Matrix.hstack(*[v for _, v in pairs])
+
+
+def _held_ellipsoid(J: Any, rows: Any, hold: Any):
+    """velocity_ellipsoid(J, rows, hold): the ellipsoid of J_r θ̇ over θ̇ ∈ null(J_h), ‖θ̇‖ ≤ 1."""
+    if rows is None:
+        raise ValueError("rows must name the task rows drawn (e.g. rows=('vx', 'vy')) when hold is given, got None")
+    if isinstance(J, np.ndarray) and J.ndim == 3:
+        raise ValueError(f"J must be one Jacobian (m×n) when hold is given (loop over a batch), got {describe(J)}")
+    symbolic = is_symbolic(J)
+    M = exact_jacobian(J) if symbolic else numeric_jacobian(J)
+    if M.shape[0] == 0 or len(M.shape) != 2:
+        raise ValueError(f"J must be a matrix (m×n Jacobian), got {describe(J)}")
+    m = M.shape[0]
+    r_idx = task_row_indices(rows, None, m)
+    try:
+        h_idx = task_row_indices(hold, None, m)
+    except (TypeError, ValueError) as e:
+        raise type(e)(f"hold: {e}") from None
+    both = sorted(set(r_idx) & set(h_idx))
+    if both:
+        raise ValueError(
+            f"rows and hold must not share a row (a held row is zero), got rows={describe(rows)}, "
+            f"hold={describe(hold)} (both name rows {both})"
+        )
+    if symbolic:
+        A, H = M.extract(list(r_idx), list(range(M.cols))), M.extract(list(h_idx), list(range(M.cols)))
+        B = H.nullspace(simplify=True)
+        if not B:
+            return [], sp.zeros(A.rows, 0)
+        B = sp.Matrix.hstack(*B)
+        P = B * (B.T * B).inv() * B.T
+        return _exact_axes(A * P * A.T, min(A.rows, B.cols))
+    A, H = M[list(r_idx)], M[list(h_idx)]
+    _, s, Vt = np.linalg.svd(H)
+    rank = int(np.sum(s > max(H.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0))) if s[0] > 0 else 0
+    N = Vt[rank:].T  # n × d, orthonormal basis of null(J_h)
+    if N.shape[1] == 0:
+        return np.zeros(0), np.zeros((A.shape[0], 0))
+    U, s2, _ = np.linalg.svd(A @ N, full_matrices=False)
+    return s2, U
 
 
 def twist_speed_form(J: Any, simplify: bool = False):

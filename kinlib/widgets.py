@@ -19,8 +19,21 @@ than rows) the manipulability (both from :mod:`kinlib.manipulability`), the conf
   slider ranges: a relative, unit-free threshold),
 * ``"regular"`` otherwise.
 
+What the picture shows agrees with the status: when the task has orientation rows besides the drawn ṗ
+rows (planar: (ω_z, ṗ_x, ṗ_y)), the main (green) ellipse is the tool velocities reachable **with the
+orientation held**, {ṗ = J_ṗ θ̇ : J_ω θ̇ = 0, ‖θ̇‖ ≤ 1} (:func:`kinlib.manipulability.velocity_ellipsoid` with
+``hold``): since rank J_r = rank J_ω + rank(J_ṗ N) (N a basis of null(J_ω)), it collapses to a segment
+exactly at the singular configurations where J_ω keeps its rank; the ellipse of ṗ with every joint free
+(which need not flatten) is a light dashed outline. At and near a singularity a red dashed line through the
+tool marks the direction it cannot move (the thin axis of the main ellipse: its left null direction). The
+readout's det J is exactly "0" when the rank test says singular. HTML hooks (for browser tests): the status
+is ``<div class='kinlib-status' data-state='singular|near|regular'>``, the readout holds
+``<span class='kinlib-det'>`` and ``<span class='kinlib-held'>`` (the held ellipse's semi-axes). Displayed,
+an explorer also carries a static ``image/png`` (:func:`kinlib.widgets_render.display_bundle`).
+
 Speed: the static part of the figure (axes, grid, ticks, legend, {s}) is rendered once and cached;
-a slider move restores it, draws only the moving artists (blitting with Agg) and encodes a PNG.
+a slider move restores it, draws only the moving artists (blitting with Agg) and encodes an 8-bit PNG
+(palette made once; :class:`kinlib.widgets_render.Blitter`); labels keep their spots while they fit.
 
 >>> from kinlib.robots import planar_2r
 >>> ex = explorer(planar_2r(1, 1), q=[0.3, 0.0])
@@ -31,9 +44,8 @@ a slider move restores it, draws only the moving artists (blitting with Agg) and
 from __future__ import annotations
 
 import html
-import io
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 
 import ipywidgets as W
 import numpy as np
@@ -51,9 +63,20 @@ from .plotting import (
     draw_velocity_ellipse,
 )
 from .plotting.common import as_configuration, checked_numeric, theta_tex
+from .plotting.primitives import add_line, set_line
 from .taskspace import ROW_LABELS, ROW_TEX, default_task_rows, is_planar, rows_label, task_row_indices, task_rows
+from .widgets_render import Blitter, display_bundle, new_figure, render_png
 
-__all__ = ["explorer", "Explorer", "config_picker", "ConfigPicker", "classify"]
+__all__ = [
+    "explorer",
+    "Explorer",
+    "config_picker",
+    "ConfigPicker",
+    "classify",
+    "weakest_direction",
+    "format_det",
+    "format_lengths",
+]
 
 
 def classify(J_rows: np.ndarray, tol: float = 1e-6, near: float = 0.1, w_max: float | None = None) -> dict:
@@ -90,57 +113,44 @@ def classify(J_rows: np.ndarray, tol: float = 1e-6, near: float = 0.1, w_max: fl
     }
 
 
-def _png(canvas, fmt: str = "png") -> bytes:
-    """The canvas as PNG (RGB, fast zlib level 1: about 2/3 of the time of RGBA) or JPEG (quality 90,
-    several times faster to encode, slightly soft lines)."""
-    from PIL import Image
+def weakest_direction(lengths, directions) -> tuple[np.ndarray, float]:
+    """(u, ratio): the unit direction u in which the ellipsoid with semi-axes ``lengths`` (k,) along the unit
+    columns of ``directions`` (m×k) is thinnest, and σ_min/σ_max (0 when k < m: then u is orthogonal to
+    every column, a direction the map never reaches). At a singular configuration u spans the left null
+    space of the map: the direction the tool cannot move.
 
-    w, h = canvas.get_width_height(physical=True)
-    im = Image.frombuffer("RGBA", (w, h), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
-    buf = io.BytesIO()
-    if fmt == "jpeg":
-        im.save(buf, format="jpeg", quality=90)
-    else:
-        im.save(buf, format="png", compress_level=1)
-    return buf.getvalue()
-
-
-def _render_png(fig: Figure) -> bytes:
-    """Draw the whole figure with Agg and encode it as PNG."""
-    fig.canvas.draw()
-    return _png(fig.canvas)
+    >>> u, r = weakest_direction(np.array([2.0, 0.0]), np.eye(2)); u.tolist(), r
+    ([0.0, 1.0], 0.0)
+    """
+    s, U = np.asarray(lengths, float).reshape(-1), np.asarray(directions, float)
+    m, k = U.shape
+    if k < m:
+        Q = np.linalg.svd(U, full_matrices=True)[0] if k else np.eye(m)
+        return Q[:, k], 0.0
+    i = int(np.argmin(s))
+    top = float(s.max())
+    return U[:, i], (float(s[i]) / top if top > 0 else 0.0)
 
 
-class _Blitter:
-    """Render a figure whose static part (axes, grid, ticks, legend, {s}) is drawn once and cached;
-    each render restores that background and draws only the moving artists, then encodes a PNG."""
+def format_det(det: float, singular: bool) -> str:
+    """det J for the readout: exactly "0" when the rank test says singular (never +0.0000 or −0.0000),
+    else signed with 4 significant digits.
 
-    def __init__(self, fig: Figure, artists: Sequence, fmt: str = "png"):
-        self.fig, self.artists, self.fmt = fig, [a for a in artists if a is not None], fmt
-        for a in self.artists:
-            a.set_animated(True)
-        self.background = None
-
-    def render(self) -> bytes:
-        canvas = self.fig.canvas
-        if self.background is None:
-            canvas.draw()  # animated artists are skipped
-            self.background = canvas.copy_from_bbox(self.fig.bbox)
-        else:
-            canvas.restore_region(self.background)
-        renderer = canvas.get_renderer()
-        for a in self.artists:
-            if hasattr(a, "do_3d_projection") and hasattr(a, "set_segments"):
-                a.do_3d_projection()
-            a.draw(renderer)
-        return _png(canvas, self.fmt)
+    >>> format_det(-3.2e-17, True), format_det(0.70710678, False), format_det(-1.5e-5, False)
+    ('0', '+0.7071', '-1.5e-05')
+    """
+    return "0" if singular else f"{det:+.4g}"
 
 
-def _new_figure(figsize, dpi, three_d: bool):
-    """A Figure with an Agg canvas, not registered with pyplot, and its one (2-D or 3-D) axes."""
-    fig = Figure(figsize=figsize, dpi=dpi)
-    FigureCanvasAgg(fig)
-    return fig, fig.add_subplot(projection="3d" if three_d else None)
+def format_lengths(lengths, tol: float = 1e-6) -> str:
+    """Semi-axes for the readout, 3 significant digits; those below ``tol`` · the largest are exactly "0".
+
+    >>> format_lengths([2.7909, 1.0283]), format_lengths([1.7155, 4e-17])
+    ('2.79, 1.03', '1.72, 0')
+    """
+    s = np.asarray(lengths, float).reshape(-1)
+    top = float(s.max()) if s.size else 0.0
+    return ", ".join("0" if x <= tol * top or x == 0 else f"{x:.3g}" for x in s) if s.size else "0"
 
 
 def _slider_label(chain, i: int, rate: bool = False) -> str:
@@ -157,10 +167,16 @@ class Explorer(W.VBox):
     arrow, the velocity ellipse, with a readout of det J_r (square task rows) or √det(J_r J_rᵀ), the
     ratio σ_min/σ_max and a plain-words status.
 
+    When the task rows include orientation rows besides the drawn ṗ rows, the main ellipse is ṗ with those
+    rows held (``held_ellipse``, ``hold`` = their indices) and ``ellipse`` (ṗ, all joints free) a dashed
+    outline; ``cannot_move`` (a red dashed line, ``cannot_move_direction`` its unit vector or None) shows
+    where the tool cannot move, at and near a singular configuration (see the module text).
+
     State for tests and scripts: ``sliders``, ``rate_sliders``, ``status`` (HTML widget: contains
-    "singular" exactly when at or near a singular configuration), ``readout`` (HTML), ``image``
-    (the rendered PNG), ``fig``/``ax``, ``arm``/``velocity``/``ellipse`` artists, ``q``, ``qdot``,
-    ``info`` (the last :func:`classify` result), ``update(q=None, qdot=None)``.
+    "singular" exactly when at or near a singular configuration; ``<div class='kinlib-status'
+    data-state=…>``), ``readout`` (HTML, with ``kinlib-det`` and ``kinlib-held`` spans), ``image``
+    (the rendered PNG), ``fig``/``ax``, ``arm``/``velocity``/``ellipse``/``held_ellipse`` artists, ``q``,
+    ``qdot``, ``info`` (the last :func:`classify` result), ``update(q=None, qdot=None)``.
 
     >>> from kinlib.robots import planar_offset_3r
     >>> ex = Explorer(planar_offset_3r(1), q=[0.3, 0.7, 0.2])
@@ -190,20 +206,43 @@ class Explorer(W.VBox):
             q0[i] = min(max(q0[i], lo), hi)
         self.q, self.qdot = q0, qd0
         self.planar = is_planar(chain)
-        self.fig, self.ax = _new_figure(figsize, dpi, not self.planar)
+        self.fig, self.ax = new_figure(figsize, dpi, not self.planar)
         self.arm = draw_chain(chain, q0, self.ax, ranges=self.ranges, title=title or chain.name)
+        ell_rows = task_row_indices(ellipse_rows) if ellipse_rows is not None else ((3, 4) if self.planar else (3, 4, 5))
+        self.ellipse_rows = ell_rows
+        angular = tuple(r for r in self.rows if r < 3)
+        # the orientation rows of the task are held when the task also holds the drawn ṗ rows
+        self.hold = angular if show_ellipse and angular and set(ell_rows) <= set(self.rows) else ()
+        self.held_ellipse = self.cannot_move = self.cannot_move_direction = None
+        if self.hold:
+            held = rows_label(self.hold, tex=True)
+            self.held_ellipse = draw_velocity_ellipse(
+                self.ax, chain, q0, rows=ell_rows, scale=velocity_scale, hold=self.hold, color="tab:green",
+                label=rf"$\dot p$ with {held} held (×{velocity_scale:g})",
+            )  # fmt: skip
         self.ellipse = (
             draw_velocity_ellipse(
                 self.ax,
                 chain,
                 q0,
-                rows=ellipse_rows,
+                rows=ell_rows,
                 scale=velocity_scale,
-                label=f"velocity ellipse (×{velocity_scale:g})",
-            )
+                label=rf"$\dot p$, all joints free (×{velocity_scale:g})" if self.hold else
+                f"velocity ellipse (×{velocity_scale:g})",
+                **(dict(color="0.45", fill=False, axes_lines=False, lw=1.1, ls="--", alpha=0.8) if self.hold else {}),
+            )  # fmt: skip
             if show_ellipse
             else None
         )
+        main = self.held_ellipse or self.ellipse
+        if main is not None:
+            d = len(ell_rows)
+            self.cannot_move = add_line(
+                self.ax, np.zeros((3, 2)), color="tab:red", lw=2.0, ls=(0, (4, 2)), zorder=6,
+                label="tool cannot move" + (f" ({rows_label(self.hold, tex=True)} held)" if self.hold else ""),
+            )  # fmt: skip
+            self._cannot_len = 1.15 * velocity_scale * max(float(np.max(main.semi_axes)), 1e-9) if d else 0.0
+            self._cannot_len = max(self._cannot_len, 0.25 * self.arm.scale)
         self.velocity = (
             draw_velocity(
                 self.ax, chain, q0, qd0, scale=velocity_scale, label=rf"$\dot p = J\,\dot\theta$ (×{velocity_scale:g})"
@@ -250,9 +289,11 @@ class Explorer(W.VBox):
         moving = (
             self.arm.artists
             + (self.ellipse.artists if self.ellipse is not None else [])
+            + (self.held_ellipse.artists if self.held_ellipse is not None else [])
+            + ([self.cannot_move] if self.cannot_move is not None else [])
             + (self.velocity.artists if self.velocity is not None else [])
         )
-        self._blit = _Blitter(self.fig, moving, image_format)
+        self._blit = Blitter(self.fig, moving, image_format)
         self.w_max = self._max_manipulability()
         self.status = W.HTML(value="")
         self.readout = W.HTML(value="")
@@ -298,15 +339,38 @@ class Explorer(W.VBox):
             self.qdot = np.array([s.value for s in self.rate_sliders], float)
         self.q = q
         self.arm.update(q)
+        Jg = self.chain.jacobian_geometric(q)
+        p = self.arm.tool_position
         if self.ellipse is not None:
-            self.ellipse.update(q)
+            self.ellipse.update(q, Jg, p)
+        if self.held_ellipse is not None:
+            self.held_ellipse.update(q, Jg, p)
         if self.velocity is not None:
             self.velocity.update(q, self.qdot)
-        J = task_rows(self.chain.jacobian_geometric(q), self.rows)
-        self.info = info = classify(J, self.tol, self.near, self.w_max)
-        self.readout.value = self._readout_html(info)
-        self.status.value = self._status_html(info)
+        self.info = info = classify(task_rows(Jg, self.rows), self.tol, self.near, self.w_max)
+        self._show_cannot_move(info, p)
+        for w, v in ((self.readout, self._readout_html(info)), (self.status, self._status_html(info))):
+            if w.value != v:  # an unchanged text sends no message to the browser
+                w.value = v
         self.image.value = self._blit.render()
+
+    def _show_cannot_move(self, info, p):
+        """The red dashed line through the tool along the direction it cannot move (the smallest axis u_min of
+        the main ellipse — with the orientation held, if the task has orientation rows — i.e. the left-null
+        direction of that map within the ṗ space), shown when the state is 'singular' or 'near' and that
+        ellipse is thin (σ_min < 0.35 σ_max): the flattening is in ṗ, not only in the held rows."""
+        if self.cannot_move is None:
+            return
+        main = self.held_ellipse or self.ellipse
+        u, ratio = weakest_direction(main.semi_axes, main.directions)
+        show = info["state"] in ("singular", "near") and ratio < 0.35
+        self.cannot_move.set_visible(show)
+        if show:
+            d = u.size
+            c = p[:d]
+            seg = np.column_stack([c - self._cannot_len * u, c + self._cannot_len * u])
+            set_line(self.cannot_move, np.vstack([seg, np.zeros((3 - d, 2))]))
+        self.cannot_move_direction = u if show else None
 
     def _max_manipulability(self) -> float:
         """The largest √det(J_r J_rᵀ) over a fixed sample of the slider ranges (the reference for "near")."""
@@ -318,27 +382,46 @@ class Explorer(W.VBox):
         return float(np.max(manipulability_values(J, "yoshikawa")))
 
     def _readout_html(self, info) -> str:
+        esc = html.escape
         rows = rows_label(self.rows)
-        lines = [f"task rows of J: ({rows})"]
+        lines = [esc(f"task rows of J: ({rows})")]
         if info["det"] is not None:
-            lines.append(f"det J = {info['det']:+.4f}")
+            det = format_det(info["det"], info["state"] == "singular")
+            lines.append(f"det J = <span class='kinlib-det'>{det}</span>")
         m, n = len(self.rows), self.chain.n
-        lines.append(f"manipulability {'√det(JᵀJ)' if n < m else '√det(JJᵀ)'} = {info['manipulability']:.4f}")
+        sing = info["state"] == "singular"  # the rank test decides: then w, σ_min/σ_max and det are exactly 0
+        w = "0" if sing else f"{info['manipulability']:.4f}"
+        lines.append(esc(f"manipulability {'√det(JᵀJ)' if n < m else '√det(JJᵀ)'} = {w}"))
         if self.show_maximum:
-            lines.append(f"  = {100 * info['relative']:.1f}% of its maximum {self.w_max:.4f}")
-        lines.append(f"σ_min/σ_max = {info['ratio']:.4f}, rank {info['rank']} of {info['full_rank']}")
+            share = "0" if sing else f"{100 * info['relative']:.1f}"
+            lines.append(esc(f"  = {share}% of its maximum {self.w_max:.4f}"))
+        ratio = "0" if sing else f"{info['ratio']:.4f}"
+        lines.append(esc(f"σ_min/σ_max = {ratio}, rank {info['rank']} of {info['full_rank']}"))
+        if self.held_ellipse is not None:
+            held = format_lengths(self.held_ellipse.semi_axes, self.tol)
+            lines.append(
+                esc(f"ṗ ellipse, {rows_label(self.hold)} held: semi-axes ")
+                + f"<span class='kinlib-held'>{esc(held)}</span>"
+            )
+            lines.append(esc(f"ṗ ellipse, all joints free: {format_lengths(self.ellipse.semi_axes, self.tol)}"))
+        elif self.ellipse is not None:
+            lines.append(esc(f"velocity ellipse semi-axes: {format_lengths(self.ellipse.semi_axes, self.tol)}"))
         if self.velocity is not None:
             v = self.velocity.velocity
-            lines.append("ṗ = (" + ", ".join(f"{x:+.3f}" for x in v) + ")")
-        return "<div style='font-family:monospace;font-size:12px'>" + "<br>".join(map(html.escape, lines)) + "</div>"
+            lines.append(esc("ṗ = (" + ", ".join(f"{x:+.3f}" for x in v) + ")"))
+        return "<div class='kinlib-readout' style='font-family:monospace;font-size:12px'>" + "<br>".join(lines) + "</div>"
 
     def _status_html(self, info) -> str:
         if info["state"] == "singular":
+            where = (
+                f"with {rows_label(self.hold)} held the ṗ ellipse is "
+                + ("a segment" if self.planar else "flat")
+                + ": the tool cannot move along the red dashed line"
+                if self.held_ellipse is not None and self.cannot_move_direction is not None
+                else "some end-effector velocities are impossible here"
+            )
             msg, color = (
-                (
-                    f"SINGULAR configuration: J loses rank (rank {info['rank']} of {info['full_rank']}); "
-                    f"some end-effector velocities are impossible here (singular)"
-                ),
+                f"SINGULAR configuration: J loses rank (rank {info['rank']} of {info['full_rank']}); {where}",
                 "#b00020",
             )
         elif info["state"] == "near":
@@ -346,12 +429,24 @@ class Explorer(W.VBox):
             msg, color = f"near a singular configuration{share}: some directions need large joint rates", "#b36b00"
         else:
             msg, color = f"regular configuration: full rank {info['rank']}", "#1b5e20"
-        return f"<b style='color:{color}'>{html.escape(msg)}</b>"
+        return (
+            f"<div class='kinlib-status' data-state='{info['state']}'>"
+            f"<b style='color:{color}'>{html.escape(msg)}</b></div>"
+        )
 
     @property
     def state(self) -> str:
         """'singular', 'near' or 'regular' at the current sliders."""
         return self.info["state"]
+
+    def _repr_mimebundle_(self, **kwargs):
+        """The live widget view, plus a static ``image/png`` of the current picture and a one-line text
+        (see :func:`kinlib.widgets_render.display_bundle`): a notebook opened without a widget manager shows
+        the picture, not ``Explorer(children=…``."""
+        png = self.image.value if self.image.format == "png" else render_png(self.fig)
+        q = ", ".join(f"{x:.3f}" for x in self.q)
+        text = f"explorer of {self.chain.name} at θ = ({q}): {self.state} configuration (run the cell for sliders)"
+        return display_bundle(super()._repr_mimebundle_(**kwargs), png, text)
 
 
 def explorer(chain, **kwargs) -> Explorer:
@@ -447,6 +542,11 @@ class ConfigPicker(W.VBox):
         super().__init__([self.buttons, self.image, self.table])
         self.select(name0)
 
+    def _repr_mimebundle_(self, **kwargs):
+        """The live widget view, plus a static ``image/png`` of the current picture and a one-line text."""
+        text = f"configuration picker for {self.chain.name}: {self.name} (run the cell for the buttons)"
+        return display_bundle(super()._repr_mimebundle_(**kwargs), self.image.value, text)
+
     @staticmethod
     def _one_row(r) -> int:
         idx = task_row_indices(r)
@@ -492,7 +592,7 @@ class ConfigPicker(W.VBox):
             f"<tr><td>θ = ({', '.join(f'{x:.4f}' for x in q)})</td>{cells}</tr></table>"
             f"<div>largest |{html.escape(lab)}|: {who}</div>"
         )
-        self.image.value = _render_png(self.fig)
+        self.image.value = render_png(self.fig)
         return self
 
 

@@ -10,6 +10,21 @@ import pytest
 collect_ignore = ["fixtures"]
 
 
+@pytest.fixture(autouse=True, scope="session")
+def _grader_secret(tmp_path_factory):
+    """The grader's secret (kinlib.course.secret) for the whole run: a temporary file, never the tester's
+    ~/.config/kinlib/grader-secret (subprocesses inherit it through the environment)."""
+    import os
+
+    old = os.environ.get("KINLIB_GRADER_SECRET")
+    os.environ["KINLIB_GRADER_SECRET"] = str(tmp_path_factory.mktemp("grader-secret") / "grader-secret")
+    yield
+    if old is None:
+        os.environ.pop("KINLIB_GRADER_SECRET", None)
+    else:
+        os.environ["KINLIB_GRADER_SECRET"] = old
+
+
 @pytest.fixture
 def rng():
     """A NumPy generator with a fixed seed (reproducible random configurations)."""

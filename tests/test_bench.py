@@ -50,6 +50,7 @@ def test_bench_quick_writes_table(tmp_path):
         "symbolic condition number and isotropy",
         "## Notebooks",
         "## Explorers",
+        "## In the browser",
         "## Instructor checker",
         "import kinlib",
     ]:

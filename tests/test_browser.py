@@ -6,41 +6,34 @@ downloaded browser, with the network blocked.
    page error and no failed request, shows typeset math (MathJax output, no raw TeX) and its figures
    (every image decoded), and the saved widgets; a screenshot of each goes to build/screenshots/.
    An animation (matplotlib ``to_jshtml``) plays in the static page.
-2. JupyterLab on a free loopback port runs notebook 05; its joint slider is moved with the keyboard to
-   a singular configuration; the explorer then says so and its picture changes.
+2. JupyterLab as ``make lab`` starts it (tests/labdriver.py: notebooks trusted, lab-settings/), on a free
+   loopback port: every notebook opened fresh shows its widgets' and animation's pictures before running,
+   runs all cells (the time is printed, not asserted), and a slider of each explorer (a button of a picker)
+   gives a new picture; in notebook 05 the explorer at θ2 = −π/4 says "singular" (``kinlib-status``), shows
+   det J = 0 (``kinlib-det``) and a collapsed held-orientation ellipse (``kinlib-held``). Opened untrusted
+   (without ``make lab``), notebook 05 still shows static pictures (the display bundles' image/png).
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
-import shutil
-import signal
-import socket
 import subprocess
-import sys
-import time
-import urllib.request
 from pathlib import Path
 
 import pytest
+
+import labdriver
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 VENDOR = ROOT / "build" / "vendor"
 SCREENSHOTS = ROOT / "build" / "screenshots"
-CHROMIUM = "/usr/bin/chromium"
-ARGS = [
-    "--no-sandbox",
-    "--headless",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-    "--no-first-run",
-]
+CHROMIUM = labdriver.CHROMIUM
+ARGS = labdriver.CHROMIUM_ARGS
 
 pytestmark = [pytest.mark.browser]
 
@@ -123,31 +116,7 @@ def _site(sites, name):
     return site
 
 
-class Watch:
-    """Records what a page asks of the network and what goes wrong on it."""
-
-    def __init__(self, page, allow=("file:", "data:", "blob:", "about:")):
-        self.blocked, self.failed, self.errors, self.console = [], [], [], []
-        self.allow = allow
-
-        def route(r):
-            if r.request.url.startswith(self.allow):
-                r.continue_()
-            else:
-                self.blocked.append(r.request.url)
-                r.abort()
-
-        page.route("**/*", route)
-        page.on("requestfailed", lambda r: self.failed.append(f"{r.url} ({r.failure})"))
-        page.on("pageerror", lambda e: self.errors.append(str(e)))
-        page.on("console", lambda m: self.console.append(m.text) if m.type == "error" else None)
-        page.on("response", lambda r: self.failed.append(f"{r.url} (HTTP {r.status})") if r.status >= 400 else None)
-
-    def assert_clean(self, what):
-        assert not self.blocked, f"{what} tried to reach the network: {self.blocked[:5]}"
-        assert not self.failed, f"{what}: failed requests {self.failed[:5]}"
-        assert not self.errors, f"{what}: page errors {self.errors[:5]}"
-        assert not self.console, f"{what}: console errors {self.console[:5]}"
+Watch = labdriver.Watch  # blocked/failed requests, page and console errors
 
 
 def _open(browser, path: Path):
@@ -275,140 +244,169 @@ def test_an_animation_plays_without_a_kernel(sites, browser):
 
 
 # ---------------------------------------------------------------------------------------------------
-# 2. JupyterLab: notebook 05's explorer reaches a singular configuration
+# 2. JupyterLab, as `make lab` starts it (tests/labdriver.py): every notebook opens with its pictures, runs,
+#    and its explorers move; notebook 05's explorer at a singular configuration says so and shows it.
+#    Times are printed (run with -s to see them; `make bench` reports them), never asserted.
 
 
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+def _lab_notebooks() -> Path:
+    """notebooks/, or ``KINLIB_LAB_NOTEBOOKS`` (e.g. a copy just run by ``kinlib execute``, to test the
+    notebooks as `make notebooks` would leave them without touching notebooks/)."""
+    return Path(os.environ.get("KINLIB_LAB_NOTEBOOKS") or NOTEBOOKS).resolve()
 
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
-    nb05 = NOTEBOOKS / "05_singularities_planar.ipynb"
-    assert nb05.exists(), "notebooks/05_singularities_planar.ipynb is missing"
-    work = tmp_path_factory.mktemp("lab")
-    scratch = work / "notebooks"
-    shutil.copytree(NOTEBOOKS, scratch)
-    port = _free_port()
-    jupyter = Path(sys.executable).parent / "jupyter"
-    env = dict(
-        os.environ,
-        JUPYTER_CONFIG_DIR=str(work / "config"),
-        JUPYTERLAB_SETTINGS_DIR=str(work / "settings"),
-        JUPYTERLAB_WORKSPACES_DIR=str(work / "workspaces"),
-    )
-    notif = work / "settings" / "@jupyterlab" / "apputils-extension" / "notification.jupyterlab-settings"
-    notif.parent.mkdir(parents=True)
-    notif.write_text('{"fetchNews": "false", "checkForUpdates": false}')  # no news toast
-    log = open(work / "lab.log", "w")
-    proc = subprocess.Popen(
-        [
-            str(jupyter),
-            "lab",
-            "--no-browser",
-            "--IdentityProvider.token=",
-            "--expose-app-in-browser",
-            "--allow-root",
-            f"--port={port}",
-            "--ServerApp.ip=127.0.0.1",
-            "--ServerApp.port_retries=0",
-            f"--ServerApp.root_dir={scratch}",
-            "--LabApp.news_url=None",
-            "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
-        ],
-        stdout=log,
-        stderr=subprocess.STDOUT,
-        env=env,
-        start_new_session=True,
-    )
-    url = f"http://127.0.0.1:{port}"
-    try:
-        deadline = time.time() + 60
-        while True:
-            try:
-                urllib.request.urlopen(url + "/api/status", timeout=2)
-                break
-            except OSError:
-                if proc.poll() is not None or time.time() > deadline:
-                    raise RuntimeError("JupyterLab did not start:\n" + (work / "lab.log").read_text()[-3000:]) from None
-                time.sleep(0.3)
+    """JupyterLab on a copy of the notebooks, trusted and with lab-settings/ (what `make lab` does)."""
+    with labdriver.jupyterlab(tmp_path_factory.mktemp("lab"), _lab_notebooks(), trust=True) as url:
         yield url
-    finally:
-        os.killpg(proc.pid, signal.SIGTERM)
-        try:
-            proc.wait(15)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-        log.close()
 
 
-_KERNEL_IDLE = """() => {
-  const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;
-  const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;
-  return !!k && k.status === 'idle' && w.content && w.content.widgets && w.content.widgets.length > 0;
-}"""
-
-_RUN_ALL_DONE = """() => {
-  const w = window.jupyterapp.shell.currentWidget;
-  const k = w.sessionContext.session.kernel;
-  return k.status === 'idle' && w.content.widgets.every(c => c.model.type !== 'code' || !c.promptNode
-           || !c.promptNode.textContent.includes('*'));
-}"""
+@pytest.fixture(scope="module")
+def lab_untrusted(tmp_path_factory):
+    """JupyterLab on a copy of the notebooks that nobody trusted (opened without `make lab`)."""
+    with labdriver.jupyterlab(tmp_path_factory.mktemp("lab-untrusted"), _lab_notebooks(), trust=False) as url:
+        yield url
 
 
-def test_lab_explorer_reaches_a_singular_configuration(browser, lab):
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
-    host = lab.split("//")[1]
-    watch = Watch(page, allow=(lab, f"ws://{host}", "data:", "blob:", "about:"))
+def test_make_lab_trusts_the_notebooks_and_uses_the_project_settings():
+    """`make lab` trusts the notebooks (JupyterLab renders saved widgets only in trusted notebooks) and starts
+    JupyterLab with lab-settings/, whose overrides save the widget state with the notebook."""
+    out = subprocess.run(["make", "-n", "lab"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
+    assert re.search(r"jupyter trust .*notebooks/\d\d_", out), out
+    assert f"--LabApp.app_settings_dir={ROOT / 'lab-settings'}" in out, out
+    overrides = json.loads((labdriver.LAB_SETTINGS / "overrides.json").read_text())
+    assert overrides["@jupyter-widgets/jupyterlab-manager:plugin"]["saveState"] is True
+
+
+def _no_text_reprs(page):
+    """No widget or animation shown as its text repr (`Explorer(children=…`, `<…Animation object…>`)."""
+    text = page.locator(".jp-OutputArea-output[data-mime-type='text/plain']").evaluate_all(
+        "els => els.map(e => e.textContent).join('\\n')"
+    )
+    for bad in ("Explorer(children", "ConfigPicker(children", "VBox(children", "Animation object"):
+        assert bad not in text, f"a widget is shown as text: {bad}…"
+    assert page.get_by_text("Error displaying widget").count() == 0
+
+
+@pytest.mark.parametrize("stem", REAL)
+def test_lab_notebook_opens_with_pictures_runs_and_its_explorers_move(browser, lab, stem):
+    page, watch = labdriver.open_notebook(browser, lab, stem)
     try:
-        t0 = time.time()
-        page.goto(f"{lab}/lab/tree/05_singularities_planar.ipynb", wait_until="domcontentloaded")
-        page.wait_for_function(_KERNEL_IDLE, timeout=60000)
-        page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
-        page.wait_for_timeout(500)
-        page.wait_for_function(_RUN_ALL_DONE, timeout=90000, polling=250)
-        assert (
-            page.locator(
-                ".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.stderr'] :text('Traceback')"
-            ).count()
-            == 0
-        )
-        errors = page.locator(".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
-        assert errors.count() == 0, "a cell raised: " + errors.first.inner_text()[:500]
+        # 1. opened fresh, not run: every widget and animation shows its saved picture
+        widgets = labdriver.widget_cells(page)
+        for area in widgets:
+            labdriver.wait_picture(area, what="a widget output on open (saved widget state)")
+        anims = labdriver.animations(page)
+        for k in range(anims.count()):
+            labdriver.wait_picture(anims.nth(k), what="the animation on open")
+        _no_text_reprs(page)
+        if stem.startswith("05"):
+            assert widgets and anims.count(), "notebook 05 has an explorer and an animation"
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        if widgets:
+            labdriver.scroll_to(widgets[0])
+            widgets[0].screenshot(path=str(SCREENSHOTS / f"lab-{stem}-on-open.png"))
 
-        ex = page.locator(".jp-OutputArea-output").filter(has_text="joint positions").first
-        ex.scroll_into_view_if_needed()
-        status = ex.locator(".widget-html").filter(has_text="configuration").last
-        page.wait_for_function("(el) => el.innerText.length > 0", arg=status.element_handle(), timeout=20000)
-        assert "SINGULAR" not in status.inner_text(), "the explorer should start at a regular configuration"
-        picture = ex.locator("img").first
-        before = picture.screenshot()
+        # 2. run all (time reported, not asserted)
+        seconds, kernel = labdriver.run_all(page, details=True)
+        print(f"\n{stem}: run-all {seconds:.1f} s in JupyterLab (kernel busy {kernel:.1f} s)")
+        for k in range(anims.count()):  # the player shows frame 0 after run-all, not a blank
+            labdriver.wait_picture(anims.nth(k), what="the animation after run-all")
+        _no_text_reprs(page)
 
-        # θ2's slider: move it with the keyboard to the singular θ2 = -π/4 (det J ∝ sin(θ2 + π/4))
-        slider = ex.locator(".widget-slider, .widget-hslider").filter(has_text="θ2").first
-        handle = slider.locator(".noUi-handle").first
-        readout = slider.locator(".widget-readout").first
+        # 3. each explorer: one key press on θ1 gives a new picture; a picker: another button, a new picture
+        for area in labdriver.widget_cells(page):
+            labdriver.wait_picture(area)
+            if labdriver.EXPLORER_TEXT in area.text_content():
+                _slider, handle, readout = labdriver.slider(area, "θ1")
+                before = readout.inner_text()
+                handle.focus()
+                ms = labdriver.move_slider(area, handle, "ArrowRight")
+                assert readout.inner_text() != before, "the slider did not move"
+                print(f"{stem}: slider move → new picture {ms:.0f} ms")
+            else:
+                buttons = area.locator("button:not(.mod-active)")
+                assert buttons.count() > 0, "a widget that is neither an explorer nor a picker"
+                ms = labdriver.click_and_wait(area, buttons.first)
+                print(f"{stem}: picker button → new picture {ms:.0f} ms")
+        assert not watch.blocked, f"JupyterLab tried to reach the network: {watch.blocked[:5]}"
+        assert not watch.errors, f"page errors: {[e[-300:] for e in watch.errors[:3]]}"
+    finally:
+        labdriver.close_notebook(page)
+
+
+def _numbers(text: str) -> list[float]:
+    return [float(x) for x in re.findall(r"[-+]?\d+(?:\.\d+)?(?:e[-+]?\d+)?", text.replace("\u2212", "-"))]
+
+
+def test_lab_05_explorer_at_a_singular_configuration(browser, lab):
+    """θ2 = −π/4 (det J ∝ sin(θ2 + π/4)): the banner says singular, det J shows 0 and the ṗ ellipse with the
+    orientation held is collapsed (a zero semi-axis); the picture changes on the way there."""
+    stem = "05_singularities_planar"
+    assert stem in REAL, "notebooks/05_singularities_planar.ipynb is missing"
+    page, watch = labdriver.open_notebook(browser, lab, stem)
+    try:
+        labdriver.run_all(page)
+        explorers = labdriver.explorers(page)
+        assert explorers, "notebook 05 has no explorer"
+        ex = explorers[-1]
+        labdriver.wait_picture(ex)
+        status, det, held = ex.locator(".kinlib-status"), ex.locator(".kinlib-det"), ex.locator(".kinlib-held")
+        for name, loc in (("kinlib-status", status), ("kinlib-det", det), ("kinlib-held", held)):
+            assert loc.count() == 1, f"the explorer has no element of class {name} (kinlib.widgets)"
+        before = ex.locator("img").first.get_attribute("src")
+        _slider, handle, readout = labdriver.slider(ex, "θ2")
         handle.focus()
         target, step = -math.pi / 4, math.pi / 180
-        for _ in range(200):
-            value = float(readout.inner_text().replace("\u2212", "-"))
+        for _ in range(400):
+            value = labdriver.slider_value(readout)
             if abs(value - target) < step / 2:
                 break
             handle.press("ArrowLeft" if value > target else "ArrowRight")
         else:
             pytest.fail(f"the θ2 slider did not reach {target:.3f} (at {readout.inner_text()})")
-        page.wait_for_function("(el) => el.innerText.includes('SINGULAR')", arg=status.element_handle(), timeout=20000)
-        page.wait_for_timeout(500)  # the last picture
-        after = picture.screenshot()
-        assert after != before, "the explorer's picture did not change"
+        # the HTML widgets replace their content on every update: query the explorer afresh each time
+        page.wait_for_function(
+            "(root) => { const s = root.querySelector('.kinlib-status'); "
+            "return !!s && s.getAttribute('data-state') === 'singular'; }",
+            arg=ex.element_handle(),
+            timeout=60000,
+            polling=100,
+        )
+        assert "SINGULAR" in status.inner_text().upper()
+        assert det.inner_text().strip() == "0", f"det J shows {det.inner_text()!r} at a singular configuration"
+        axes = _numbers(held.inner_text())
+        assert len(axes) == 2 and min(axes) == 0 and max(axes) > 0, f"held-orientation ellipse: {held.inner_text()}"
+        page.wait_for_function(
+            "([img, before]) => img.src !== before && img.complete && img.naturalWidth > 0",
+            arg=[ex.locator("img").first.element_handle(), before],
+            timeout=60000,
+        )
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-        (SCREENSHOTS / "lab-05-explorer-before.png").write_bytes(before)
-        (SCREENSHOTS / "lab-05-explorer-singular.png").write_bytes(after)
-        ex.screenshot(path=str(SCREENSHOTS / "lab-05-explorer.png"))
-        assert time.time() - t0 < 120
+        ex.screenshot(path=str(SCREENSHOTS / "lab-05-explorer-singular.png"))
         assert not watch.blocked, f"JupyterLab tried to reach the network: {watch.blocked[:5]}"
-        assert not watch.errors, f"page errors: {watch.errors[:5]}"
+        assert not watch.errors, f"page errors: {[e[-300:] for e in watch.errors[:3]]}"
     finally:
-        page.close()
+        labdriver.close_notebook(page)
+
+
+def test_untrusted_notebook_shows_static_pictures(browser, lab_untrusted):
+    """Opened without `make lab` (not trusted), JupyterLab cannot draw widgets; the explorer's and the
+    animation's display bundles carry a static image/png, which it shows instead of the text repr."""
+    stem = "05_singularities_planar"
+    assert stem in REAL, "notebooks/05_singularities_planar.ipynb is missing"
+    page, watch = labdriver.open_notebook(browser, lab_untrusted, stem)
+    try:
+        areas = labdriver.widget_cells(page)
+        assert areas, "notebook 05 has no widget output"
+        for area in areas:
+            labdriver.wait_picture(area, what="an untrusted widget output (its static image/png)")
+            assert area.locator("[data-mime-type='image/png'] img").count() == 1, "no static image/png"
+        anim = labdriver.output_of(page, "animate_singularity(")
+        assert anim is not None, "notebook 05 has no animation"
+        labdriver.wait_picture(anim, what="the untrusted animation (frame 0 without scripts)")
+        _no_text_reprs(page)
+        assert not watch.blocked, f"JupyterLab tried to reach the network: {watch.blocked[:5]}"
+    finally:
+        labdriver.close_notebook(page)

@@ -18,6 +18,7 @@ import pytest
 from kinlib.course import compare as C
 from kinlib.course import grade, schema
 from kinlib.course.cli import main
+from kinlib.course.secret import load_secret
 
 FIX = Path(__file__).parent / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
@@ -124,6 +125,8 @@ def batch(tmp_path_factory):
     (d / "garbage.ipynb").write_bytes(b"\x00this is not JSON {")
     foreign = _load(REF)
     del foreign["metadata"]["kinlib"]
+    # without its id a notebook is recognised by its questions (test_grade_verdicts.py): this one has none of ours
+    foreign["cells"] = [_code("x = 1  # someone else's notebook")]
     (d / "foreign.ipynb").write_text(json.dumps(foreign))
     out = tmp_path_factory.mktemp("grades")
     summary = grade.grade_batch(
@@ -175,7 +178,7 @@ def test_every_submission_has_rows_and_the_batch_completed(batch):
     }
     with open(batch["out"] / "grades.csv") as f:
         rows = list(csv.DictReader(f))
-    assert list(rows[0]) == ["submission", "notebook", "part", "status", "points", "message"]
+    assert {"submission", "notebook", "part", "status", "points", "message"} <= set(rows[0])
     assert len(rows) == len(batch["summary"]["rows"])
     assert {r["status"] for r in rows} <= {"pass", "fail", "error"}
     feedback = list((batch["out"] / "feedback").glob("*.md"))
@@ -210,7 +213,7 @@ def test_mistakes_are_named(batch):
     assert "does not depend on L" in _msg(batch, "erin_mistakes_a", "1.2")
     assert "rows" in _msg(batch, "erin_mistakes_a", "1.3") and "column" in _msg(batch, "erin_mistakes_a", "1.3")
     assert "degrees" in _msg(batch, "erin_mistakes_a", "1.4")
-    assert "partly right" in _msg(batch, "erin_mistakes_a", "1.5")
+    assert "a tie counts" in _msg(batch, "erin_mistakes_a", "1.5")  # not "partly right": that tells the key
     assert _status(batch, "frank_mistakes_b") == dict.fromkeys(PARTS, "fail")
     assert "columns swapped" in _msg(batch, "frank_mistakes_b", "1.1")
     assert "wrong sign" in _msg(batch, "frank_mistakes_b", "1.2")
@@ -226,7 +229,7 @@ def test_loop_and_raise_at_top_still_graded(batch):
     res = {r["submission"].split("/")[-1]: r for r in batch["summary"]["results"]}
     loop = res["loops.ipynb"]
     assert [c["status"] for c in loop["cells"]].count("timeout") == 1
-    assert loop["seconds"] < 30
+    assert loop["seconds"] < 60  # the loop cost its cell's limit, not the submission's (60 s)
     fb = Path(loop["feedback"]).read_text()
     assert f"{CELL_TIMEOUT:g} s limit" in fb
     assert "RuntimeError: boom at the top" in Path(res["raises_at_top.ipynb"]["feedback"]).read_text()
@@ -273,7 +276,7 @@ def test_points_come_from_the_question_cells(batch):
 
 @pytest.mark.slow
 def test_reruns_are_reproducible(batch):
-    refs = grade.load_references(FIX / "notebooks", batch["out"] / "cache")
+    refs = grade.load_references(FIX / "notebooks", batch["out"] / "cache", secret=load_secret())
     sub = next(p for p in (batch["out"].parent).glob("subs*/dan_transposed.ipynb"))
     again = grade.grade_submission(sub, refs, cell_timeout=CELL_TIMEOUT, display_name=str(sub))
     first = batch["rows"]["dan_transposed"]
@@ -348,11 +351,11 @@ def test_compare_set_and_choice():
     same = {"tag": "set", "conditions": [[[{"var": None, "points": [-math.pi / 4, 3 * math.pi / 4], "intervals": []}]]]}
     assert C.compare_set(same, ref, "S") == (True, "")
     other = {"tag": "set", "conditions": [[[{"var": "theta1", "points": [0.0], "intervals": []}]]]}
-    assert "theta2" in C.compare_set(other, ref, "S")[1]
+    assert "not the right joint variables" in C.compare_set(other, ref, "S")[1]  # the key's are not named
     empty_ref = {"conditions": [[]]}
     empty = {"tag": "set", "conditions": [[[{"var": None, "points": [], "intervals": []}]]]}
     assert C.compare_set(empty, empty_ref, "S") == (True, "")
-    assert "no such configurations" in C.compare_set(same, empty_ref, "S")[1]
+    assert "not the right set" in C.compare_set(same, empty_ref, "S")[1]  # not "there are none": the key
     union = {
         "conditions": [
             [

@@ -293,12 +293,29 @@ def test_workbook_runs_top_to_bottom_unanswered(built, tmp_path):
     assert "skipped: this cell uses Js" in _stream(ran)
 
 
+def _solution_setup(source) -> str:
+    """The imports and helper functions of the notebook's own cells (the workbook leaves out those only
+    the solutions use): a student pasting the solutions needs them too."""
+    parts = []
+    for c in source.cells:
+        if c.cell_type != "code" or {"solution", "check"} & set(c.metadata.get("tags", [])):
+            continue
+        try:
+            tree = ast.parse(c.source)
+        except SyntaxError:
+            continue
+        for node in tree.body:
+            if isinstance(node, (ast.ImportFrom, ast.FunctionDef)):
+                parts.append(ast.get_source_segment(c.source, node))
+    return "\n".join(parts) + "\n"
+
+
 def _paste_solutions(wb, source, edit=None):
     wb = copy.deepcopy(wb)
     src = [c for c in _solution_cells(source) if c.cell_type == "code"]
     dst = [c for c in _solution_cells(wb) if c.cell_type == "code"]
-    for a, b in zip(src, dst):
-        b.source = edit(a.source) if edit else a.source
+    for k, (a, b) in enumerate(zip(src, dst)):
+        b.source = (_solution_setup(source) if k == 0 else "") + (edit(a.source) if edit else a.source)
     return wb
 
 
@@ -325,6 +342,32 @@ def test_workbook_with_wrong_answers_fails(built, tmp_path):
     assert any(ln.startswith("part 1.1 · Js: ✗") for ln in lines), lines
     assert any(ln.startswith("part 1.2 · fastest: ✗") for ln in lines), lines
     assert any(ln.startswith("part 1.4 · span: ") for ln in lines)
+
+
+def _setup_cell(nb):
+    return next(c for c in nb.cells if c.cell_type == "code" and "workbook-setup" not in c.metadata.get("tags", []))
+
+
+def test_workbook_setup_imports_only_what_the_student_starts_with(built):
+    out, _, _ = built
+    wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
+    setup = _setup_cell(wb).source
+    assert "from kinlib import robots" in setup and "r = robots.planar_offset_3r()" in setup
+    assert "import sympy as sp" in setup and "import kinlib" in setup
+    # the solving call of 1.4 and the helper only the check cells use are not there
+    assert "column_space" not in setup and "same_matrix" not in setup
+    text = (out / "workbooks" / f"{STEM}.ipynb").read_text()
+    assert "column_space" not in text and "same_matrix" not in text
+    ast.parse(setup)
+
+
+def test_problems_show_only_the_students_setup(built):
+    out, entry, _ = built
+    visible = _visible((out / "problems" / f"{STEM}.html").read_text())
+    assert "column_space" not in visible and "same_matrix" not in visible
+    assert "from kinlib import robots" in visible  # the setup itself is still shown
+    setup = _setup_cell(entry["problems"]).source
+    assert setup == _setup_cell(nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)).source
 
 
 def test_a_failing_notebook_is_named_with_its_cell(tmp_path, capsys):

@@ -157,3 +157,122 @@ def test_bad_qdot_and_rows():
         twist_speed(sp.ones(6, 4), sp.symbols("a b c"))
     with pytest.raises(ValueError, match="unknown row"):
         velocity_ellipsoid(np.ones((6, 3)), rows=["vw"])
+
+
+# --- velocity_ellipsoid(J, rows, hold): the ellipse with some task rows held at zero (issue 13, item 3) ------
+def _null_basis_qr(H: np.ndarray) -> np.ndarray:
+    """An orthonormal basis of null(H) by a complete QR of Hᵀ (independent of the SVD used by kinlib)."""
+    r = np.linalg.matrix_rank(H)
+    Q, _ = np.linalg.qr(H.T, mode="complete")
+    return Q[:, r:]
+
+
+def _support(lengths, U, d):
+    """Support function of the ellipse with semi-axes lengths along the columns of U, in direction d."""
+    return float(np.sqrt(np.sum((np.asarray(lengths) * (U.T @ d)) ** 2)))
+
+
+def _geometric_J_mr(chain, q):
+    """[ω_s; ṗ] from modern_robotics: ṗ = v_s + ω_s × p (p the tool origin)."""
+    S, M = np.array(chain.screws, float), np.array(chain.M, float)
+    Js = mr.JacobianSpace(S, np.asarray(q, float))
+    p = mr.FKinSpace(M, S, np.asarray(q, float))[:3, 3]
+    return np.vstack([Js[:3], Js[3:] - np.cross(p, Js[:3].T).T])
+
+
+@pytest.mark.parametrize("n, rows, hold", [(3, ("vx", "vy"), ("wz",)), (6, "linear", "angular"), (5, [3, 4], [0, 2])])
+def test_held_ellipsoid_support_function_and_extreme_points(rng, n, rows, hold):
+    from kinlib.taskspace import task_row_indices
+
+    r, h = list(task_row_indices(rows)), list(task_row_indices(hold))
+    for _ in range(6):
+        J = rng.normal(size=(6, n))
+        lengths, U = velocity_ellipsoid(J, rows=rows, hold=hold)
+        N = _null_basis_qr(J[h])
+        A = J[r]
+        assert np.allclose(U.T @ U, np.eye(U.shape[1]), atol=1e-10)
+        for _ in range(10):  # support function: max over the unit ball of null(J_h) of d·(A θ̇) = ‖Nᵀ Aᵀ d‖
+            d = rng.normal(size=len(r))
+            assert _support(lengths, U, d) == pytest.approx(np.linalg.norm(N.T @ A.T @ d), rel=1e-9, abs=1e-12)
+        # extreme points: sampled θ̇ = N z, ‖z‖ = 1 never leave the ellipse, and reach its largest semi-axis
+        z = rng.normal(size=(N.shape[1], 400))
+        pts = A @ N @ (z / np.linalg.norm(z, axis=0))
+        big = np.max(np.abs(U[:, 0] @ pts))
+        assert big <= lengths[0] * (1 + 1e-12) and big >= 0.9 * lengths[0]
+
+
+def test_held_ellipse_semi_axes_by_mpmath(rng):
+    import mpmath
+
+    J = rng.normal(size=(6, 4))
+    lengths, _ = velocity_ellipsoid(J, rows=("vx", "vy", "vz"), hold=("wz",))
+    N = _null_basis_qr(J[[2]])
+    s = mpmath.svd_r(mpmath.matrix((J[[3, 4, 5]] @ N).tolist()), compute_uv=False)
+    assert sorted(lengths, reverse=True) == pytest.approx(sorted([float(x) for x in s], reverse=True), rel=1e-12)
+
+
+def test_held_ellipse_collapses_at_theta2_minus_pi_over_4_on_the_section_5_robot():
+    """Notebook 05's explorer at θ2 = −π/4: the held ellipse is a segment, the free ṗ ellipse stays fat."""
+    chain = robots.planar_offset_3r(1)
+    q = [np.pi / 6, -np.pi / 4, -np.pi / 3]
+    J = _geometric_J_mr(chain, q)
+    held, U = velocity_ellipsoid(J, rows=("vx", "vy"), hold=("wz",))
+    free, _ = velocity_ellipsoid(J, rows=("vx", "vy"))
+    assert held[1] < 1e-12 and held[0] > 1.0
+    assert free == pytest.approx([2.79, 1.03], abs=0.01)
+    # the exact values at the exact configuration: the zero is an exact 0
+    Je = robots.planar_offset_3r(1).jacobian_geometric([pi / 6, -pi / 4, -pi / 3])
+    exact, Ue = velocity_ellipsoid(Je, rows=("vx", "vy"), hold=("wz",))
+    assert exact[1] == 0 and float(exact[0]) == pytest.approx(held[0], rel=1e-12)
+    assert all(isinstance(x, sp.Basic) for x in exact) and not any(e.has(sp.Float) for e in exact)
+    assert np.allclose(np.abs(np.array(Ue, float)), np.abs(U), atol=1e-12)
+
+
+def test_held_ellipse_is_flat_exactly_on_the_singular_set(rng):
+    """|det [J_ω; J_ṗ]| = ‖J_ω‖ · σ1 σ2 of the held map (an identity for one held row): the smallest held
+    semi-axis is 0 exactly where the task rows (ω_z, ṗ_x, ṗ_y) lose rank — on the family θ2 = −π/4, 3π/4."""
+    chain = robots.planar_offset_3r(1)
+    for _ in range(20):
+        q = rng.uniform(-np.pi, np.pi, 3)
+        J = _geometric_J_mr(chain, q)
+        held, _ = velocity_ellipsoid(J, rows=("vx", "vy"), hold=("wz",))
+        T = J[[2, 3, 4]]
+        assert np.sqrt(3) * np.prod(held) == pytest.approx(abs(np.linalg.det(T)), abs=1e-12)
+    for theta2 in (-np.pi / 4, 3 * np.pi / 4):
+        for _ in range(10):
+            q = [rng.uniform(-np.pi, np.pi), theta2, rng.uniform(-np.pi, np.pi)]
+            J = _geometric_J_mr(chain, q)
+            held, _ = velocity_ellipsoid(J, rows=("vx", "vy"), hold=("wz",))
+            assert held[-1] < 1e-12 * held[0]
+            assert np.linalg.matrix_rank(J[[2, 3, 4]], tol=1e-9) == 2
+
+
+@pytest.mark.parametrize(
+    "kwargs, exc, words",
+    [
+        (dict(rows=("vx", "vy"), hold=("vx",)), ValueError, ["rows", "hold", "share"]),
+        (dict(rows=("vx", "vy"), hold=("spin",)), ValueError, ["hold", "unknown"]),
+        (dict(rows=None, hold=("wz",)), ValueError, ["rows"]),
+        (dict(rows=("vx", "vy"), hold=True), TypeError, ["hold"]),
+        (dict(rows=("vx", "vy"), hold=[]), ValueError, ["hold"]),
+    ],
+)
+def test_held_ellipse_refuses_bad_arguments(kwargs, exc, words):
+    J = np.arange(18.0).reshape(6, 3)
+    with pytest.raises(exc) as e:
+        velocity_ellipsoid(J, **kwargs)
+    assert all(w in str(e.value) for w in words), str(e.value)
+
+
+@pytest.mark.parametrize(
+    "J, exc",
+    [
+        (np.full((6, 3), np.nan), ValueError),
+        (np.zeros((4, 6, 3)), ValueError),
+        ("J", TypeError),
+        (np.zeros((2, 3)), ValueError),  # names need 6 rows
+    ],
+)
+def test_held_ellipse_refuses_bad_J(J, exc):
+    with pytest.raises(exc, match="J|rows"):
+        velocity_ellipsoid(J, rows=("vx", "vy"), hold=("wz",))

@@ -1,8 +1,8 @@
 """Which cells of a notebook depend on its answers: name analysis of code cells, and worked solutions.
 
 Used by :mod:`kinlib.course.handouts` to leave answers out of the problem pages and the workbooks: cells
-that read answer variables (computed by ``solution`` cells) and the untagged markdown of worked
-solutions.
+that read answer variables (computed by ``solution`` cells), the untagged markdown of worked
+solutions, and the imports and helper functions only the solutions use (:func:`trim_setup`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import ast
 
 from .schema import ANSWER_TAGS, CHECK, QUESTION, SOLUTION, cell_tags
 
-__all__ = ["cell_names", "worked_narrative", "answer_dependents"]
+__all__ = ["cell_names", "loaded_names", "trim_setup", "worked_narrative", "answer_dependents"]
 
 
 def _python_source(src: str) -> str:
@@ -189,3 +189,63 @@ def answer_dependents(nb) -> dict:
         else:
             defined |= binds - answer_names
     return needs
+
+
+def loaded_names(src: str) -> set:
+    """Every name a code cell reads anywhere (bound before or not; a conservative "uses"), or None when
+    it does not parse.
+
+    >>> sorted(loaded_names("from m import f\\nx = f(y)\\n%matplotlib inline"))
+    ['f', 'get_ipython', 'y']
+    """
+    try:
+        tree = ast.parse(_python_source(src))
+    except SyntaxError:
+        return None
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+
+
+def trim_setup(src: str, used: set) -> str:
+    """``src`` without the ``from M import`` names and top-level functions that no name in ``used`` reads
+    (what only the solutions need: the workbook and the problems show the student's setup). Other
+    statements, ``import M`` lines and comments stay; a cell that does not parse as plain Python is kept.
+
+    >>> print(trim_setup("import numpy as np\\nfrom kinlib.singularities import (task_rows,\\n"
+    ...                  "    column_space)\\n\\n\\ndef fd(x):\\n    return x\\n\\nr = 1", {"task_rows", "np"}))
+    import numpy as np
+    from kinlib.singularities import task_rows
+    <BLANKLINE>
+    r = 1
+    """
+    try:
+        tree = ast.parse(src)
+    except SyntaxError:
+        return src
+    lines = src.splitlines()
+    edits = []  # (first line, last line, replacement lines), 0-based inclusive
+    for node in tree.body:
+        first = min([node.lineno] + [d.lineno for d in getattr(node, "decorator_list", [])]) - 1
+        last = node.end_lineno - 1
+        if isinstance(node, ast.ImportFrom) and node.module and node.level == 0:
+            keep = [a for a in node.names if a.name == "*" or (a.asname or a.name) in used]
+            if len(keep) == len(node.names):
+                continue
+            names = ", ".join(a.name + (f" as {a.asname}" if a.asname else "") for a in keep)
+            text = f"from {node.module} import {names}"
+            if len(text) > 110:
+                text = f"from {node.module} import (\n    {names},\n)"
+            edits.append((first, last, text.splitlines() if keep else []))
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) and node.name not in used:
+            edits.append((first, last, []))
+    if not edits:
+        return src
+    for first, last, new in sorted(edits, reverse=True):
+        lines[first : last + 1] = new
+    out: list = []
+    for line in lines:  # no runs of blank lines left where statements went
+        if not line.strip() and (not out or not out[-1].strip()):
+            continue
+        out.append(line)
+    while out and not out[-1].strip():
+        out.pop()
+    return "\n".join(out) + ("\n" if src.endswith("\n") else "")

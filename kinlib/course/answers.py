@@ -36,6 +36,7 @@ __all__ = [
     "looks_like_set",
     "choice_value",
     "type_name",
+    "expr_tree",
 ]
 
 
@@ -257,3 +258,48 @@ def choice_value(value):
     if math.isfinite(f) and f == int(f):
         return int(f)
     return f
+
+
+_TREE_FUNCS = ("sin", "cos", "tan")
+_TREE_MAX_NODES = 4000
+
+
+def expr_tree(obj, max_nodes=_TREE_MAX_NODES):
+    """A SymPy expression or matrix as a JSON tree of plain lists: a ``property`` answer (or a constant exact
+    subspace) is decided exactly in the grader, which rebuilds it from a whitelist of numbers, symbols, π,
+    +, ×, powers and sin/cos/tan (:func:`kinlib.course.properties.from_tree`). Raises ValueError for
+    anything else or more than ``max_nodes`` nodes.
+
+    >>> import sympy as sp
+    >>> expr_tree(sp.Symbol("L", positive=True) * sp.cos(sp.Symbol("t")) + sp.Rational(1, 2))
+    ['add', ['rat', '1', '2'], ['mul', ['sym', 'L', True], ['fn', 'cos', ['sym', 't', False]]]]
+    """
+    count = [0]
+
+    def walk(e):
+        count[0] += 1
+        if count[0] > max_nodes:
+            raise ValueError(f"more than {max_nodes} nodes")
+        if isinstance(e, sp.Integer):
+            return ["int", str(int(e))]
+        if isinstance(e, sp.Rational):
+            return ["rat", str(e.p), str(e.q)]
+        if isinstance(e, sp.Float):
+            return ["float", repr(float(e))]
+        if e is sp.pi:
+            return ["pi"]
+        if isinstance(e, sp.Symbol):
+            return ["sym", e.name, bool(e.is_positive)]
+        if isinstance(e, sp.Add):
+            return ["add", *[walk(a) for a in e.args]]
+        if isinstance(e, sp.Mul):
+            return ["mul", *[walk(a) for a in e.args]]
+        if isinstance(e, sp.Pow):
+            return ["pow", walk(e.base), walk(e.exp)]
+        if isinstance(e, sp.Function) and type(e).__name__ in _TREE_FUNCS and len(e.args) == 1:
+            return ["fn", type(e).__name__, walk(e.args[0])]
+        raise ValueError(f"{type(e).__name__} is not supported here")
+
+    if isinstance(obj, sp.MatrixBase):
+        return ["matrix", obj.rows, obj.cols, *[walk(x) for x in obj]]
+    return walk(sp.sympify(obj))

@@ -1,7 +1,15 @@
 """The ``kinlib`` command: ``kinlib handouts ...``, ``kinlib grade ...``, ``kinlib --version``.
 
     kinlib handouts notebooks --out build/handouts [--jobs 2] [--timeout 120] [--no-verify] [--only 05]
+    kinlib execute notebooks [--timeout 600]      (run notebooks in place, saving widget state: make notebooks)
     kinlib grade SUBMISSIONS... --out build/grades [--jobs 2] [--timeout 300] [--cell-timeout 60]
+                 [--id-pattern REGEX] [--overrides FILE] [--fresh]
+    kinlib grade gradescope --out autograder.zip [--only 05] [--visibility visible] [--no-sandbox]
+    kinlib grade prairielearn --out build/prairielearn [--only 05]
+    kinlib grade canvas build/grades --assignment "Problem Set 4" --out canvas.csv [--roster export.csv]
+
+(``gradescope``, ``prairielearn`` and ``canvas`` right after ``grade`` are platforms, :mod:`kinlib.course.lms`;
+a submissions folder with one of those names is given as ``./gradescope``.)
 
 The console script (``kinlib = "kinlib.course.cli:main"``); ``python -m kinlib.course`` is the same.
 Usage errors exit with status 2 and a one-line message; the subcommands are imported only when run.
@@ -11,6 +19,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -81,13 +90,28 @@ def build_parser() -> argparse.ArgumentParser:
     h.add_argument("--only", nargs="*", help="only notebooks whose name starts with these (e.g. 05)")
     h.set_defaults(run=_handouts, parser=h)
 
+    x = sub.add_parser(
+        "execute",
+        help="run notebooks top to bottom and save them in place, with their widget state",
+        description="Run each notebook in a fresh kernel and save it in place with its outputs and widget "
+        "state (deterministic ids), so that it opens with pictures; a failing notebook is left unchanged.",
+    )
+    x.add_argument("paths", nargs="+", type=Path, help="notebooks, or folders (their NN_*.ipynb)")
+    x.add_argument("--timeout", type=_positive_float, default=600.0, help="seconds allowed per cell (default 600)")
+    x.set_defaults(run=_execute, parser=x)
+
     g = sub.add_parser(
         "grade",
         help="grade completed workbooks against the solution notebooks",
         description="Grade completed kinlib workbooks against the solution notebooks: writes "
         "OUT/grades.csv and OUT/feedback/<submission>.md.",
     )
-    g.add_argument("submissions", nargs="+", help="submission notebooks, or folders (every .ipynb inside)")
+    g.add_argument(
+        "submissions",
+        nargs="*",
+        help="submission notebooks, or folders (every .ipynb inside); none: only rewrite OUT's class files "
+        "(after editing the overrides)",
+    )
     g.add_argument("--out", required=True, type=Path, help="output folder (grades.csv, feedback/)")
     g.add_argument(
         "--timeout", type=_positive_float, default=300.0, help="seconds allowed per submission (default 300)"
@@ -112,8 +136,156 @@ def build_parser() -> argparse.ArgumentParser:
         help="reference cache folder (default: build/grade-cache next to the notebooks folder)",
     )
     g.add_argument("--quiet", action="store_true", help="print only the summary table")
+    g.add_argument(
+        "--no-sandbox",
+        action="store_true",
+        help="run student code WITHOUT the bubblewrap sandbox (said in every feedback page and the summary)",
+    )
+    g.add_argument(
+        "--secret",
+        type=Path,
+        default=None,
+        help="grader secret file (default ~/.config/kinlib/grader-secret, created on first use, mode 0600)",
+    )
+    _add_class_options(g)
+    g.add_argument(
+        "--fresh",
+        action="store_true",
+        help="forget the results kept in OUT (default: merge, so grading one student replaces only their rows)",
+    )
     g.set_defaults(run=_grade, parser=g)
     return ap
+
+
+def _add_class_options(p) -> None:
+    p.add_argument(
+        "--id-pattern",
+        default=None,
+        metavar="REGEX",
+        help="student id: this pattern searched in the submission's absolute path (group 'id', else group 1); "
+        r"default: the file's stem. E.g. one folder per student: '([^/]+)/[^/]+$'",
+    )
+    p.add_argument(
+        "--overrides",
+        type=Path,
+        default=None,
+        help="instructor's overrides, CSV or TOML: student_id, part (5.2, 4.1/joint_c, 5.2/drawing), score, "
+        "comment (default: OUT/overrides.toml or OUT/overrides.csv if present)",
+    )
+
+
+_LMS = ("gradescope", "prairielearn", "canvas")
+
+
+def build_lms_parser() -> argparse.ArgumentParser:
+    """The parser of ``kinlib grade gradescope|prairielearn|canvas`` (:mod:`kinlib.course.lms`).
+
+    >>> a = build_lms_parser().parse_args(["gradescope", "--out", "ag.zip", "--only", "05"])
+    >>> a.platform, a.only, a.visibility
+    ('gradescope', ['05'], 'visible')
+    >>> build_lms_parser().parse_args(["canvas", "build/grades", "--assignment", "PS4", "--out", "c.csv"]).id_column
+    'ID'
+    """
+    from .lms import VISIBILITIES
+
+    ap = _Parser(prog=f"{PROG} grade", description="Grading on the platforms a class already uses.")
+    sub = ap.add_subparsers(dest="platform", metavar="PLATFORM", required=True)
+    for name, what in (
+        ("gradescope", "a Gradescope autograder.zip (setup.sh, run_autograder, the references as data)"),
+        ("prairielearn", "a PrairieLearn external grader: OUT/serverFilesCourse/kinlib_grader/ and info.json options"),
+    ):
+        b = sub.add_parser(name, help=what, description=f"Write {what}; the same grading core runs inside.")
+        b.add_argument("--out", required=True, type=Path, help="the zip (gradescope) or folder (prairielearn)")
+        b.add_argument("--notebooks", type=Path, default=None, help="folder of solution notebooks")
+        b.add_argument("--cache", type=Path, default=None, help="reference cache folder")
+        b.add_argument("--only", nargs="*", help="only notebooks whose name starts with these (e.g. 05)")
+        b.add_argument("--timeout", type=_positive_float, default=300.0, help="seconds per submission")
+        b.add_argument("--cell-timeout", type=_positive_float, default=60.0, help="seconds per cell")
+        b.add_argument("--secret", type=Path, default=None, help="the instructor's grader secret file")
+        b.add_argument(
+            "--no-sandbox",
+            action="store_true",
+            help="run student code without bubblewrap inside the platform's container (every result says so)",
+        )
+        if name == "gradescope":
+            b.add_argument("--visibility", choices=VISIBILITIES, default="visible", help="of every test")
+        b.set_defaults(run=_lms_bundle, parser=b)
+    c = sub.add_parser(
+        "canvas",
+        help="a Canvas gradebook import CSV from a class folder",
+        description="Write a Canvas gradebook import CSV (Student, ID, SIS User ID, SIS Login ID, Section, "
+        "the assignment; a Points Possible row) from the class folder of kinlib grade --out.",
+    )
+    c.add_argument("grades", type=Path, help="the class folder (kinlib grade --out)")
+    c.add_argument("--assignment", required=True, help="the Canvas assignment's column name")
+    c.add_argument("--out", required=True, type=Path, help="the CSV to write")
+    c.add_argument("--id-column", default="ID", choices=["Student", "ID", "SIS User ID", "SIS Login ID"])
+    c.add_argument("--roster", type=Path, default=None, help="a Canvas gradebook export, to fill names/sections")
+    c.add_argument("--overrides", type=Path, default=None, help="overrides file (default: the class folder's)")
+    c.add_argument("--include-pending", action="store_true", help="upload totals with manual parts pending")
+    c.add_argument("--points-possible", type=_positive_float, default=None, help="(default: from the notebooks)")
+    c.set_defaults(run=_lms_canvas, parser=c)
+    return ap
+
+
+def _lms_bundle(args) -> int:
+    from . import lms
+
+    kw = dict(
+        notebooks=args.notebooks,
+        only=args.only,
+        cache=args.cache if args.cache else "default",
+        secret=args.secret,
+        sandbox=not args.no_sandbox,
+        timeout=args.timeout,
+        cell_timeout=args.cell_timeout,
+        log=lambda s: print(s, flush=True),
+    )
+    try:
+        if args.platform == "gradescope":
+            path = lms.gradescope_zip(args.out, visibility=args.visibility, **kw)
+        else:
+            path = lms.prairielearn_dir(args.out, **kw)
+    except (RuntimeError, ValueError, OSError) as exc:
+        print(f"{PROG} grade {args.platform}: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    print(f"wrote {path}")
+    return 0
+
+
+def _lms_canvas(args) -> int:
+    from .lms import canvas_csv
+
+    try:
+        warnings = canvas_csv(
+            args.grades,
+            args.assignment,
+            args.out,
+            id_column=args.id_column,
+            roster=args.roster,
+            include_pending=args.include_pending,
+            overrides=args.overrides,
+            points_possible=args.points_possible,
+        )
+    except (ValueError, OSError) as exc:
+        print(f"{PROG} grade canvas: error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    for w in warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    print(f"wrote {args.out}")
+    return 0
+
+
+def _execute(args) -> int:
+    from .execute import execute_all
+
+    try:
+        failures = execute_all(args.paths, timeout=args.timeout, log=lambda s: print(s, flush=True))
+    except FileNotFoundError as exc:
+        args.parser.error(str(exc))
+    for f in failures:
+        print(f"{PROG} execute: FAILED: {f}", file=sys.stderr)
+    return 1 if failures else 0
 
 
 def _handouts(args) -> int:
@@ -140,9 +312,11 @@ def _handouts(args) -> int:
 
 
 def _grade(args) -> int:
-    from .grade import find_submissions, grade_batch
+    from .grade import SandboxUnavailable, find_submissions, grade_batch
     from .report import summary_table
 
+    if not args.submissions:
+        return _rewrite_class_files(args)
     try:
         subs = find_submissions(args.submissions)
     except FileNotFoundError as exc:
@@ -152,19 +326,70 @@ def _grade(args) -> int:
     if not subs:
         print(f"{PROG} grade: no .ipynb submissions found", file=sys.stderr)
     log = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
-    summary = grade_batch(
-        subs,
-        args.out,
-        jobs=args.jobs,
-        timeout=args.timeout,
-        cell_timeout=args.cell_timeout,
-        notebooks=args.notebooks,
-        cache=args.cache if args.cache else "default",
-        log=log,
-    )
+    from . import credit, report
+
+    if args.id_pattern is not None:
+        try:
+            re.compile(args.id_pattern)
+        except re.error as exc:
+            args.parser.error(f"--id-pattern {args.id_pattern!r} is not a regular expression: {exc}")
+    overrides = args.overrides or report.default_overrides(args.out)
+    try:
+        overrides = credit.load_overrides(overrides) if overrides is not None else []
+    except (ValueError, OSError) as exc:
+        print(f"{PROG} grade: overrides: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    try:
+        summary = grade_batch(
+            subs,
+            args.out,
+            jobs=args.jobs,
+            timeout=args.timeout,
+            cell_timeout=args.cell_timeout,
+            notebooks=args.notebooks,
+            cache=args.cache if args.cache else "default",
+            log=log,
+            sandbox=not args.no_sandbox,
+            secret=args.secret,
+            id_pattern=args.id_pattern,
+            overrides=overrides,
+            merge=not args.fresh,
+        )
+    except (SandboxUnavailable, ValueError) as exc:  # no sandbox here, or an unsafe/unreadable secret file
+        print(f"{PROG} grade: {_one_line(exc)}", file=sys.stderr)
+        return 2
     if args.quiet:
         print(summary_table(summary["results"], summary["seconds"], summary["reference_seconds"], args.jobs))
     print(f"wrote {args.out / 'grades.csv'} and {len(summary['results'])} feedback file(s) in {args.out / 'feedback'}")
+    if summary.get("infrastructure_errors"):
+        print(
+            f"{PROG} grade: {summary['infrastructure_errors']} submission(s) not graded: infrastructure "
+            "(a kernel could not start); run them again",
+            file=sys.stderr,
+        )
+        return 1
+    return 0
+
+
+def _rewrite_class_files(args) -> int:
+    """``kinlib grade --out OUT`` without submissions: grades.csv, totals.csv and feedback again from the
+    results kept in OUT, with the overrides as they are now."""
+    from . import report
+
+    if not report.load_results(args.out):
+        args.parser.error(f"no submissions given, and no graded results kept in {args.out / 'results'}")
+    try:
+        warnings = report.write_outputs(
+            args.out,
+            [],
+            id_pattern=args.id_pattern,
+            overrides=args.overrides,
+            log=lambda s: print(s, flush=True),
+        )
+    except (ValueError, OSError) as exc:
+        print(f"{PROG} grade: overrides: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    print(f"rewrote {args.out / 'grades.csv'}, totals.csv and feedback/ ({len(warnings)} override warning(s))")
     return 0
 
 
@@ -172,7 +397,9 @@ def main(argv=None) -> int:
     """Run the ``kinlib`` command with ``argv`` (default: the command line); returns the exit status.
 
     ``kinlib handouts`` returns 0, 1 when a notebook fails (named with its cell) or 2 for another error;
-    ``kinlib grade`` returns 0 whenever the batch ran, whatever the grades. Usage errors raise
+    ``kinlib grade`` returns 0 when the batch ran (whatever the grades), 1 when some submission could not be
+    graded for an infrastructure failure (a kernel that would not start), 2 without a usable sandbox (unless
+    ``--no-sandbox``) or secret. Usage errors raise
     SystemExit(2) after a one-line message, ``--help`` and ``--version`` SystemExit(0).
 
     >>> try:
@@ -182,7 +409,12 @@ def main(argv=None) -> int:
     kinlib ...
     exit status 0
     """
-    args = build_parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if len(argv) >= 2 and argv[0] == "grade" and argv[1] in _LMS:  # kinlib grade gradescope|prairielearn|canvas
+        args = build_lms_parser().parse_args(argv[1:])
+        args.command = f"grade {args.platform}"
+    else:
+        args = build_parser().parse_args(argv)
     try:
         return args.run(args)
     except ImportError as exc:  # kinlib installed without its course extra

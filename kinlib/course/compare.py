@@ -4,15 +4,29 @@ Everything here works on plain JSON data (numbers, strings, lists) produced by
 :mod:`kinlib.course.probe`; nothing from a submission is evaluated. Each comparison returns
 ``(ok, message)``; messages name the mistake when it is recognizable (wrong shape, transposed,
 wrong sign, columns swapped, [v; ω] instead of [ω; v], degrees instead of radians, a missing or
-extra variable) without printing the reference answer.
+extra variable) without printing the reference answer or anything that gives it away (a factor, the
+answer's dimension, its number of members or conditions, which joints it restricts): only what the
+student can read off their own answer.
+
+* **expr**: values at the points; **subspace**: spans, whatever the basis and its scaling (each column
+  normalised, principal angles between orthonormal bases; constant exact bases by exact ranks);
+* **set**: members compared modulo 2π whenever the reference is a set of angles (members that are simple
+  multiples of π, or a joint angle's family), whatever the set is keyed by; FiniteSets, ImageSets, unions
+  and ``solveset`` results alike; degrees named; **choice**: as sets;
+* **property:<p>** (:mod:`kinlib.course.properties`): open-ended answers by the property asked, decided
+  exactly, never by one design's value (5.5: det(J Jᵀ) ≠ 0 for every θ).
 """
 
 from __future__ import annotations
 
 import math
+import re
 from fractions import Fraction
 
 import numpy as np
+
+from . import mistakes
+from .properties import PROPERTIES, exact_ranks
 
 __all__ = [
     "compare",
@@ -20,6 +34,7 @@ __all__ = [
     "compare_subspace",
     "compare_set",
     "compare_choice",
+    "compare_property",
     "COMPARE",
     "NOT_ANSWERED",
     "RTOL",
@@ -117,7 +132,13 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
         if stu.get("tag") != "dict":
             return False, f"{name} is a {stu.get('type')}; expected a dict with keys {', '.join(ref['items'])}"
         if set(stu["items"]) != set(ref["items"]):
-            return False, f"{name} has keys {sorted(stu['items'])}; expected {sorted(ref['items'])}"
+            missing, extra = (
+                sorted(set(ref["items"]) - set(stu["items"])),
+                sorted(set(stu["items"]) - set(ref["items"])),
+            )
+            what = [f"no key {', '.join(map(repr, missing))}"] if missing else []
+            what += [f"keys {', '.join(map(repr, extra))} that are not asked for"] if extra else []
+            return False, f"{name} has " + " and ".join(what)
         msgs = [compare_expr(stu["items"][k], ref["items"][k], f"{name}[{k!r}]") for k in ref["items"]]
         return all(ok for ok, _ in msgs), "; ".join(m for _, m in msgs if m)
     if stu.get("tag") not in ("matrix", "scalar"):
@@ -147,32 +168,40 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
         if stu.get("has_float") and not ref.get("has_float"):
             extra.append("contains decimals: use exact values (sp.pi, sp.sqrt(2), sp.Rational(1, 2))")
         return True, "; ".join(extra)
-    return False, f"{name} " + "; ".join(notes + [_diagnose(S, R, rshape, stu)])
+    return False, f"{name} " + "; ".join(notes + [_no_key(_diagnose(S, R, rshape, stu))])
+
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_LEAKS = [
+    (re.compile(rf"\s*\({_NUM}\s*times the answer\)"), ""),
+    (re.compile(rf"\bis {_NUM} times the answer"), "is within 1% of the answer"),
+    (re.compile(rf"\b{_NUM} times the answer"), "a constant times the answer"),
+]
+
+
+def _no_key(msg: str) -> str:
+    """A diagnosis without numbers that give the reference away: "off by a constant factor (0.5 times the
+    answer)" tells the student the answer is theirs / 0.5, so the factor is dropped.
+
+    >>> _no_key("is off by a constant factor (0.5 times the answer)")
+    'is off by a constant factor'
+    >>> _no_key("is 0.997 times the answer: rounded decimals?")
+    'is within 1% of the answer: rounded decimals?'
+    """
+    for rx, rep in _LEAKS:
+        msg = rx.sub(rep, msg)
+    return msg
 
 
 def _diagnose(S, R, shape, stu) -> str:
+    """What is wrong with values S (points × entries) against R: a named mistake of
+    :mod:`kinlib.course.mistakes` (the self-check's too), else which entries differ; never a value."""
     P = S.shape[0]
     r, c = (shape + [1, 1])[:2] if len(shape) == 2 else (1, 1)
     S3, R3 = S.reshape(P, r, c), R.reshape(P, r, c)
-    if _close(S, -R):
-        return "has the wrong sign (every entry is negated)"
-    if r == c and r > 1 and _close(S3, np.swapaxes(R3, 1, 2)):
-        return "is transposed"
-    if r == 6 and _close(S3, np.concatenate([R3[:, 3:], R3[:, :3]], axis=1)):
-        return (
-            "has the rows in [v; ω] order: the textbook stacks angular first, [ω; v] "
-            "(rows 1–3 angular, rows 4–6 linear)"
-        )
-    if c > 1:
-        perm = _match(S3, R3, axis=2)
-        if perm is not None and perm != list(range(c)):
-            moved = [f"your column {i + 1} is column {j + 1}" for i, j in enumerate(perm) if i != j]
-            return "has its columns swapped: " + ", ".join(moved) + " (column i belongs to joint i)"
-    if r > 1:
-        perm = _match(S3, R3, axis=1)
-        if perm is not None and perm != list(range(r)):
-            moved = [f"your row {i + 1} is row {j + 1}" for i, j in enumerate(perm) if i != j]
-            return "has its rows swapped: " + ", ".join(moved)
+    found = mistakes.search(S3, lambda X: X.shape == R3.shape and _close(X, R3), exhaustive=True)
+    if found is not None:
+        return found.says
     neg = [k for k in range(S.shape[1]) if _close(S[:, k], -R[:, k]) and not _close(S[:, k], R[:, k])]
     bad = [k for k in range(S.shape[1]) if not _close(S[:, k], R[:, k])]
     if neg and len(neg) == len(bad):
@@ -184,32 +213,13 @@ def _diagnose(S, R, shape, stu) -> str:
         if abs(abs(ratio) - 180 / math.pi) < 1e-6 * 180 / math.pi or abs(abs(ratio) - math.pi / 180) < 1e-9:
             return "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)"
         if abs(ratio - 1) < 1e-2:
-            return (
-                f"is {ratio:.6g} times the answer: rounded decimals? Use exact values "
-                "(sp.sqrt(2), sp.pi, sp.Rational(1, 3))"
-            )
-        return f"is off by a constant factor ({ratio:.6g} times the answer)"
+            return "is close to the answer but not equal: rounded decimals? Use exact values (sp.sqrt(2), sp.pi)"
+        return "is off by a constant factor (a factor missing or extra, e.g. a length or ½?)"
     if stu.get("degrees"):
         return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
     if S.shape[1] > 1:
         return f"differs in entries {_entries(bad, shape)}"
     return "has the wrong value"
-
-
-def _match(S3, R3, axis):
-    """Permutation p with S[..., i] == R[..., p[i]] along ``axis`` (columns 2, rows 1), or None."""
-    n = S3.shape[axis]
-    take = (lambda A, i: A[:, :, i]) if axis == 2 else (lambda A, i: A[:, i, :])
-    perm = []
-    used = set()
-    for i in range(n):
-        cands = [j for j in range(n) if j not in used and _close(take(S3, i), take(R3, j))]
-        if not cands:
-            return None
-        j = i if i in cands else cands[0]
-        used.add(j)
-        perm.append(j)
-    return perm
 
 
 def _const_ratio(S, R):
@@ -225,19 +235,47 @@ def _const_ratio(S, R):
 # ----------------------------------------------------------------------------- subspaces
 
 
-def _rank(A, tol=1e-7):
+SUBSPACE_TOL = 1e-7  # rank cut-off on singular values of unit columns; largest principal angle (sine)
+
+
+def _orthonormal(A):
+    """An orthonormal basis (columns) of the span of A's columns, whatever their scaling.
+
+    Each column is scaled to length 1 first (a column 10¹² or 10⁻¹² times another counts the same), columns
+    that are zero (or round-off beside the largest: below 10⁻¹³ of it) dropped; the rank is the number of
+    singular values of the unit columns above ``SUBSPACE_TOL`` (the largest is ≥ 1).
+    """
     if A.size == 0:
-        return 0
-    s = np.linalg.svd(A, compute_uv=False)
-    return int(np.sum(s > tol * max(1.0, s.max() if s.size else 0)))
+        return A[:, :0]
+    norms = np.linalg.norm(A, axis=0)
+    top = norms.max()
+    if not np.isfinite(top) or top == 0:
+        return A[:, :0]
+    keep = norms > 1e-13 * top
+    U = A[:, keep] / norms[keep]
+    u, s, _ = np.linalg.svd(U, full_matrices=False)
+    return u[:, : int(np.sum(s > SUBSPACE_TOL * s[0]))]
+
+
+def _same_span(QA, QB):
+    """Largest principal angle between two subspaces of one dimension (orthonormal bases) is ~0."""
+    if QA.shape[1] != QB.shape[1]:
+        return False
+    if QA.shape[1] == 0:
+        return True
+    resid = QA - QB @ (QB.conj().T @ QA)
+    return float(np.linalg.norm(resid, 2)) < 1e-6
 
 
 def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
-    """A subspace by its span: rank [A B] = rank A = rank B at every point.
+    """A subspace by its span, at every point: orthonormal bases of both (each column normalised first,
+    so no scaling of a basis matters) of one dimension, and principal angles ~0 between them.
 
     >>> ref = {"shape": [2, 1], "symbols": [], "values": [[[1.0, 0.0], [0.0, 0.0]]]}
-    >>> compare_subspace(dict(ref, tag="matrix", values=[[[3.0, 0.0], [0.0, 0.0]]]), ref, "s")
+    >>> compare_subspace(dict(ref, tag="matrix", values=[[[3e12, 0.0], [0.0, 0.0]]]), ref, "s")
     (True, '')
+    >>> compare_subspace(dict(ref, tag="matrix", values=[[[1e12, 0.0], [1e12, 0.0]]]), ref, "s")[0]
+    False
     """
     na = _not_answered(stu)
     if na:
@@ -245,8 +283,14 @@ def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     if stu.get("tag") not in ("matrix", "scalar"):
         return False, f"{name} is a {stu.get('type')}; expected a Matrix whose columns span the subspace"
     rshape, sshape = list(ref["shape"]) or [1, 1], list(stu["shape"]) or [1, 1]
+    if len(sshape) == 1:
+        sshape = [sshape[0], 1]
+    if len(rshape) == 1:
+        rshape = [rshape[0], 1]
     S, R = _arr(stu["values"]), _arr(ref["values"])
-    if np.isnan(S).any():
+    if S.shape[0] != R.shape[0]:
+        return False, f"{name} could not be compared (malformed values)"
+    if np.isnan(S).any() or not np.isfinite(S).all():
         return False, f"{name} could not be evaluated at some values of the symbols"
     if sshape[0] != rshape[0]:
         if sshape[1] == rshape[0]:
@@ -255,22 +299,32 @@ def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
             )
         return False, f"{name} has vectors of length {sshape[0]}; expected {rshape[0]}"
     notes = _symbol_notes(stu, ref)
-    for p in range(S.shape[0]):
-        A = S[p].reshape(sshape)
-        B = R[p].reshape(rshape)
-        ra, rb, rab = _rank(A), _rank(B), _rank(np.hstack([A, B]))
+    exact = exact_ranks(stu.get("tree"), ref.get("tree"))
+    if exact is not None:
+        ra, rb, rab = exact
         if ra != rb:
-            what = "too small" if ra < rb else "too large"
             dep = f" ({sshape[1]} columns, {ra} independent)" if sshape[1] != ra else ""
-            return False, (
-                f"{name} spans a {ra}-dimensional space{dep}; the answer is {rb}-dimensional "
-                f"({what})" + (f"; {notes[0]}" if notes else "")
-            )
+            return False, f"{name} spans a {ra}-dimensional space{dep}, not the right dimension"
         if rab != rb:
             return False, (
-                f"{name} spans a {ra}-dimensional space of the right dimension but not the "
-                "right one (some of your directions are not in the answer's span)"
-                + (f"; {'; '.join(notes)}" if notes else "")
+                f"{name} spans a space of the right dimension but not the right one (some of your directions "
+                "are not in the answer's span)"
+            )
+        return True, "" if sshape[1] == rshape[1] else f"same span (you gave {sshape[1]} columns)"
+    for p in range(S.shape[0]):
+        QA = _orthonormal(S[p].reshape(sshape))
+        QB = _orthonormal(R[p].reshape(rshape))
+        ra = QA.shape[1]
+        if ra != QB.shape[1]:
+            dep = f" ({sshape[1]} columns, {ra} independent)" if sshape[1] != ra else ""
+            return False, (
+                f"{name} spans a {ra}-dimensional space{dep}, not the right dimension"
+                + (f"; {notes[0]}" if notes else "")
+            )
+        if not _same_span(QA, QB):
+            return False, (
+                f"{name} spans a space of the right dimension but not the right one (some of your directions "
+                "are not in the answer's span)" + (f"; {'; '.join(notes)}" if notes else "")
             )
     extra = "" if sshape[1] == rshape[1] else f"same span (you gave {sshape[1]} columns)"
     return True, extra
@@ -311,17 +365,38 @@ def _free(c):
     return c.get("intervals") == [[-math.inf, math.inf]] and not c.get("points")
 
 
+_GREEK = {"θ": "theta", "φ": "phi", "ψ": "psi", "α": "alpha", "β": "beta", "γ": "gamma"}
+
+
+def _var_name(v):
+    """A joint variable's name without typesetting: θ_2, theta_{2}, \\theta_2 and theta2 are one variable.
+
+    >>> [_var_name(v) for v in ("θ_2", "theta_{2}", r"\\theta_2", "theta2", None)]
+    ['theta2', 'theta2', 'theta2', 'theta2', None]
+    """
+    if v is None:
+        return None
+    v = str(v)
+    for g, name in _GREEK.items():
+        v = v.replace(g, name)
+    return "".join(ch for ch in v if ch not in "\\_{} ") or str(v)
+
+
 def _conds(desc_point, ref_vars):
     """Conditions as {var: component}; unsatisfiable ones (an empty component) dropped, "any value" ones
-    ignored, and a bare set (var None) taken as the set of the only reference variable."""
+    ignored, and a bare set (var None) taken as the set of the only reference variable; when the reference
+    is itself a bare set, a one-variable condition of the student's is taken as that set (whatever its key)."""
     out = []
     for cond in desc_point:
         d = {}
         dead = False
+        live = [c for c in cond if not _free(c)]
         for c in cond:
-            v = c.get("var")
+            v = _var_name(c.get("var"))
             if v is None and len(ref_vars) == 1:
                 v = next(iter(ref_vars))
+            elif not ref_vars and len(live) == 1:
+                v = None
             if _empty(c):
                 dead = True
             if _free(c):
@@ -332,23 +407,63 @@ def _conds(desc_point, ref_vars):
     return out
 
 
+_ANGLE_NAMES = ("theta", "phi", "psi", "alpha", "beta", "gamma", "q", "th", "angle")
+
+
+def _pi_rational(x: float) -> bool:
+    fr = Fraction(x / math.pi).limit_denominator(24)
+    return abs(float(fr) * math.pi - x) < 1e-9 * max(1.0, abs(x))
+
+
+def _periodic_points(pts) -> bool:
+    """The points are a 2π-periodic family (as enumerated in a window): x + 2π is a member for each x that
+    has room for it."""
+    top = max(pts, default=0.0)
+    inner = [x for x in pts if x + 2 * math.pi <= top + 1e-9]
+    return bool(inner) and all(any(abs(x + 2 * math.pi - y) < 1e-6 for y in pts) for x in inner)
+
+
+def _is_angle(var, r) -> bool:
+    """Whether the reference component ``r`` (of variable ``var``) is a set of angles, compared modulo 2π:
+    its members are all simple multiples of π (whatever the key), or it is keyed by an angle's name (θ…, φ…,
+    q…) and is itself a 2π-periodic family. Continuous ranges, keys like d3/x and other isolated values
+    (a prismatic θ3 = −L) compare as numbers."""
+    if "tuples" in r:
+        flat = [x for t in r["tuples"] for x in t]
+        return str(var or "").startswith(_ANGLE_NAMES) or bool(flat) and all(_pi_rational(x) for x in flat)
+    if r.get("intervals"):
+        return False
+    pts = r.get("points", [])
+    name = str(var or "")
+    if name[:1] in ("d", "x", "y", "z") and not name.startswith(_ANGLE_NAMES):
+        return False
+    if pts and all(_pi_rational(x) for x in pts):
+        return True
+    return name.startswith(_ANGLE_NAMES) and _periodic_points(pts)
+
+
 def _cond_match(s, r, periodic):
     if set(s) != set(r):
         return False, None
     for v in r:
-        ok, msg = _compare_component(s[v], r[v], periodic and str(v).startswith("theta"))
+        ok, msg = _compare_component(s[v], r[v], periodic and _is_angle(v, r[v]))
         if not ok:
-            return False, f"({v}): {msg}"
+            return False, (f"({v}): {msg}" if v is not None else msg)
     return True, ""
 
 
 def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple[bool, str]:
-    """Sets of configurations as sets: the same conditions, each with the same members (angles modulo 2π).
+    """Sets of configurations as sets: the same conditions, each with the same members (angles modulo 2π,
+    whatever the set is keyed by: a member of the reference that is a simple multiple of π, or a key named
+    like an angle, makes it a set of angles).
 
     >>> ref = {"conditions": [[[{"var": "theta1", "points": [0.0], "intervals": []}]]]}
     >>> stu = {"tag": "set", "conditions": [[[{"var": None, "points": [6.283185307179586], "intervals": []}]]]}
     >>> compare_set(stu, ref, "S")
     (True, '')
+    >>> bare = {"conditions": [[[{"var": None, "points": [-1.5707963267948966, 1.5707963267948966]}]]]}
+    >>> compare_set({"tag": "set", "conditions": [[[{"var": None, "points": [90.0, 270.0]}]]]}, bare, "v")[1]
+    'v: these look like degrees (90, 270): angles are radians (90° = sp.pi/2)'
     """
     na = _not_answered(stu)
     if na:
@@ -357,42 +472,62 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
         return False, (
             f"{name} is a {stu.get('type')}; expected a SymPy Set, a dict {{symbol: Set}} or a list of those"
         )
+    if len(stu.get("conditions", [])) != len(ref.get("conditions", [])):
+        return False, f"{name} could not be compared (malformed values)"
     for sp_, rp in zip(stu["conditions"], ref["conditions"]):
-        ref_vars = {c.get("var") for cond in rp for c in cond if c.get("var") is not None}
+        ref_vars = {_var_name(c.get("var")) for cond in rp for c in cond if c.get("var") is not None}
         rc, sc = _conds(rp, ref_vars), _conds(sp_, ref_vars)
         errs = [f"{v or 'your set'}: {c['error']}" for d in sc for v, c in d.items() if c.get("error")]
         if errs:
             return False, f"{name} could not be compared: " + "; ".join(errs)
-        if not rc and sc:
-            return False, f"{name} is not empty, but there are no such configurations"
         if rc and not sc:
-            return False, f"{name} is empty, but such configurations exist"
+            return False, f"{name} is empty: not the right set"
+        if not rc and sc:
+            return False, f"{name} is not the right set"
         if len(rc) == 1 and len(sc) == 1:
             r, s = rc[0], sc[0]
             if set(s) != set(r):
-                missing, extra = sorted(set(r) - set(s), key=str), sorted(set(s) - set(r), key=str)
-                parts = []
-                if missing:
-                    parts.append(f"says nothing about {', '.join(map(str, missing))}")
-                if extra:
-                    parts.append(f"constrains {', '.join(map(str, extra))}, which the answer leaves free")
-                return False, f"{name} " + " and ".join(parts)
+                mine = ", ".join(sorted(map(str, (v for v in s if v is not None)))) or "one unnamed variable"
+                return False, (
+                    f"{name} constrains {mine}: not the right joint variables (which joints does the "
+                    "condition restrict, and which are free?)"
+                )
             ok, msg = _cond_match(s, r, periodic)
             if not ok:
-                return False, f"{name} {msg}"
+                return False, f"{name}{'' if msg.startswith('(') else ':'} {msg}"
             continue
         unmatched = list(sc)
         for r in rc:
             hit = next((s for s in unmatched if _cond_match(s, r, periodic)[0]), None)
             if hit is None:
-                return False, (
-                    f"{name}: {len(sc)} condition(s) given, {len(rc)} expected, and not all of them "
-                    f"match (conditions on {', '.join(sorted(map(str, r)))})"
-                )
+                return False, f"{name}: {len(sc)} condition(s) given, and not all of them are right"
             unmatched.remove(hit)
         if unmatched:
-            return False, f"{name} has {len(unmatched)} condition(s) more than the answer"
+            return False, f"{name}: {len(sc)} condition(s) given, and not all of them are right"
     return True, ""
+
+
+_DEGREE_VALUES = {15 * k for k in range(1, 25)}
+
+
+def _looks_like_degrees(pts) -> list:
+    """The student's values as degrees in [0, 360) when they all are whole multiples of 15 (not 0), else []."""
+    out = []
+    for x in pts:
+        if not math.isfinite(x) or abs(x - round(x)) > 1e-9 or round(x) == 0:
+            return []
+        d = round(x) % 360
+        if d not in _DEGREE_VALUES and d != 0:
+            return []
+        if d not in out:
+            out.append(d)
+    return sorted(out)
+
+
+def _degrees_msg(pts) -> str:
+    degs = _looks_like_degrees(pts)
+    shown = ", ".join(str(d) for d in degs[:4]) + (" …" if len(degs) > 4 else "")
+    return f"these look like degrees ({shown}): angles are radians (90° = sp.pi/2)"
 
 
 def _compare_component(s, r, periodic):
@@ -411,19 +546,20 @@ def _compare_component(s, r, periodic):
         a, b = canon(s["tuples"]), canon(r["tuples"])
         if len(a) == len(b) and all(len(x) == len(y) and _same(x, y) for x, y in zip(a, b)):
             return True, ""
-        return False, f"{len(a)} configuration(s) given, {len(b)} expected, or different ones"
+        return False, f"{len(a)} configuration(s) given: not the right ones"
     si, ri = _canon_intervals(s.get("intervals", [])), _canon_intervals(r.get("intervals", []))
     if len(si) != len(ri) or any(not _same(x, y) for x, y in zip(si, ri)):
         if ri and not si:
-            return False, "the answer is a continuous range of values; yours lists isolated values"
+            return False, "yours lists isolated values; a continuous range of values is expected"
         if si and not ri:
-            return False, "the answer is isolated values; yours is a continuous range"
-        return False, "a different range of values"
+            return False, "yours is a continuous range; isolated values are expected"
+        return False, "not the right range of values"
     sp_, rp = _canon_points(s.get("points", []), periodic), _canon_points(r.get("points", []), periodic)
     if _same(sp_, rp):
         return True, ""
-    if periodic and _same(_canon_points(s.get("points", []), True, math.pi / 180), rp):
-        return False, "these look like degrees: angles are radians (45° = sp.pi/4)"
+    raw = s.get("points", [])
+    if periodic and (_same(_canon_points(raw, True, math.pi / 180), rp) or _looks_like_degrees(raw)):
+        return False, _degrees_msg(raw)
     missing = [x for x in rp if not any(abs(x - y) < 1e-6 for y in sp_)]
     wrong = [x for x in sp_ if not any(abs(x - y) < 1e-6 for y in rp)]
     where = " (compared modulo 2π)" if periodic else ""
@@ -432,7 +568,39 @@ def _compare_component(s, r, periodic):
             f"{', '.join(_pi_multiple(x) for x in wrong[:4])} "
             f"{'is' if len(wrong) == 1 else 'are'} not in the set{where}"
         )
-    return False, f"{len(missing)} value(s) of the set are missing{where}"
+    if missing:
+        return False, f"some values of the set are missing{where}"
+    return False, "not the right set"
+
+
+# ----------------------------------------------------------------------------- answers graded by a property
+
+
+def compare_property(stu: dict, ref: dict, name: str, prop: str = "nonsingular") -> tuple[bool, str]:
+    """An open-ended answer graded by the property asked, never by one design's value (the reference is not
+    used). ``prop``: "nonsingular": the answer is det(J Jᵀ) of the student's own design (or its task
+    Jacobian J), and it must be nonzero for every joint value, proved exactly (kinlib.singularities).
+
+    >>> compare_property({"tag": "scalar", "tree": ["rat", "1", "2"]}, {}, "d")
+    (True, 'det(J Jᵀ) ≠ 0 for every joint value: proved')
+    >>> compare_property({"tag": "scalar", "tree": ["pow", ["fn", "sin", ["sym", "theta2", False]], ["int", "2"]]},
+    ...                  {}, "d")[1]
+    'd: det(J Jᵀ) = 0 where theta2 = 0, pi (+ 2πk): your design still has singular configurations'
+    """
+    na = _not_answered(stu)
+    if na:
+        return False, f"{name} {na}"
+    if stu.get("tag") not in ("matrix", "scalar"):
+        return False, f"{name} is a {stu.get('type')}; expected a SymPy expression or Matrix"
+    if prop not in PROPERTIES:
+        return False, f"{name} could not be graded (unknown property {prop!r}: a problem in the solution notebook)"
+    if "tree" not in stu:
+        why = stu.get("tree_error") or "no expression"
+        return False, f"{name} could not be read exactly ({why}): use SymPy numbers, symbols, sin and cos"
+    try:
+        return PROPERTIES[prop](stu, name)
+    except (ValueError, TypeError, RecursionError) as exc:
+        return False, f"{name} could not be read exactly ({str(exc)[:120]})"
 
 
 # ----------------------------------------------------------------------------- choices
@@ -456,7 +624,7 @@ def compare_choice(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     >>> compare_choice({"tag": "choice", "value": [2, 1]}, {"value": [1, 2]}, "j")
     (True, '')
     >>> compare_choice({"tag": "choice", "value": [1]}, {"value": [1, 2]}, "j")[1]
-    'j: partly right, but more than one choice is correct (a tie counts: give a tuple)'
+    'j: (1) is not the right choice (a tie counts: give a tuple of every joint that qualifies)'
     """
     na = _not_answered(stu)
     if na:
@@ -467,17 +635,22 @@ def compare_choice(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     if a == b:
         return True, ""
     if isinstance(a, frozenset) and isinstance(b, frozenset):
-        if a < b:
-            return False, f"{name}: partly right, but more than one choice is correct (a tie counts: give a tuple)"
-        if a > b:
-            return False, f"{name}: you chose {sorted(a, key=str)}, more than the correct choice(s)"
-        if any(isinstance(e, int) and e == 0 for e in a):
+        if any(isinstance(e, int) and not isinstance(e, bool) and e == 0 for e in a):
             return False, f"{name}: joints are numbered from 1"
-        return False, f"{name}: {sorted(a, key=str)} is not the right choice"
+        mine = ", ".join(map(str, sorted(a, key=str)))
+        joints = all(isinstance(e, int) and not isinstance(e, bool) for e in a)
+        tie = " (a tie counts: give a tuple of every joint that qualifies)" if joints else ""
+        return False, f"{name}: ({mine}) is not the right choice" + tie
     return False, f"{name}: not the right choice(s)"
 
 
-COMPARE = {"expr": compare_expr, "subspace": compare_subspace, "set": compare_set, "choice": compare_choice}
+COMPARE = {
+    "expr": compare_expr,
+    "subspace": compare_subspace,
+    "set": compare_set,
+    "choice": compare_choice,
+    "property": compare_property,
+}
 
 
 def compare(kind: str, stu: dict, ref: dict, name: str) -> tuple[bool, str]:
@@ -487,7 +660,10 @@ def compare(kind: str, stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     >>> compare("choice", {"tag": "ellipsis"}, {"value": 1}, "j")
     (False, 'j is still `...`: not answered yet')
     """
+    base, _, arg = str(kind).partition(":")
     try:
-        return COMPARE.get(kind, compare_expr)(stu, ref, name)
+        if base == "property":
+            return compare_property(stu, ref, name, arg or "nonsingular")
+        return COMPARE.get(base, compare_expr)(stu, ref, name)
     except Exception as exc:  # noqa: BLE001  malformed data from a kernel must not stop the batch
         return False, f"{name} could not be compared ({type(exc).__name__}: {str(exc)[:200]})"

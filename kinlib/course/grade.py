@@ -1,28 +1,36 @@
 """Instructor solution checker: grade a class's completed workbooks against the solution notebooks.
 
     kinlib grade SUBMISSION.ipynb|FOLDER ... --out DIR [--timeout S] [--cell-timeout S] [--jobs N]
-                 [--notebooks notebooks] [--cache build/grade-cache] [--quiet]
+                 [--notebooks notebooks] [--cache build/grade-cache] [--quiet] [--secret FILE] [--no-sandbox]
 
 (the command line is :mod:`kinlib.course.cli`; the outputs are written by :mod:`kinlib.course.report`)
 
 Writes ``DIR/grades.csv`` (submission, notebook, part, status pass|fail|error, points, message),
 ``DIR/feedback/<submission>.md`` (one page a student can read) and prints a summary table. Exit status 0
-whenever the batch ran (whatever the grades); 2 for a usage error.
+when the batch ran (whatever the grades); 1 when a submission could not be graded for an infrastructure
+failure (its rows say "not graded: infrastructure", never 0 points silently); 2 for a usage error or
+when the sandbox is unavailable (unless ``--no-sandbox``).
 
 How it works
 ------------
 * **Which notebook.** A submission is identified by ``metadata.kinlib.notebook`` (students rename
-  files). A file that is not JSON, not a notebook, or not one of ours gets one ``error`` row.
+  files); one whose metadata was lost (solution cells pasted into a new notebook) by its questions
+  (:func:`kinlib.course.schema.match_notebook`: the answer names it assigns, the part numbers it mentions),
+  with a note in its feedback. A file that is not JSON, not a notebook, or not one of ours gets one
+  ``error`` row.
 * **Reference answers** come from executing the solution notebooks in ``--notebooks`` (never from the
   installed package, which holds no answer key). For each graded part (a ``question`` markdown cell,
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
   :mod:`kinlib.course.schema` reads them) the
-  reference kernel returns each answer's ``sympy.srepr``; the result is cached in
-  ``--cache/<id>-<hash>.json``, keyed by the notebook's bytes and the checker's version. Points per part:
+  reference kernel (the grader's own, never a student's) returns each answer as data (``sympy.srepr``
+  text, read back by the strict parser :mod:`kinlib.course.srepr`, never ``eval``); the result is
+  cached in ``--cache/<id>-<hash>.json`` with an HMAC tag keyed by the grader secret
+  (:mod:`kinlib.course.refdata`), keyed by the notebook's bytes and the checker's version. Points per part:
   ``points`` in the solution cell's ``kinlib`` metadata if present, else "(N points)" parsed from the
   question cell (split evenly when several parts share one question cell).
-* **Each submission** runs in its own fresh kernel (:mod:`kinlib.course.kernel`) in a scratch copy
-  (a temp dir as cwd), every code cell in order with a per-cell and a total time limit. A cell that
+* **Each submission** runs in its own fresh kernel (:mod:`kinlib.course.kernel`) in the bubblewrap
+  sandbox (:mod:`kinlib.course.sandbox`) in a scratch copy (a temp dir as cwd), every code cell in
+  order with a per-cell and a total time limit. A cell that
   raises is recorded and the next one runs; a cell that kills the kernel (``os._exit``) or ignores the
   time limit is skipped after a restart (at most two), so the other parts are still graded. An answer
   is the value its variable has when its part ends (before the next ``question`` cell; the last part
@@ -33,29 +41,41 @@ How it works
   starts :mod:`kinlib.course.probe` in the kernel from its source text, with the answer normaliser
   :mod:`kinlib.course.answers` (private modules under a random name) and snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
   namespaces, then asks for each answer's *values* at checker-chosen random points (joint angles in
-  (-π, π), positive symbols in (0.5, 2); random per submission, seeded by its SHA-256, so reruns are
-  reproducible) as [re, im] floats, plus shape, symbol names and type. The worker process compares them
+  (-π, π), positive symbols in (0.5, 2); random per submission, seeded by HMAC(grader secret,
+  submission bytes) (:mod:`kinlib.course.secret`): reruns are reproducible, and nobody without the
+  secret can compute them from the file) as [re, im] floats, plus shape, symbol names and type. The
+  worker process compares them
   with the reference evaluated at the same points: shapes first, then values, with diagnoses (wrong
   sign, transposed, columns swapped, [v; ω] rows, degrees, a missing or extra variable). Only after
   all values are in does the checker send the reference's srepr into the kernel for an exact check
   (expand_trig/expand, then simplify), reported as advice: it cannot turn a numeric failure into a pass.
 * **Kinds** (``kinds`` beside ``answers``): ``expr`` (default: matrices/expressions as functions of
-  the symbols), ``subspace`` (by span: rank [A B] = rank A = rank B), ``set`` (sets of configurations:
-  members compared, angles modulo 2π; a list of {symbol: Set} conditions is their union, [] the empty
-  set), ``choice`` (ints/tuples compared as sets). A default-kind answer that is a Set, a
-  {symbol: Set} dict or a list of those is compared as a set; a bool or string as a choice; a dict with
-  string keys entry by entry.
+  the symbols), ``subspace`` (by span, whatever the basis and its scaling: principal angles between
+  orthonormal bases), ``set`` (sets of configurations: members compared, angles modulo 2π whatever the
+  set is keyed by; a list of {symbol: Set} conditions is their union, [] the empty set), ``choice``
+  (ints/tuples compared as sets); ``properties`` beside ``answers`` grade an open-ended answer by the
+  property asked (``property:nonsingular``, 5.5: :mod:`kinlib.course.properties`). A default-kind answer
+  that is a Set, a {symbol: Set} dict or a list of those is compared as a set; a bool or string as a
+  choice; a dict with string keys entry by entry.
 
 Threat model
 ------------
-The kernel is not a sandbox: a submission runs as the grader's user, with its files and network
-(run the batch in a container or as a user that cannot read the solution notebooks or the cache if
-students are hostile). Within that, the checker never evaluates student text in its own process
+Each kernel runs in the sandbox: its own user, PID, network and IPC namespaces (no network, no view of
+the grader's processes; everything it starts dies with it), a read-only system and Python environment,
+the ``kinlib`` package folder but not the repository around it (no notebooks, build folder, reference
+cache, secret, output folder or home), and writable only its own scratch folder and a private /tmp.
+grades.csv and the feedback are written after every kernel of the batch, and every process a submission
+started, is gone (checked: :func:`kinlib.course.sandbox.reap_namespaces`). Without bubblewrap the grader
+refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.
+A kernel that cannot start is retried (:data:`kinlib.course.kernel.START_ATTEMPTS`), judged by its
+process, not by heartbeats. Within the sandbox, the checker never evaluates student text in its own process
 (only JSON numbers and strings come back, read from a size-capped file), compares in its own
 process, and records failures from the kernel protocol, so a submission can *lie about the values it
 computes* (equivalent to writing those values as its answer) but cannot make the comparison pass
 without producing the right values, and cannot hide a missing answer, a crash or a timeout: those
-become fail/error rows. Redefining ``kinlib.course.selfcheck.check`` changes nothing (the checker does not
+become fail/error rows. The result files the kernel writes are opened without following links, regular
+files only, and only known words from the advisory exact check reach the feedback. Redefining
+``kinlib.course.selfcheck.check`` changes nothing (the checker does not
 use it); monkeypatching SymPy (``sympy.simplify = ...``, class attributes) or builtins is undone
 before the answers are read. The random points are known to the kernel when the values are asked
 for, but the reference is not (it is sent only afterwards, for the advisory exact check).
@@ -63,7 +83,6 @@ for, but the reference is not (it is sent only afterwards, for the advisory exac
 
 from __future__ import annotations
 
-import hashlib
 import json
 import math
 import os
@@ -72,13 +91,24 @@ import shutil
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from . import answers, compare, probe
-from .kernel import ANSWERS_SOURCE, GUARD_SOURCE, PROBE_SOURCE, NotebookRun
+from . import compare, credit
+from .kernel import KernelStartError, NotebookRun
+from .refdata import (
+    GRADE_VERSION,
+    Reference,
+    build_reference,
+    code_cells,
+    default_notebooks,
+    load_references,
+    reference_description,
+)
 from .report import summary_table, write_outputs
-from .schema import cell_meta, cell_part, notebook_id, notebook_title, parse_parts, stash_points
+from .sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
+from .schema import cell_meta, cell_part, match_notebook, notebook_id, stash_points
+from .secret import default_secret_path, evaluation_seed, load_secret
 
 __all__ = [
     "grade_batch",
@@ -90,9 +120,14 @@ __all__ = [
     "make_points",
     "Reference",
     "Row",
+    "GRADE_VERSION",
+    "SandboxUnavailable",
+    "NO_SANDBOX_NOTE",
 ]
 
-GRADE_VERSION = "1"
+NO_SANDBOX_NOTE = (
+    "graded WITHOUT the sandbox (--no-sandbox): the submission's code ran with the grader's files and network"
+)
 N_POINTS = 5
 N_SET_POINTS = 2
 MAX_SUBMISSION_BYTES = 50 * 2**20
@@ -116,160 +151,7 @@ class Row:
     points: float  # points earned
     message: str
     max_points: float = 0.0
-
-
-@dataclass
-class Reference:
-    """A solution notebook's graded parts and reference answers (as the reference kernel described them).
-
-    :func:`build_reference` makes them (and caches them as JSON, read back with ``Reference(**d)``):
-
-    >>> ref = Reference("02_planar", "Planar arms", "notebooks/02_planar.ipynb", "0" * 64,
-    ...                 parts=[{"part": "2.1", "points": 5.0, "answers": ["L"], "kinds": {"L": "expr"}}],
-    ...                 answers={"L": {"kind": "expr", "srepr": "Symbol('L', positive=True)",
-    ...                                "symbols": {"L": {"positive": True}}}})
-    >>> ref.error, [p["part"] for p in ref.parts]
-    ('', ['2.1'])
-    """
-
-    notebook: str
-    title: str
-    path: str
-    sha: str
-    parts: list  # [schema.Part as dict]
-    answers: dict  # name -> {"srepr"/"choice", "symbols"} or {"error"}
-    error: str = ""
-
-
-# ----------------------------------------------------------------------------------------- notebooks
-
-
-def default_notebooks() -> Path:
-    """The repository's ``notebooks/`` (next to the kinlib package), else ``notebooks`` in the cwd.
-
-    >>> default_notebooks().name
-    'notebooks'
-    """
-    p = Path(__file__).resolve().parents[2] / "notebooks"
-    return p if p.is_dir() else Path("notebooks")
-
-
-def _code_cells(nb: dict) -> list:
-    return [c for c in nb.get("cells", []) if isinstance(c, dict) and c.get("cell_type") == "code"]
-
-
-# ----------------------------------------------------------------------------------------- references
-
-
-def _hash(data: bytes) -> str:
-    h = hashlib.sha256(data)
-    h.update(PROBE_SOURCE.encode())
-    h.update(ANSWERS_SOURCE.encode())
-    h.update(GUARD_SOURCE.encode())
-    h.update(GRADE_VERSION.encode())
-    return h.hexdigest()
-
-
-def build_reference(path: Path, cache: Path | None = None, timeout: float = 300.0, log=None) -> Reference:
-    """Execute the solution notebook ``path`` and read its answers (cached by content hash).
-
-    It runs the notebook in a Jupyter kernel (seconds; tests/test_grade.py exercises it), hence not run here:
-
-    >>> ref = build_reference(Path("notebooks/02_planar_robot_jacobian.ipynb"), cache=None)  # doctest: +SKIP
-    >>> ref.notebook, ref.error  # doctest: +SKIP
-    ('02_planar_robot_jacobian', '')
-    """
-    path = Path(path)
-    data = path.read_bytes()
-    sha = _hash(data)
-    nb = json.loads(data)
-    nid = notebook_id(nb) or path.stem
-    if cache is not None:
-        cfile = Path(cache) / f"{nid}-{sha[:16]}.json"
-        if cfile.exists():
-            try:
-                return Reference(**json.loads(cfile.read_text()))
-            except (ValueError, TypeError):
-                pass
-    t0 = time.monotonic()
-    parts = parse_parts(nb)
-    title = notebook_title(nb, nid)
-    answers = {n: k for p in parts for n, k in p.kinds.items()}
-    code = _code_cells(nb)
-    stash_after = stash_points(nb)
-    tmp = tempfile.mkdtemp(prefix="kinlib-grade-ref-")
-    err = ""
-    ans: dict = {}
-    run = NotebookRun(
-        code,
-        str(path.parent.resolve()),
-        tmp,
-        cell_timeout=timeout,
-        total_timeout=timeout * 4,
-        stash_after=stash_after,
-        snapshot=False,
-    )
-    try:
-        run.execute()
-        bad = [r for r in run.results.values() if r.status != "ok"]
-        if bad:
-            err = f"code cell {bad[0].index + 1} of the solution notebook: {bad[0].summary()}"
-        got, e = run.call(f"probe_reference(globals(), {answers!r}, PATH)", timeout=120)
-        if got is None:
-            err = err or f"could not read the reference answers: {e}"
-        else:
-            ans = got
-    except RuntimeError as exc:
-        err = str(exc)
-    finally:
-        run.close()
-        shutil.rmtree(tmp, ignore_errors=True)
-    missing = [f"{n}: {a['error']}" for n, a in ans.items() if "error" in a]
-    if missing and not err:
-        err = "; ".join(missing)[:1000]
-    ref = Reference(nid, title, str(path), sha, [asdict(p) for p in parts], ans, err)
-    if log:
-        log(
-            f"  reference {nid}: {len(parts)} parts, {len(answers)} answers "
-            f"({time.monotonic() - t0:.1f} s){' ERROR: ' + err if err else ''}"
-        )
-    if cache is not None and not err:
-        Path(cache).mkdir(parents=True, exist_ok=True)
-        cfile.write_text(json.dumps(asdict(ref)))
-    return ref
-
-
-def load_references(notebooks: Path, cache: Path | None, ids: set | None = None, log=None, jobs: int = 1) -> dict:
-    """{notebook id: Reference} for the solution notebooks in ``notebooks`` (only ``ids`` if given).
-
-    Each one is a :func:`build_reference` (a kernel run); notebooks without a ``kinlib.notebook`` id are
-    not references:
-
-    >>> import tempfile
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     _ = (Path(d) / "scratch.ipynb").write_text('{"cells": [], "metadata": {}}')
-    ...     load_references(Path(d), cache=None)
-    {}
-    >>> refs = load_references(default_notebooks(), cache=None, ids={"02_planar_robot_jacobian"})  # doctest: +SKIP
-    >>> list(refs)  # doctest: +SKIP
-    ['02_planar_robot_jacobian']
-    """
-    todo = {}
-    for p in sorted(Path(notebooks).glob("*.ipynb")):
-        try:
-            nid = notebook_id(json.loads(p.read_bytes()))
-        except (OSError, ValueError):
-            continue
-        if nid is None or (ids is not None and nid not in ids):
-            continue
-        todo[nid] = p
-    if jobs <= 1 or len(todo) <= 1:
-        return {nid: build_reference(p, cache, log=log) for nid, p in todo.items()}
-    from concurrent.futures import ThreadPoolExecutor
-
-    with ThreadPoolExecutor(max_workers=jobs) as pool:
-        futures = {nid: pool.submit(build_reference, p, cache, log=log) for nid, p in todo.items()}
-        return {nid: f.result() for nid, f in futures.items()}
+    answers: list = field(default_factory=list)  # [{answer, status, message}]: credit.score_parts scores them
 
 
 # ----------------------------------------------------------------------------------------- one submission
@@ -301,57 +183,6 @@ def make_points(symbols: dict, seed: int, n: int) -> list[dict]:
     return pts
 
 
-_PARSED: dict = {}
-
-
-def _fast_expr(obj):
-    """(template description, f) with f(point) -> values for a reference Matrix/expression, or None."""
-    import numpy as np
-    import sympy as sp
-
-    tmpl = probe.describe_expr(obj, [], 0)
-    syms = sorted((s for s in obj.free_symbols if isinstance(s, sp.Symbol)), key=lambda s: s.name)
-    entries = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
-    try:
-        f = sp.lambdify(syms, entries, modules="numpy", cse=True)
-    except Exception:  # noqa: BLE001
-        return None
-
-    def values(point):
-        with np.errstate(all="ignore"):
-            out = f(*[np.complex128(point[s.name]) for s in syms])
-        row = [[float(np.real(v)), float(np.imag(v))] for v in (complex(x) for x in out)]
-        if not all(math.isfinite(x) for v in row for x in v):
-            raise ValueError("not finite")
-        return row
-
-    return tmpl, values
-
-
-def _ref_desc(ref: Reference, name: str, kind: str, points: list, seed: int) -> dict:
-    """The reference answer described like a student's (same code path; cached lambdified for speed)."""
-    a = ref.answers[name]
-    if "choice" in a:
-        return a["choice"]
-    key = (ref.sha, name)
-    if key not in _PARSED:
-        obj = probe.parse_srepr(a["srepr"])
-        fast = (
-            _fast_expr(obj)
-            if kind in ("expr", "subspace") and obj is not None and answers.to_sympy(obj)[0] in ("matrix", "scalar")
-            else None
-        )
-        _PARSED[key] = (obj, fast)
-    obj, fast = _PARSED[key]
-    if fast is not None:
-        try:
-            tmpl, values = fast
-            return dict(tmpl, values=[values(p) for p in points])
-        except Exception:  # noqa: BLE001  fall back to SymPy's evaluation
-            pass
-    return probe.describe(kind, obj, points, seed)
-
-
 def _error_rows(sub, nid, parts, msg) -> list[Row]:
     if not parts:
         return [Row(sub, nid, "-", "error", 0, msg)]
@@ -359,9 +190,19 @@ def _error_rows(sub, nid, parts, msg) -> list[Row]:
 
 
 def grade_submission(
-    path, refs: dict, cell_timeout: float = 60.0, total_timeout: float = 300.0, display_name: str | None = None
+    path,
+    refs: dict,
+    cell_timeout: float = 60.0,
+    total_timeout: float = 300.0,
+    display_name: str | None = None,
+    sandbox=True,
+    secret=None,
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises).
+
+    ``sandbox``: a :class:`~kinlib.course.sandbox.Sandbox`, True (the default one) or False (no sandbox:
+    said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
+    :func:`~kinlib.course.secret.default_secret_path`), which chooses the evaluation points.
 
     A file that is not one of the notebooks gets one ``error`` row, without starting a kernel:
 
@@ -381,6 +222,10 @@ def grade_submission(
     t0 = time.monotonic()
     sub = display_name or str(path)
     out = {"submission": sub, "notebook": "", "title": "", "rows": [], "cells": [], "restarts": 0, "output_bytes": 0}
+    out["sandbox"] = sandbox is not False
+    out["path"] = str(Path(path).absolute())  # the student id is read from it (credit.student_id)
+    if sandbox is False:
+        out["notes"] = [NO_SANDBOX_NOTE]
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
@@ -400,6 +245,12 @@ def grade_submission(
         out["rows"] = [Row(sub, "", "-", "error", 0, "not a notebook: JSON, but not a version-4 Jupyter notebook")]
         return _done(out, t0)
     nid = notebook_id(nb)
+    if nid is None:  # metadata lost (solution cells pasted into a new notebook): recognised by its questions
+        nid = match_notebook(nb, {k: r.parts for k, r in refs.items() if not r.error})
+        if nid is not None:
+            out.setdefault("notes", []).append(
+                f"recognised as {nid} by its answers and questions: the notebook's kinlib metadata was missing"
+            )
     if nid is None:
         out["rows"] = [
             Row(
@@ -420,16 +271,28 @@ def grade_submission(
         return _done(out, t0)
     out["title"] = ref.title
     parts = ref.parts
+    out["parts"] = parts  # points per answer and manual rows: credit.score_parts, in _done
     if ref.error:
         out["rows"] = _error_rows(sub, nid, parts, f"the reference for {nid} is broken: {ref.error}")
         return _done(out, t0)
-    seed = int(hashlib.sha256(data).hexdigest()[:15], 16)
+    try:
+        key = secret if isinstance(secret, bytes) else load_secret(secret)
+        if sandbox is True:
+            ok, why = check()
+            if not ok:
+                raise SandboxUnavailable(why)
+            sandbox = Sandbox()
+    except (OSError, ValueError, SandboxUnavailable) as exc:
+        out["infrastructure"] = str(exc)
+        out["rows"] = _error_rows(sub, nid, parts, f"not graded: infrastructure: {exc}")
+        return _done(out, t0)
+    seed = evaluation_seed(key, data)
     symbols: dict = {}
     for a in ref.answers.values():
         symbols.update(a.get("symbols", {}))
     points = make_points(symbols, seed, N_POINTS)
 
-    code = _code_cells(nb)
+    code = code_cells(nb)
     part_of_cell = {}
     for i, c in enumerate(code):
         part = cell_part(cell_meta(c))
@@ -438,13 +301,15 @@ def grade_submission(
     stash_after = stash_points(nb)
 
     tmp = tempfile.mkdtemp(prefix="kinlib-grade-")
-    run = None
+    run, cpu0 = None, time.process_time()
     try:
         scratch = os.path.join(tmp, "work")
         os.makedirs(scratch)
         with open(os.path.join(scratch, Path(path).name), "wb") as f:
             f.write(data)
-        run = NotebookRun(code, scratch, tmp, cell_timeout, total_timeout, stash_after=stash_after)
+        run = NotebookRun(
+            code, scratch, tmp, cell_timeout, total_timeout, stash_after=stash_after, sandbox=sandbox or None
+        )
         rows, exact = _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         out["restarts"] = run.restarts
         out["cells"] = [asdict(r) | {"part": part_of_cell.get(i, "")} for i, r in sorted(run.results.items())]
@@ -454,6 +319,8 @@ def grade_submission(
     finally:
         if run is not None:
             run.close()
+            out["namespaces"], out["start_failures"] = run.namespaces, run.start_failures
+            out["cpu_seconds"] = round(run.cpu_seconds + time.process_time() - cpu0, 3)
         shutil.rmtree(tmp, ignore_errors=True)
     out["rows"] = rows
     out["exact"] = exact
@@ -469,6 +336,8 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
     timing = out.setdefault("timing", {})
     try:
         run.execute()
+    except KernelStartError as exc:
+        fatal = out["infrastructure"] = f"infrastructure: {exc}"
     except RuntimeError as exc:
         fatal = str(exc)
     if not fatal and run.kernel is None:
@@ -496,7 +365,7 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         if fatal:
             rows.append(Row(sub, nid, p["part"], "error", 0, f"not graded: {fatal}", p["points"]))
             continue
-        msgs, ok_all, err = [], True, False
+        msgs, ok_all, err, verdicts = [], True, False, []
         for name in p["answers"]:
             kind = ref.answers.get(name, {}).get("kind") or p["kinds"].get(name, "expr")
             ra = ref.answers.get(name, {})
@@ -506,15 +375,18 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
             if stu.get("tag") == "probe-error" and stu.get("kernel"):
                 err, ok_all = True, False
                 msgs.append(f"{name} could not be read: {stu.get('error')}")
+                verdicts.append({"answer": name, "status": "error", "message": msgs[-1]})
                 continue
             n = N_SET_POINTS if kind == "set" else (0 if kind == "choice" else N_POINTS)
             try:
-                rd = _ref_desc(ref, name, kind, points[:n], seed)
+                rd = reference_description(ref, name, kind, points[:n], seed)
             except Exception as exc:  # noqa: BLE001
                 err, ok_all = True, False
                 msgs.append(f"{name}: the reference could not be evaluated ({exc})")
+                verdicts.append({"answer": name, "status": "error", "message": msgs[-1]})
                 continue
             ok, msg = compare.compare(kind, stu, rd, name)
+            verdicts.append({"answer": name, "status": "pass" if ok else "fail", "message": "" if ok else msg})
             if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "srepr" in ra:
                 pending_exact.append((p["part"], name, ra["srepr"]))
             if not ok:
@@ -523,7 +395,9 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
             elif msg:
                 msgs.append(f"{name}: {msg}")
         status = "pass" if ok_all else ("error" if err else "fail")
-        rows.append(Row(sub, nid, p["part"], status, p["points"] if ok_all else 0, "; ".join(msgs), p["points"]))
+        rows.append(
+            Row(sub, nid, p["part"], status, p["points"] if ok_all else 0, "; ".join(msgs), p["points"], verdicts)
+        )
     timing["compare"] = round(time.monotonic() - t2, 3)
     t3 = time.monotonic()
     # the advisory exact check, only now that every value is in
@@ -531,6 +405,8 @@ def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         for part, name, text in pending_exact:
             got, e = run.call(f"probe_exact(globals(), {name!r}, {text!r}, PATH)", EXACT_TIMEOUT)
             exact[name] = (got or {}).get("exact", "not checked") if isinstance(got, dict) else "not checked"
+            if exact[name] not in ("equal", "not proved", "not sympy", "missing", "error"):
+                exact[name] = "not checked"  # the kernel wrote the file: only known words reach the feedback
             if exact[name] != "equal":
                 for r in rows:
                     if r.part == part and r.status == "pass":
@@ -554,7 +430,7 @@ def _cell_hint(part, results, part_of_cell) -> str:
 def _done(out, t0):
     out["seconds"] = round(time.monotonic() - t0, 3)
     out["rows"] = [asdict(r) if isinstance(r, Row) else r for r in out["rows"]]
-    return out
+    return credit.score_parts(out, out.pop("parts", None) or [])
 
 
 # ----------------------------------------------------------------------------------------- batch
@@ -586,26 +462,32 @@ def find_submissions(paths) -> list[Path]:
     return found
 
 
-def _peek_id(path: Path):
+def _peek_id(path: Path, unmatched: bool = False):
+    """The notebook id of a submission (None if none); ``unmatched``: whether it is a notebook without one."""
     try:
         with open(path, "rb") as f:
             data = f.read(MAX_SUBMISSION_BYTES + 1)
-        return notebook_id(json.loads(data))
+        nb = json.loads(data)
+        if unmatched:
+            return isinstance(nb, dict) and isinstance(nb.get("cells"), list) and notebook_id(nb) is None
+        return notebook_id(nb)
     except (OSError, ValueError, UnicodeDecodeError, AttributeError):
         return None
 
 
 _REFS: dict = {}
+_CTX: dict = {}
 
 
-def _init_worker(refs_json):
+def _init_worker(refs_json, sandbox, secret):
     global _REFS
     _REFS = {k: Reference(**v) for k, v in refs_json.items()}
+    _CTX.update(sandbox=sandbox, secret=secret)
 
 
 def _work(args):
     path, name, cell_timeout, total_timeout = args
-    return grade_submission(path, _REFS, cell_timeout, total_timeout, display_name=name)
+    return grade_submission(path, _REFS, cell_timeout, total_timeout, display_name=name, **_CTX)
 
 
 def grade_batch(
@@ -617,11 +499,22 @@ def grade_batch(
     notebooks=None,
     cache="default",
     log=print,
+    sandbox: bool = True,
+    secret=None,
+    id_pattern=None,
+    overrides=None,
+    merge: bool = True,
 ) -> dict:
     """Grade every submission in ``paths`` (files or folders) into ``out``; returns a summary dict.
 
     ``summary = {"results": [per-submission dict], "rows": [...], "seconds": wall time,
-    "per_minute": submissions per minute, "reference_seconds": ...}``. Never raises for a bad submission.
+    "per_minute": submissions per minute, "reference_seconds": ..., "infrastructure_errors": n,
+    "sandbox": bool}``. Never raises for a bad submission. Each student kernel runs in the bubblewrap
+    sandbox (:mod:`kinlib.course.sandbox`); without it (bwrap missing) this raises SandboxUnavailable
+    unless ``sandbox=False`` (``--no-sandbox``), and then every feedback page and the summary say so.
+    ``secret``: the grader secret's file (default :func:`~kinlib.course.secret.default_secret_path`,
+    created on first use) or bytes. grades.csv and the feedback are written only after every kernel of
+    the batch (and every process a submission started) is gone.
 
     It runs the solution notebooks and every submission in Jupyter kernels (seconds to minutes;
     tests/test_grade.py exercises it), hence not run here:
@@ -638,8 +531,21 @@ def grade_batch(
     notebooks = Path(notebooks) if notebooks else default_notebooks()
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
+    key = secret if isinstance(secret, bytes) else load_secret(secret)
+    sb = None
+    if sandbox:
+        ok, why = check()
+        if not ok:
+            raise SandboxUnavailable(f"{why}; to grade without the sandbox pass --no-sandbox")
+        hidden = [notebooks, out, cache or "", "" if isinstance(secret, bytes) else secret or default_secret_path()]
+        sb = Sandbox(hidden=[str(Path(h).resolve()) for h in hidden if h] + [str(p.resolve().parent) for p in subs])
+        sb.command(["true"], cwd="/tmp", rw=[], env={})  # refuses now if a bind would expose a hidden folder
+    else:
+        log(f"WARNING: {NO_SANDBOX_NOTE}")
     ids = {i for i in (_peek_id(p) for p in subs) if i}
-    refs = load_references(notebooks, Path(cache) if cache else None, ids, log=log, jobs=max(1, int(jobs)))
+    if any(_peek_id(p, unmatched=True) for p in subs):
+        ids = None  # a notebook without its id is matched against every assignment's questions
+    refs = load_references(notebooks, Path(cache) if cache else None, ids, log=log, jobs=max(1, int(jobs)), secret=key)
     t_ref = time.monotonic() - t0
     names = _display_names(subs)
     jobs = max(1, int(jobs))
@@ -647,7 +553,9 @@ def grade_batch(
     results = []
     if jobs == 1 or len(work) <= 1:
         for k, w in enumerate(work, 1):
-            results.append(grade_submission(w[0], refs, cell_timeout, timeout, display_name=w[1]))
+            results.append(
+                grade_submission(w[0], refs, cell_timeout, timeout, display_name=w[1], sandbox=sb or False, secret=key)
+            )
             _progress(log, k, len(work), results[-1])
     else:
         import multiprocessing as mp
@@ -657,13 +565,17 @@ def grade_batch(
             max_workers=min(jobs, len(work)),
             mp_context=mp.get_context("spawn"),
             initializer=_init_worker,
-            initargs=(refs_json,),
+            initargs=(refs_json, sb or False, key),
         ) as pool:
             for k, r in enumerate(pool.map(_work, work), 1):
                 results.append(r)
                 _progress(log, k, len(work), r)
+    # every kernel is stopped by now; make sure no process of any sandbox survives before writing results
+    survivors = reap_namespaces([n for r in results for n in r.get("namespaces", [])])
+    if survivors:
+        raise RuntimeError(f"processes {survivors} of the batch's sandboxes could not be killed: no results written")
     wall = time.monotonic() - t0
-    write_outputs(out, results)
+    write_outputs(out, results, id_pattern=id_pattern, overrides=overrides, merge=merge, log=log)
     summary = {
         "results": results,
         "rows": [r for res in results for r in res["rows"]],
@@ -671,6 +583,8 @@ def grade_batch(
         "reference_seconds": t_ref,
         "n": len(results),
         "per_minute": 60 * len(results) / max(wall - t_ref, 1e-9) if results else 0.0,
+        "infrastructure_errors": sum(1 for r in results if r.get("infrastructure")),
+        "sandbox": sb is not None,
     }
     log(summary_table(results, wall, t_ref, jobs))
     return summary

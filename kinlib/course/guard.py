@@ -58,8 +58,17 @@ def _display_only(k):
     return str(k).startswith("_repr_")
 
 
+def _library_made(v, top: str) -> bool:
+    """True when ``v`` was made by the library itself (``top``: 'sympy', 'mpmath', 'numpy', …): SymPy's polys
+    domains build ``mpmath`` contexts, which re-wrap ``MPContext``'s class functions on every construction. Such
+    a change is undone like any other but is not reported as the notebook's doing."""
+    mod = str(getattr(v, "__module__", None) or getattr(getattr(v, "__func__", None), "__module__", "") or "")
+    return mod == top or mod.startswith(top + ".")
+
+
 def restore(snap):
-    """Undo replaced functions/classes in the snapshotted namespaces; returns the names put back.
+    """Undo replaced functions/classes in the snapshotted namespaces; returns the names put back that the
+    notebook replaced (a change the library made itself, see :func:`_library_made`, is undone silently).
 
     >>> import math
     >>> snap, real = snapshot(), math.sqrt
@@ -68,6 +77,9 @@ def restore(snap):
     (['math.sqrt'], True)
     """
     import types
+
+    def top_of(module_name: str) -> str:
+        return str(module_name).split(".")[0]
 
     fixed = []
     for name, m in snap["sysmods"].items():
@@ -84,26 +96,34 @@ def restore(snap):
                 and not k.startswith("__")
                 and k not in _NOT_RESTORED
             ):
+                if not _library_made(cur[k], top_of(name)):
+                    fixed.append(f"{name}.{k} (added)")
                 del cur[k]
-                fixed.append(f"{name}.{k} (added)")
         for k, v in saved.items():
-            if cur.get(k, _MISSING) is not v and _fn(v) and not k.startswith("__") and k not in _NOT_RESTORED:
+            new = cur.get(k, _MISSING)
+            if new is not v and _fn(v) and not k.startswith("__") and k not in _NOT_RESTORED:
+                if not _library_made(new, top_of(name)):
+                    fixed.append(f"{name}.{k}")
                 cur[k] = v
-                fixed.append(f"{name}.{k}")
     for cls, saved in snap["classes"].values():
         where = f"{cls.__module__}.{cls.__qualname__}"
+        top = top_of(cls.__module__)
         for k in list(cls.__dict__):
             if k not in saved and _fn(cls.__dict__[k]) and not _display_only(k):
                 try:
+                    new = cls.__dict__[k]
                     delattr(cls, k)
-                    fixed.append(f"{where}.{k} (added)")
+                    if not _library_made(new, top):
+                        fixed.append(f"{where}.{k} (added)")
                 except (AttributeError, TypeError):
                     pass
         for k, v in saved.items():
-            if cls.__dict__.get(k, _MISSING) is not v and _fn(v) and not _display_only(k):
+            new = cls.__dict__.get(k, _MISSING)
+            if new is not v and _fn(v) and not _display_only(k):
                 try:
                     setattr(cls, k, v)
-                    fixed.append(f"{where}.{k}")
+                    if not _library_made(new, top):
+                        fixed.append(f"{where}.{k}")
                 except (AttributeError, TypeError):
                     pass
     try:

@@ -8,8 +8,9 @@ executed notebooks.
 For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with nbconvert) it writes
 
 - ``solutions/NN_*.html``: the whole notebook with its outputs;
-- ``problems/NN_*.html``: questions, narrative, set-up and figures; left out: ``solution`` and
-  ``check`` cells, the untagged markdown inside a worked solution (between a ``question`` and the last
+- ``problems/NN_*.html``: questions, narrative, the student's set-up and figures; left out: ``solution`` and
+  ``check`` cells, the set-up's imports and helper functions that only they use (they would give the
+  method away: :func:`kinlib.course.analysis.trim_setup`), the untagged markdown inside a worked solution (between a ``question`` and the last
   ``solution``/``check`` cell answering it), cells that read answer variables (and their markdown
   caption just above), any output that repeats an answer cell's output; no prompt numbers; the saved
   widget state pruned to the widgets still shown;
@@ -17,8 +18,10 @@ For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with n
   (``Js = ...  # TODO: ...``, keeping its ``kinlib`` metadata), each solution markdown cell a prompt,
   each ``check`` cell a self-check (:mod:`kinlib.course.selfcheck`) that compares a fingerprint of the
   student's answer with the reference's made here (a part without a check cell gets one after its
-  last solution cell); worked-solution markdown left out as above; cells that use answer variables
-  run only once those are filled in (``%%needs``); outputs cleared. Unless ``--no-verify``, each
+  last solution cell); worked-solution markdown left out as above; the set-up imports only what the
+  student starts with (as in the problems); cells that use answer variables run only once those are
+  filled in, and say "fix the answer above first" if they fail on a wrong one (``%%needs``,
+  :mod:`kinlib.course.needs`); outputs cleared. Unless ``--no-verify``, each
   workbook is then run top to bottom (the stubs must not crash it);
 - ``index.html`` linking everything, and ``assets/``: MathJax 2 (copied from the installed
   ``jupyter-server-mathjax``), require.js and the ``@jupyter-widgets/html-manager`` embed bundle
@@ -40,7 +43,7 @@ from pathlib import Path
 
 import nbformat
 
-from .analysis import answer_dependents, worked_narrative
+from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
 from .pages import HTML_MANAGER, REQUIREJS, build_assets, export_html, write_index
 from .schema import (
     ANSWER_TAGS,
@@ -283,6 +286,24 @@ def prune_widget_state(nb) -> None:
         del nb.metadata["widgets"]
 
 
+def _used_names(cells) -> set | None:
+    """Every name the code ``cells`` read (None when one of them does not parse: then trim nothing)."""
+    used: set = set()
+    for c in cells:
+        if c.cell_type == "code":
+            names = loaded_names(c.source)
+            if names is None:
+                return None
+            used |= names
+    return used
+
+
+def _student_setup(cell, used) -> None:
+    """Drop from a kept code cell the imports and helpers only the solutions use (see ``trim_setup``)."""
+    if used is not None and cell.cell_type == "code":
+        cell.source = trim_setup(cell.source, used)
+
+
 def make_problems(executed) -> tuple:
     """The problem version of an executed notebook, and a list of notes on what was dropped.
 
@@ -323,10 +344,16 @@ def make_problems(executed) -> tuple:
         and not cell_tags(nb.cells[i - 1])
         and not nb.cells[i - 1].source.lstrip().startswith("#")
     }
+
+    def dropped_cell(i, c):
+        return bool(ANSWER_TAGS & set(cell_tags(c))) or i in narrative or i in dependents or i in captions
+
+    used = _used_names([c for i, c in enumerate(nb.cells) if not dropped_cell(i, c)])
     for i, c in enumerate(nb.cells):
-        if ANSWER_TAGS & set(cell_tags(c)) or i in narrative or i in dependents or i in captions:
+        if dropped_cell(i, c):
             continue  # answers, worked-solution steps, what is computed from answers and its caption
         if c.cell_type == "code":
+            _student_setup(c, used)  # the student's setup: not the imports that give the method away
             kept = [o for o in c.outputs if not _leaks(o, texts, images)]
             if len(kept) != len(c.outputs):
                 notes.append(
@@ -404,6 +431,9 @@ def make_workbook(source_nb, groups: list, fps: dict):
 
     needs = answer_dependents(nb)
     narrative = worked_narrative(nb)
+    used = _used_names(
+        [c for i, c in enumerate(nb.cells) if not (ANSWER_TAGS & set(cell_tags(c))) and i not in narrative]
+    )
 
     cells = []
     part = ""
@@ -430,6 +460,8 @@ def make_workbook(source_nb, groups: list, fps: dict):
         else:
             if i in needs:
                 cell.source = f"%%needs {' '.join(needs[i])}\n" + cell.source
+            else:
+                _student_setup(cell, used)  # imports only what the student starts with
             cells.append(cell)
         if i in after:
             cells.append(_selfcheck_cell(after[i], fps, None))

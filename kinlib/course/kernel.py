@@ -1,8 +1,13 @@
 """One isolated IPython kernel per submission, driven through jupyter_client, with time and size limits.
 
-The kernel is a fresh ``python -c ... ipykernel`` process in its own session (process group), with the
-scratch directory as its working directory, a unix-socket (ipc) connection, no history database,
-``MPLBACKEND=Agg`` and resource limits (address space, file size, no core dumps). Each cell runs with
+The kernel is a fresh ``python -P -B -c ... ipykernel`` process (no working directory on sys.path) in its
+own session (process group), with the scratch directory as its working directory, a unix-socket (ipc) connection, no history database,
+``MPLBACKEND=Agg`` and resource limits (address space, file size, no core dumps). With a
+:class:`kinlib.course.sandbox.Sandbox` it runs under bubblewrap (own PID/network/user namespaces, read-only
+system, only its own folder writable); stopping it kills its whole PID namespace, daemons included.
+Start-up and liveness are judged by the process itself (``poll()``), never by heartbeats: a start is
+retried up to :data:`START_ATTEMPTS` times with a generous time limit, and a kernel that still cannot
+start raises :class:`KernelStartError` (an infrastructure failure, not the submission's fault). Each cell runs with
 a per-cell time limit; past it the kernel gets SIGINT, and if it does not come back within a grace
 period the whole process group is killed. Outputs are never stored: only their size is counted (so a
 submission printing megabytes costs nothing but the time it spends printing), and errors are kept as
@@ -19,6 +24,7 @@ import json
 import os
 import queue
 import signal
+import stat
 import subprocess
 import sys
 import time
@@ -37,16 +43,30 @@ __all__ = [
     "PROBE_SOURCE",
     "ANSWERS_SOURCE",
     "GUARD_SOURCE",
+    "SREPR_SOURCE",
     "MAX_RESTARTS",
     "MAX_RESULT_BYTES",
+    "START_ATTEMPTS",
+    "KernelStartError",
 ]
 
 # the checker's code for the kernel, sent as text (see kinlib.course.probe)
 PROBE_SOURCE = (Path(__file__).parent / "probe.py").read_text()
 ANSWERS_SOURCE = (Path(__file__).parent / "answers.py").read_text()
 GUARD_SOURCE = (Path(__file__).parent / "guard.py").read_text()
+SREPR_SOURCE = (Path(__file__).parent / "srepr.py").read_text()
 MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
 MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
+START_ATTEMPTS = 3  # tries to start a kernel before it is an infrastructure failure
+
+
+class KernelStartError(RuntimeError):
+    """The kernel (or the checker's probe in it) could not be started: an infrastructure failure.
+
+    >>> str(KernelStartError("no answer in 120 s"))
+    'no answer in 120 s'
+    """
+
 
 _LAUNCH = (
     "import resource, sys\n"
@@ -62,6 +82,16 @@ _LAUNCH = (
     "from ipykernel import kernelapp as app\n"
     "app.launch_new_instance()\n"
 )
+
+
+def _cpu_seconds(pid) -> float:
+    """utime + stime + cutime + cstime of process ``pid`` in seconds (0 if it cannot be read)."""
+    try:
+        with open(f"/proc/{int(pid)}/stat") as f:
+            fields = f.read().rsplit(")", 1)[-1].split()
+        return sum(int(x) for x in fields[11:15]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, TypeError, IndexError):
+        return 0.0
 
 
 @dataclass
@@ -120,58 +150,116 @@ class Kernel:
     conn_dir: str
     mem_bytes: int = 3 * 2**30
     fsize_bytes: int = 200 * 2**20
-    startup_timeout: float = 60.0
+    startup_timeout: float = 120.0
     grace: float = 3.0
+    sandbox: object | None = None  # a kinlib.course.sandbox.Sandbox, or None (a plain subprocess)
     proc: subprocess.Popen | None = None
     kc: BlockingKernelClient | None = None
     dead_reason: str = ""
+    info: dict | None = None  # bwrap's --info-fd (child-pid, pid-namespace) when sandboxed
+    record: list | None = None  # sandbox.sandbox_record: [pid namespace, init PID, its start time]
+    start_failures: int = 0
+    cpu_seconds: float = 0.0  # CPU time the kernel process (and what it waited for) used, read when it is killed
 
     def start(self) -> None:
-        """Launch the kernel process and wait until it answers (RuntimeError if it does not start)."""
+        """Launch the kernel and wait until it answers, retrying (:data:`START_ATTEMPTS` tries); raise
+        :class:`KernelStartError` if it never does."""
+        errors = []
+        for _ in range(START_ATTEMPTS):
+            try:
+                self._launch()
+                self._wait_ready(time.monotonic() + self.startup_timeout)
+                return
+            except KernelStartError as exc:
+                errors.append(str(exc))
+                self.start_failures += 1
+                self.kill()
+        raise KernelStartError(f"the kernel did not start ({START_ATTEMPTS} tries: {'; '.join(errors)})"[:600])
+
+    def _launch(self) -> None:
         Kernel._counter = getattr(Kernel, "_counter", 0) + 1
         base = os.path.join(self.conn_dir, f"k{os.getpid()}-{Kernel._counter}")
         fn, _ = write_connection_file(fname=base + ".json", transport="ipc", ip=base)
-        env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
-        env.update(
-            MPLBACKEND="Agg",
-            JPY_PARENT_PID=str(os.getpid()),
-            PYTHONDONTWRITEBYTECODE="1",
-            PYDEVD_DISABLE_FILE_VALIDATION="1",
-        )
+        extra = {"MPLBACKEND": "Agg", "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
         code = _LAUNCH.format(mem=int(self.mem_bytes), fsize=int(self.fsize_bytes))
-        self.proc = subprocess.Popen(
-            [
-                sys.executable,
-                "-c",
-                code,
-                "-f",
-                fn,
-                "--HistoryManager.enabled=False",
-                "--IPKernelApp.log_level=ERROR",
-                "--Application.log_level=ERROR",
-            ],
-            cwd=self.cwd,
-            env=env,
-            stdin=subprocess.DEVNULL,
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            start_new_session=True,
-        )
+        argv = [sys.executable, "-P", "-B", "-c", code, "-f", fn, "--HistoryManager.enabled=False"]
+        argv += ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
+        fds: tuple = ()
+        rfd = None
+        if self.sandbox is not None:
+            rfd, wfd = os.pipe()
+            fds = (wfd,)
+            env = self.sandbox.environment(extra)
+            try:
+                argv = self.sandbox.command(argv, cwd=self.cwd, rw=[self.conn_dir, self.cwd], env=env, info_fd=wfd)
+            except Exception:
+                os.close(rfd)
+                os.close(wfd)
+                raise
+        else:
+            env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
+            env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+        try:
+            self.proc = subprocess.Popen(
+                argv,
+                cwd=self.cwd,
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                start_new_session=True,
+                pass_fds=fds,
+            )
+        except OSError as exc:
+            raise KernelStartError(f"cannot run {argv[0]}: {exc}") from None
+        finally:
+            for fd in fds:
+                os.close(fd)
+        if rfd is not None:
+            from .sandbox import read_info, sandbox_record
+
+            self.info = read_info(rfd, self.proc, self.startup_timeout)
+            self.record = sandbox_record(self.info)
+            if self.record is None:
+                raise KernelStartError(f"the sandbox did not start (bwrap exit status {self.proc.poll()})")
         self.kc = BlockingKernelClient(connection_file=fn)
         self.kc.load_connection_file()
-        self.kc.start_channels()
-        try:
-            self.kc.wait_for_ready(timeout=self.startup_timeout)
-        except RuntimeError as exc:
-            self.kill()
-            raise RuntimeError(f"the kernel did not start: {exc}") from None
+        self.kc.start_channels(hb=False)
+
+    def _wait_ready(self, deadline: float) -> None:
+        """kernel_info until it is answered and IOPub delivers; alive means ``proc.poll()`` is None."""
+        kc = self.kc
+        while True:
+            if self.proc.poll() is not None:
+                raise KernelStartError(f"the kernel process exited (status {self.proc.returncode}) before answering")
+            if time.monotonic() > deadline:
+                raise KernelStartError(f"no answer in {self.startup_timeout:g} s")
+            kc.kernel_info()
+            t_end = min(time.monotonic() + 5.0, deadline)
+            while time.monotonic() < t_end and self.proc.poll() is None:
+                try:
+                    msg = kc.get_shell_msg(timeout=0.5)
+                except queue.Empty:
+                    continue
+                if msg.get("msg_type") != "kernel_info_reply":
+                    continue
+                try:  # the reply came; IOPub must be connected too (it publishes the busy/idle status)
+                    kc.get_iopub_msg(timeout=2.0)
+                except queue.Empty:
+                    break  # ask again
+                while True:
+                    try:
+                        kc.get_iopub_msg(timeout=0.2)
+                    except queue.Empty:
+                        return
 
     def alive(self) -> bool:
         """Whether the kernel process is running."""
         return self.proc is not None and self.proc.poll() is None
 
     def kill(self) -> None:
-        """Stop the client and kill the kernel's whole process group."""
+        """Stop the client and kill the kernel's whole process group (sandboxed: its whole PID namespace,
+        waiting until no process of it is left)."""
         if self.kc is not None:
             try:
                 self.kc.stop_channels()
@@ -179,6 +267,18 @@ class Kernel:
                 pass
             self.kc = None
         if self.proc is not None:
+            if self.proc.poll() is None:
+                self.cpu_seconds += _cpu_seconds(self._kernel_pid())
+            if self.record is not None:
+                # the sandbox's init first: the kernel kills its whole namespace, init reaps it, and bwrap,
+                # seeing its child gone, exits (so CPU time is accounted up the chain to the grader)
+                from .sandbox import reap_namespaces
+
+                reap_namespaces([self.record])
+                try:
+                    self.proc.wait(timeout=2)
+                except subprocess.TimeoutExpired:
+                    pass
             try:
                 os.killpg(self.proc.pid, signal.SIGKILL)
             except (ProcessLookupError, PermissionError):
@@ -188,10 +288,26 @@ class Kernel:
             except subprocess.TimeoutExpired:
                 pass
 
-    def _interrupt(self) -> None:
+    def _kernel_pid(self):
+        """The kernel's PID as the grader sees it: the sandbox's init's child, or the process itself."""
+        child = (self.info or {}).get("child-pid")
+        if not child:
+            return self.proc.pid
         try:
-            os.kill(self.proc.pid, signal.SIGINT)
-        except ProcessLookupError:
+            with open(f"/proc/{int(child)}/task/{int(child)}/children") as f:
+                kids = f.read().split()
+            return int(kids[0]) if kids else None
+        except (OSError, ValueError):
+            return None
+
+    def _interrupt(self) -> None:
+        pid = self._kernel_pid()
+        try:
+            if pid:
+                os.kill(pid, signal.SIGINT)
+            elif self.kc is not None:  # ask the kernel to interrupt itself
+                self.kc.control_channel.send(self.kc.session.msg("interrupt_request", content={}))
+        except (ProcessLookupError, PermissionError):
             pass
 
     def run(self, code: str, timeout: float, index: int = -1, silent: bool = False) -> CellResult:
@@ -296,12 +412,17 @@ class NotebookRun:
         total_timeout: float,
         stash_after: dict | None = None,
         snapshot: bool = True,
+        sandbox=None,
     ):
         self.cells = cells
         self.cwd, self.tmp = cwd, tmp
         self.cell_timeout, self.total = cell_timeout, total_timeout
         self.stash_after = stash_after or {}
         self.snapshot = snapshot
+        self.sandbox = sandbox
+        self.namespaces: list = []  # sandbox records of every sandboxed kernel this run started
+        self.start_failures = 0
+        self.cpu_seconds = 0.0  # of every kernel this run started (read as each is stopped)
         self.nonce = "_kinlib_grade_" + os.urandom(8).hex()
         self.kernel = None
         self.results: dict = {}
@@ -309,8 +430,13 @@ class NotebookRun:
         self.t0 = time.monotonic()
 
     def _start(self):
-        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp)
-        self.kernel.start()
+        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp, sandbox=self.sandbox)
+        try:
+            self.kernel.start()
+        finally:
+            self.start_failures += self.kernel.start_failures
+            if self.kernel.record is not None:
+                self.namespaces.append(self.kernel.record)
         code = (
             f"def __kg_setup():\n"
             f"    import sys, types\n"
@@ -319,15 +445,17 @@ class NotebookRun:
             f"    m = types.ModuleType({self.nonce!r})\n"
             f"    g = types.ModuleType({self.nonce + '_guard'!r})\n"
             f"    exec(compile({GUARD_SOURCE!r}, '<kinlib-grade-guard>', 'exec'), g.__dict__)\n"
-            f"    m.answers, m.guard = a, g\n"
+            f"    r = types.ModuleType({self.nonce + '_srepr'!r})\n"
+            f"    exec(compile({SREPR_SOURCE!r}, '<kinlib-grade-srepr>', 'exec'), r.__dict__)\n"
+            f"    m.answers, m.guard, m.srepr = a, g, r\n"
             f"    exec(compile({PROBE_SOURCE!r}, '<kinlib-grade-probe>', 'exec'), m.__dict__)\n"
             f"    sys.modules[{self.nonce!r}] = m\n"
             f"    m.SNAP = g.snapshot() if {self.snapshot!r} else None\n"
             f"__kg_setup(); del __kg_setup\n"
         )
-        r = self.kernel.run(code, timeout=60, silent=True)
+        r = self.kernel.run(code, timeout=180, silent=True)
         if r.status != "ok":
-            raise RuntimeError(f"could not start the checker's probe in the kernel: {r.summary()}")
+            raise KernelStartError(f"could not start the checker's probe in the kernel: {r.summary()}")
 
     def _m(self) -> str:
         return f"__import__('sys').modules[{self.nonce!r}]"
@@ -362,6 +490,7 @@ class NotebookRun:
                 return self
             skip.add(died_at)
             self.kernel.kill()
+            self.cpu_seconds += self.kernel.cpu_seconds
             if self.restarts >= MAX_RESTARTS or self.total - (time.monotonic() - self.t0) <= 1:
                 for j in range(died_at + 1, len(self.cells)):
                     self.results.setdefault(j, CellResult(j, "skipped", note="not run: the kernel had died"))
@@ -381,8 +510,11 @@ class NotebookRun:
         r = self.kernel.run(f"{self._m()}.{expr.replace('PATH', repr(path))}", timeout=timeout, silent=True)
         if r.status != "ok":
             return None, r.summary()
-        try:
-            with open(path, "rb") as f:
+        try:  # the kernel can write in this folder: never follow a link it planted, read regular files only
+            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            with os.fdopen(fd, "rb") as f:
+                if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                    return None, "no readable result (not a regular file)"
                 data = f.read(MAX_RESULT_BYTES + 1)
             if len(data) > MAX_RESULT_BYTES:
                 return None, "the answer is too large to read"
@@ -394,4 +526,5 @@ class NotebookRun:
         """Kill the kernel, if one is running."""
         if self.kernel is not None:
             self.kernel.kill()
+            self.cpu_seconds += self.kernel.cpu_seconds
             self.kernel = None

@@ -22,13 +22,16 @@ import math
 import random
 
 if "answers" not in globals():  # in a student kernel the checker binds private copies before running this
-    from . import answers, guard
+    from . import answers, guard, srepr
+
+parse_srepr = srepr.parse_srepr  # reference data in, SymPy out (a strict parser, never eval)
 
 __all__ = [
     "describe",
     "describe_expr",
     "describe_set",
     "describe_choice",
+    "describe_property",
     "normalize_reference",
     "dump_reference",
     "parse_srepr",
@@ -219,13 +222,17 @@ def _enum1d(S, subs, window):
         f0, f1 = _real(f.xreplace({v: 0}), {}), _real(f.xreplace({v: 1}), {})
         step = abs(f1 - f0) if f0 is not None and f1 is not None else 0.0
         K = min(2000, int(2 * window / step) + 3) if step > 1e-9 else 50
-        lo = 0 if base is sp.S.Naturals0 else (1 if base is sp.S.Naturals else -K)
-        pts = []
-        for n in range(lo, K + 1):
+        # centred on the member nearest 0 (a family 2πn + 1000π, or one in degrees, has members in the window)
+        c = 0 if step <= 1e-9 or base is not sp.S.Integers else int(max(-1e6, min(1e6, round(-f0 / (f1 - f0)))))
+        lo = 0 if base is sp.S.Naturals0 else (1 if base is sp.S.Naturals else c - K)
+        pts, near = [], []
+        for n in range(lo, c + K + 1):
             x = _real(f.xreplace({v: n}), {})
             if x is not None and abs(x) <= window:
                 pts.append(x)
-        return pts, []
+            elif x is not None and abs(n - c) <= 3:
+                near.append(x)
+        return (pts or near), []
     if isinstance(S, sp.Intersection):
         enumerable = []
         filters = []
@@ -330,11 +337,41 @@ def describe_choice(value, points=(), seed=0):
 
 
 def describe_subspace(value, points, seed=0):
-    """Subspace answer: a matrix whose columns span it (a list of lists: the spanning vectors)."""
-    return describe_expr(value, points, seed, vectors=True)
+    """Subspace answer: a matrix whose columns span it (a list of lists: the spanning vectors); a constant
+    exact matrix also as its ``answers.expr_tree`` (``tree``), so the grader can compare spans exactly."""
+    out = describe_expr(value, points, seed, vectors=True)
+    if out.get("tag") == "matrix" and not out.get("symbols") and not out.get("has_float"):
+        try:
+            out["tree"] = answers.expr_tree(answers.to_sympy(value, vectors=True)[1], max_nodes=600)
+        except Exception:  # noqa: BLE001  (compared numerically then)
+            pass
+    return out
 
 
-DESCRIBE = {"expr": describe_expr, "subspace": describe_subspace, "set": describe_set, "choice": describe_choice}
+def describe_property(value, points, seed=0):
+    """An answer graded by a property (``kind`` "property:<name>"): described as an expression, plus its
+    exact expression tree (``answers.expr_tree``) for the grader's proof.
+
+    >>> import sympy as sp
+    >>> describe_property(sp.Rational(1, 2), [{}])["tree"]
+    ['rat', '1', '2']
+    """
+    out = describe_expr(value, points, seed)
+    if out.get("tag") in ("matrix", "scalar"):
+        try:
+            out["tree"] = answers.expr_tree(answers.to_sympy(value)[1])
+        except Exception as exc:  # noqa: BLE001
+            out["tree_error"] = str(exc)[:200]
+    return out
+
+
+DESCRIBE = {
+    "expr": describe_expr,
+    "subspace": describe_subspace,
+    "set": describe_set,
+    "choice": describe_choice,
+    "property": describe_property,
+}
 
 
 def describe(kind, value, points, seed=0):
@@ -343,7 +380,7 @@ def describe(kind, value, points, seed=0):
     >>> describe("choice", 3, [])["value"]
     3
     """
-    return DESCRIBE.get(kind, describe_expr)(value, points, seed)
+    return DESCRIBE.get(str(kind).split(":")[0], describe_expr)(value, points, seed)
 
 
 # ----------------------------------------------------------------------------- reference dump
@@ -428,30 +465,6 @@ def dump_reference(ns, kinds):
         except Exception as exc:  # noqa: BLE001
             out[name] = {"error": f"{type(exc).__name__}: {exc}"[:500]}
     return out
-
-
-def parse_srepr(text):
-    """Evaluate a *reference* srepr string (instructor data; never call this on student text).
-
-    >>> parse_srepr("Mul(Integer(2), Symbol('x'))")
-    2*x
-    """
-    import sympy as sp
-
-    ns = {}
-    exec("from sympy import *", ns)  # noqa: S102  (trusted instructor data)
-    ns.update(
-        {
-            "Integer": sp.Integer,
-            "Rational": sp.Rational,
-            "Float": sp.Float,
-            "Symbol": sp.Symbol,
-            "Dummy": sp.Dummy,
-            "ImmutableDenseMatrix": sp.ImmutableDenseMatrix,
-            "MutableDenseMatrix": sp.MutableDenseMatrix,
-        }
-    )
-    return eval(text, ns)  # noqa: S307  (trusted instructor data)
 
 
 # ----------------------------------------------------------------------------- exact equivalence (student kernel)

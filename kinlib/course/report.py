@@ -1,20 +1,77 @@
-"""The checker's outputs: ``grades.csv``, one feedback page per submission, and the summary table.
+"""The checker's outputs: ``grades.csv``, ``totals.csv``, one feedback page per submission, the summary table.
 
 They read the per-submission results :func:`kinlib.course.grade.grade_submission` returns (plain dicts,
-``rows`` as dicts), so they can be written again from saved results.
+``rows`` as dicts, scored per answer by :func:`kinlib.course.credit.score_parts`).
+
+The class folder (``--out``) keeps every graded submission's result as ``results/<key>.json`` (key: the
+student id and the notebook), and ``grades.csv``, ``totals.csv`` and ``feedback/`` are written from all of
+them, so **grading one student again replaces only that student's result**: every other row of the class
+files stays byte for byte the same. Files are written atomically (a temporary file, then a rename). The
+student id pattern is remembered in ``OUT/class.json`` (a later run without ``--id-pattern`` uses it; a new
+pattern re-keys every kept result from its stored path).
+Overrides (:mod:`kinlib.course.credit`) are applied each time from ``--overrides`` or, when it is not
+given, from ``OUT/overrides.toml`` / ``OUT/overrides.csv`` if present; the stored results stay automatic.
+
+``grades.csv`` columns: student_id, submission, notebook, part, answer (a manual item's label), kind
+(auto | manual), status (pass | fail | error for automatic rows; pending | graded for manual ones),
+points (empty while pending), max_points, message, comment (the instructor's), student_total,
+student_max, student_pending (the student's totals over all their notebooks, and what is still to grade).
 """
 
 from __future__ import annotations
 
+import copy
 import csv
+import io
+import json
+import os
 import re
+import tempfile
 from pathlib import Path
 
-__all__ = ["feedback_markdown", "cell_text", "write_outputs", "summary_table"]
+from . import credit
+
+__all__ = [
+    "COLUMNS",
+    "feedback_markdown",
+    "cell_text",
+    "write_outputs",
+    "summary_table",
+    "load_results",
+    "result_key",
+    "atomic_write",
+    "student_totals",
+    "default_overrides",
+]
+
+COLUMNS = [
+    "student_id",
+    "submission",
+    "notebook",
+    "part",
+    "answer",
+    "kind",
+    "status",
+    "points",
+    "max_points",
+    "message",
+    "comment",
+    "student_total",
+    "student_max",
+    "student_pending",
+]
 
 
 def _md(s) -> str:
     return str(s).replace("|", "\\|").replace("\n", " ").replace("<", "&lt;")
+
+
+def _g(x) -> str:
+    return f"{float(x or 0):g}"
+
+
+def _label(r: dict) -> str:
+    return f"{r['part']} ({r['answer']})" if r.get("answer") else str(r["part"])
 
 
 def feedback_markdown(res: dict) -> str:
@@ -24,24 +81,51 @@ def feedback_markdown(res: dict) -> str:
     ...     {"part": "2.1", "points": 5, "max_points": 5, "status": "pass", "message": ""}]}
     >>> print(feedback_markdown(res).splitlines()[4])
     **Score: 5 / 5 points**
+    >>> res["rows"].append({"part": "2.5", "answer": "drawing", "kind": "manual", "status": "pending",
+    ...                     "points": 0.0, "max_points": 5, "message": "drawing: graded by hand (pending)"})
+    >>> print(feedback_markdown(res).splitlines()[4])
+    **Score: 5 / 10 points** (pending: 2.5/drawing, 5 points graded by hand)
     """
     rows = res["rows"]
-    got = sum(r["points"] for r in rows)
-    mx = sum(r.get("max_points", 0) for r in rows)
+    tot = credit.result_totals(rows)
+    pend = [r for r in rows if r.get("status") == "pending"]
+    score = f"**Score: {_g(tot['points'])} / {_g(tot['max_points'])} points**"
+    if pend:
+        score += (
+            f" (pending: {', '.join(tot['pending'])}, {_g(sum(r.get('max_points', 0) for r in pend))} points "
+            "graded by hand)"
+        )
     lines = [
         f"# Feedback: {res.get('title') or res.get('notebook') or 'submission'}",
         "",
         f"Submission `{res['submission']}`" + (f" (notebook `{res['notebook']}`)" if res.get("notebook") else ""),
         "",
-        f"**Score: {got:g} / {mx:g} points**",
+        score,
         "",
-        "| Part | Points | Result | Feedback |",
-        "|---|---|---|---|",
     ]
+    notes = [str(n) for n in res.get("notes") or []]
+    if res.get("sandbox") is False and not any("sandbox" in n for n in notes):
+        notes.append("graded without the sandbox (--no-sandbox)")
+    lines += [f"*Note: {_md(n)}.*" for n in notes] + ([""] if notes else [])
+    lines += ["| Part | Points | Result | Feedback |", "|---|---|---|---|"]
     for r in rows:
-        lines.append(
-            f"| {_md(r['part'])} | {r['points']:g} / {r.get('max_points', 0):g} | {r['status']} | {_md(r['message'])} |"
-        )
+        pts = "–" if r.get("status") == "pending" else _g(r.get("points"))
+        status = r["status"] + (" (override)" if r.get("override") else "")
+        if r.get("kind") == "manual":
+            status += ", graded by hand"
+        msg = r.get("message", "")
+        if r.get("comment"):
+            msg = "; ".join(x for x in (msg, f"Instructor: {r['comment']}") if x)
+        lines.append(f"| {_md(_label(r))} | {pts} / {_g(r.get('max_points'))} | {status} | {_md(msg)} |")
+    multi = [r for r in rows if len(r.get("answers") or []) > 1]
+    if multi:
+        lines += ["", "## Points per answer", "", "| Part | Answer | Points | Result |", "|---|---|---|---|"]
+        for r in multi:
+            for a in r["answers"]:
+                st = a["status"] + (" (override)" if a.get("override") else "")
+                lines.append(
+                    f"| {_md(r['part'])} | `{_md(a['answer'])}` | {_g(a['points'])} / {_g(a['max_points'])} | {st} |"
+                )
     bad = [c for c in res.get("cells", []) if c["status"] != "ok"]
     if bad or res.get("restarts"):
         lines += ["", "## Cells that did not run cleanly", ""]
@@ -66,7 +150,8 @@ def feedback_markdown(res: dict) -> str:
         "How this was checked: your notebook ran top to bottom in a fresh Python kernel; each answer "
         "was evaluated at random joint angles and link lengths and compared with the solution's values "
         "there (matrices entry by entry, subspaces by their span, sets of configurations by their "
-        "members, angles modulo 2π, choices as sets). A part passes when every answer in it matches.",
+        "members, angles modulo 2π, choices as sets). Each answer that matches earns its share of its "
+        "part's points; work marked *graded by hand* is scored by your instructor.",
         "",
     ]
     return "\n".join(lines)
@@ -83,8 +168,199 @@ def cell_text(c: dict) -> str:
     return c.get("note") or c["status"]
 
 
-def write_outputs(out: Path, results: list) -> None:
-    """Write ``out/grades.csv`` and ``out/feedback/<submission>.md``; sets each result's ``feedback`` path.
+# ----------------------------------------------------------------------------------------- class files
+
+
+def _safe(s: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", s).strip("._")[:120] or "submission"
+
+
+def result_key(res: dict) -> str:
+    """The name a result is kept under in the class folder: student id and notebook (or the file's stem).
+
+    >>> result_key({"student_id": "ann", "notebook": "05_singularities_planar", "submission": "x/hw.ipynb"})
+    'ann--05_singularities_planar'
+    >>> result_key({"student_id": "bob lee", "notebook": "", "submission": "x/garbage.ipynb"})
+    'bob_lee--garbage'
+    """
+    nb = res.get("notebook") or Path(str(res.get("submission", ""))).stem
+    return f"{_safe(str(res.get('student_id') or 'unknown'))}--{_safe(nb)}"
+
+
+def atomic_write(path: Path, text: str) -> bool:
+    """Write ``text`` to ``path`` through a temporary file and a rename (readers never see half a file).
+    Returns False (and writes nothing) when the file already holds exactly that text.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     atomic_write(Path(d) / "a.txt", "x"), atomic_write(Path(d) / "a.txt", "x")
+    (True, False)
+    """
+    path = Path(path)
+    data = text.encode("utf-8")
+    try:
+        if path.read_bytes() == data:
+            return False
+    except OSError:
+        pass
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return True
+
+
+def load_results(out: Path) -> list:
+    """Every result kept in ``out/results/`` (sorted by key); unreadable files are skipped.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     load_results(Path(d))
+    []
+    """
+    found = []
+    for p in sorted((Path(out) / "results").glob("*.json")):
+        try:
+            res = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        if isinstance(res, dict) and isinstance(res.get("rows"), list):
+            found.append(res)
+    return found
+
+
+def student_totals(results: list) -> dict:
+    """{student id: {"points", "max_points", "pending"}} over all of each student's results.
+
+    >>> student_totals([{"student_id": "ann", "rows": [{"part": "1", "points": 2, "max_points": 5}]},
+    ...                 {"student_id": "ann", "rows": [{"part": "2", "points": 1, "max_points": 5}]}])
+    {'ann': {'points': 3.0, 'max_points': 10.0, 'pending': []}}
+    """
+    rows: dict = {}
+    for res in results:
+        rows.setdefault(res.get("student_id", ""), []).extend(res["rows"])
+    return {sid: credit.result_totals(rs) for sid, rs in rows.items()}
+
+
+def _csv(rows: list) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    for r in rows:
+        w.writerow(r)
+    return buf.getvalue()
+
+
+def _grades_csv(results: list, totals: dict) -> str:
+    out = [COLUMNS]
+    for res in results:
+        sid = res.get("student_id", "")
+        t = totals[sid]
+        for r in res["rows"]:
+            pending = r.get("status") == "pending"
+            out.append(
+                [
+                    sid,
+                    r.get("submission", res.get("submission", "")),
+                    r.get("notebook", res.get("notebook", "")),
+                    r["part"],
+                    r.get("answer", ""),
+                    r.get("kind", "auto"),
+                    r["status"],
+                    "" if pending else _g(r.get("points")),
+                    _g(r.get("max_points")),
+                    r.get("message", ""),
+                    r.get("comment", ""),
+                    _g(t["points"]),
+                    _g(t["max_points"]),
+                    " ".join(t["pending"]),
+                ]
+            )
+    return _csv(out)
+
+
+def _totals_csv(results: list, totals: dict) -> str:
+    nbs: dict = {}
+    for res in results:
+        nbs.setdefault(res.get("student_id", ""), []).append(res.get("notebook") or res.get("submission", ""))
+    out = [["student_id", "points", "max_points", "status", "pending", "notebooks"]]
+    for sid in sorted(totals):
+        t = totals[sid]
+        out.append(
+            [
+                sid,
+                _g(t["points"]),
+                _g(t["max_points"]),
+                "pending" if t["pending"] else "complete",
+                " ".join(t["pending"]),
+                " ".join(nbs.get(sid, [])),
+            ]
+        )
+    return _csv(out)
+
+
+def _key_results(kept: list, new: list, pattern) -> tuple:
+    """{key: result}: student ids from the stored paths (so a new pattern re-keys everyone); a new result replaces
+    the kept one of the same student and notebook. Results that still share a key (two files of one batch with
+    the same id) are all kept, the 2nd, 3rd, ... (by path) with the id suffixed "-2", "-3", and a warning."""
+    groups: dict = {}
+    for res in [*kept, *new]:
+        res["student_id"] = credit.student_id(res.get("path") or res["submission"], pattern)
+        for r in res["rows"]:
+            r.setdefault("kind", "auto")
+            r.setdefault("answer", "")
+        groups.setdefault(result_key(res), []).append(res)
+    table, warnings = {}, []
+    fresh = {id(r) for r in new}
+    for key, group in groups.items():
+        newer = [r for r in group if id(r) in fresh]
+        group = sorted(newer or group, key=lambda r: str(r.get("path") or r["submission"]))
+        table[key] = group[0]
+        for k, res in enumerate(group[1:], 2):
+            sid = res["student_id"]
+            res["student_id"] = f"{sid}-{k}"
+            table[result_key(res)] = res
+            warnings.append(
+                f"{res.get('path') or res['submission']} has the same student id {sid!r} as "
+                f"{group[0].get('path') or group[0]['submission']}: kept as {res['student_id']!r}; "
+                "give --id-pattern (one folder per student: '([^/]+)/[^/]+$')"
+            )
+    return table, warnings
+
+
+def _read_settings(out: Path) -> dict:
+    try:
+        d = json.loads((Path(out) / "class.json").read_text())
+    except (OSError, ValueError):
+        return {}
+    return d if isinstance(d, dict) else {}
+
+
+def default_overrides(out: Path):
+    """``out/overrides.toml`` or ``out/overrides.csv`` if present, else None.
+
+    >>> default_overrides(Path("/nonexistent"))
+    """
+    for name in ("overrides.toml", "overrides.csv"):
+        if (out / name).is_file():
+            return out / name
+    return None
+
+
+def write_outputs(out: Path, results: list, id_pattern=None, overrides=None, merge: bool = True, log=None) -> list:
+    """Keep ``results`` in the class folder ``out`` and write ``grades.csv``, ``totals.csv`` and
+    ``feedback/<key>.md`` from every result kept there; sets each result's ``student_id`` and ``feedback``.
+
+    ``id_pattern``: :func:`kinlib.course.credit.student_id`'s pattern (searched in ``res["path"]``, else the
+    submission name). ``overrides``: a path or a list of :class:`kinlib.course.credit.Override` (default:
+    ``out/overrides.toml`` or ``out/overrides.csv`` if present). ``merge=False`` forgets the results kept
+    before. Returns the overrides' warnings (a ValueError is raised for a bad override, before writing).
 
     >>> import tempfile
     >>> res = {"submission": "ann/hw 2.ipynb", "notebook": "02_planar", "rows": [
@@ -94,30 +370,51 @@ def write_outputs(out: Path, results: list) -> None:
     ...     write_outputs(Path(d), [res])
     ...     print(sorted(p.relative_to(d).as_posix() for p in Path(d).rglob("*")))
     ...     print((Path(d) / "grades.csv").read_text(), end="")
-    ['feedback', 'feedback/ann_hw_2.md', 'grades.csv']
-    submission,notebook,part,status,points,message
-    ann/hw 2.ipynb,02_planar,2.1,pass,5,
+    []
+    ['class.json', 'feedback', 'feedback/hw_2--02_planar.md', 'grades.csv', 'results', 'results/hw_2--02_planar.json', 'totals.csv']
+    student_id,submission,notebook,part,answer,kind,status,points,max_points,message,comment,student_total,student_max,student_pending
+    hw 2,ann/hw 2.ipynb,02_planar,2.1,,auto,pass,5,5,,,5,5,
     >>> Path(res["feedback"]).name
-    'ann_hw_2.md'
+    'hw_2--02_planar.md'
     """
-    out.mkdir(parents=True, exist_ok=True)
+    out = Path(out)
+    log = log or (lambda s: None)
     fb = out / "feedback"
-    fb.mkdir(exist_ok=True)
-    with open(out / "grades.csv", "w", newline="") as f:
-        w = csv.writer(f, lineterminator="\n")
-        w.writerow(["submission", "notebook", "part", "status", "points", "message"])
-        for res in results:
-            for r in res["rows"]:
-                w.writerow([r["submission"], r["notebook"], r["part"], r["status"], f"{r['points']:g}", r["message"]])
-    used = set()
+    store = out / "results"
+    settings = _read_settings(out)
+    pattern = id_pattern if id_pattern is not None else settings.get("id_pattern")
+    if overrides is None:
+        overrides = default_overrides(out)
+        if overrides is not None:
+            log(f"using the overrides in {overrides}")
+    if overrides is not None and not isinstance(overrides, list):
+        overrides = credit.load_overrides(overrides)
+    kept = load_results(out) if merge else []
+    if merge and not kept and (out / "grades.csv").exists():
+        log(f"note: {out / 'grades.csv'} has no kept results (written by an older kinlib): it is replaced")
+    table, clashes = _key_results(kept, results, pattern)
+    final = copy.deepcopy([table[k] for k in sorted(table)])
+    warnings = clashes + credit.apply_overrides(final, overrides or [])  # raises for a bad override: nothing written
+    for key, res in table.items():  # the raw (automatic) results, not the overridden ones
+        atomic_write(store / f"{key}.json", json.dumps(res, sort_keys=True, indent=1) + "\n")
+    for p in store.glob("*.json"):
+        if p.stem not in table:
+            p.unlink()
+    atomic_write(out / "class.json", json.dumps({"id_pattern": pattern}, indent=1) + "\n")
+    totals = student_totals(final)
+    fb.mkdir(parents=True, exist_ok=True)
+    for res in final:
+        atomic_write(fb / f"{result_key(res)}.md", feedback_markdown(res))
+    for p in fb.glob("*--*.md"):  # pages of results no longer kept (another id pattern, --fresh)
+        if p.stem not in table:
+            p.unlink()
+    atomic_write(out / "grades.csv", _grades_csv(final, totals))
+    atomic_write(out / "totals.csv", _totals_csv(final, totals))
     for res in results:
-        stem = re.sub(r"[^A-Za-z0-9_.-]+", "_", str(Path(res["submission"]).with_suffix("")))[:120] or "submission"
-        name, k = stem, 2
-        while name in used:
-            name, k = f"{stem}-{k}", k + 1
-        used.add(name)
-        res["feedback"] = str(fb / f"{name}.md")
-        (fb / f"{name}.md").write_text(feedback_markdown(res))
+        res["feedback"] = str(fb / f"{result_key(res)}.md")
+    for w in warnings:
+        log(f"warning: {w}")
+    return warnings
 
 
 def summary_table(results: list, wall: float, t_ref: float, jobs: int) -> str:
@@ -130,20 +427,20 @@ def summary_table(results: list, wall: float, t_ref: float, jobs: int) -> str:
         return "kinlib grade: no submissions"
     w = max(10, min(48, max(len(r["submission"]) for r in results)))
     nbw = max(8, min(30, max(len(r["notebook"] or "-") for r in results)))
-    lines = [f"{'submission':<{w}}  {'notebook':<{nbw}}  {'score':>9}  pass fail error  seconds"]
+    lines = [f"{'submission':<{w}}  {'notebook':<{nbw}}  {'score':>9}  pass fail error pending  seconds"]
     for r in results:
         rows = r["rows"]
-        got = sum(x["points"] for x in rows)
-        mx = sum(x.get("max_points", 0) for x in rows)
-        c = {s: sum(1 for x in rows if x["status"] == s) for s in ("pass", "fail", "error")}
+        t = credit.result_totals(rows)
+        c = {s: sum(1 for x in rows if x["status"] == s) for s in ("pass", "fail", "error", "pending")}
         lines.append(
-            f"{r['submission'][:w]:<{w}}  {(r['notebook'] or '-')[:nbw]:<{nbw}}  {got:>4g}/{mx:<4g}  "
-            f"{c['pass']:>4} {c['fail']:>4} {c['error']:>5}  {r['seconds']:7.1f}"
+            f"{r['submission'][:w]:<{w}}  {(r['notebook'] or '-')[:nbw]:<{nbw}}  "
+            f"{t['points']:>4g}/{t['max_points']:<4g}  "
+            f"{c['pass']:>4} {c['fail']:>4} {c['error']:>5} {c['pending']:>7}  {r.get('seconds', 0.0):7.1f}"
         )
     per_part: dict = {}
     for r in results:
         for x in r["rows"]:
-            if x["part"] != "-":
+            if x["part"] != "-" and x.get("kind", "auto") == "auto":
                 k = (x["notebook"], x["part"])
                 per_part.setdefault(k, [0, 0])
                 per_part[k][0] += x["status"] == "pass"
@@ -153,6 +450,8 @@ def summary_table(results: list, wall: float, t_ref: float, jobs: int) -> str:
         lines.append(
             "pass rate per part: " + ", ".join(f"{nb[:2]} {p}: {a}/{b}" for (nb, p), (a, b) in sorted(per_part.items()))
         )
+    if any(r.get("sandbox") is False for r in results):
+        lines.append("graded WITHOUT the sandbox (--no-sandbox)")
     n = len(results)
     graded = wall - t_ref
     lines.append(

@@ -11,8 +11,11 @@ The solution notebooks in ``notebooks/`` follow one structure, read here for bot
   (the workbook's self-check cells, written by ``kinlib handouts``);
 * **cell metadata** ``metadata.kinlib`` of a ``solution`` code cell: ``part`` ("2.1"), ``answers``
   (the variable names graded), ``kinds`` ({name: "expr" | "set" | "subspace" | "choice"}; "default"
-  is "expr"), ``describe`` ({name: words for the workbook's stub}), ``points`` (overrides the
-  question's points for that part).
+  is "expr"), ``properties`` ({name: "nonsingular"}: graded by that property, see :func:`grading_kind`),
+  ``describe`` ({name: words for the workbook's stub}), ``points`` (overrides the
+  question's points for that part), ``answer_points`` ({name: points} of answers within the part, for
+  partial credit; answers not listed share the rest evenly) and ``manual`` ({label: points} of work graded
+  by hand, e.g. {"drawing": 5}; also allowed on ``solution`` markdown cells). See :mod:`kinlib.course.credit`.
 
 Cells may be nbformat ``NotebookNode`` objects or the plain dicts of ``json.load``; anything malformed
 (tags that are not a list, metadata that is not a dict) reads as absent rather than raising.
@@ -38,6 +41,8 @@ __all__ = [
     "cell_part",
     "cell_answers",
     "answer_kind",
+    "grading_kind",
+    "PROPERTIES",
     "notebook_meta",
     "notebook_id",
     "notebook_title",
@@ -49,6 +54,8 @@ __all__ = [
     "parse_parts",
     "stash_points",
     "is_plain_selfcheck",
+    "assigned_names",
+    "match_notebook",
 ]
 
 QUESTION, SOLUTION, CHECK, SELFCHECK = "question", "solution", "check", "selfcheck"
@@ -140,6 +147,25 @@ def answer_kind(meta: dict, name: str) -> str:
     kinds = meta.get("kinds")
     kind = kinds.get(name) if isinstance(kinds, dict) else None
     return "expr" if kind in (None, "default") else str(kind)
+
+
+PROPERTIES = ("nonsingular",)
+
+
+def grading_kind(meta: dict, name: str) -> str:
+    """How the grader compares answer ``name``: "property:<p>" when the cell's ``kinlib`` metadata declares
+    ``properties`` {name: p} (an open-ended answer graded by the property asked, e.g. "nonsingular":
+    det(J Jᵀ) ≠ 0 for every θ, never by one design's value), else :func:`answer_kind`. The self-check and
+    the handouts keep :func:`answer_kind` (they know the printed solution's value only).
+
+    >>> grading_kind({"properties": {"d": "nonsingular"}}, "d"), grading_kind({"kinds": {"S": "set"}}, "S")
+    ('property:nonsingular', 'set')
+    """
+    props = meta.get("properties")
+    prop = props.get(name) if isinstance(props, dict) else None
+    if isinstance(prop, str) and prop:
+        return f"property:{prop}"
+    return answer_kind(meta, name)
 
 
 # ----------------------------------------------------------------------------------------- the notebook
@@ -275,7 +301,7 @@ class Part:
     :func:`parse_parts` makes them from a solution notebook:
 
     >>> Part("2.1", 5.0, ["J"], {"J": "expr"})
-    Part(part='2.1', points=5.0, answers=['J'], kinds={'J': 'expr'}, cells=[])
+    Part(part='2.1', points=5.0, answers=['J'], kinds={'J': 'expr'}, cells=[], answer_points={}, manual={})
     """
 
     part: str
@@ -283,6 +309,8 @@ class Part:
     answers: list
     kinds: dict
     cells: list = field(default_factory=list)
+    answer_points: dict = field(default_factory=dict)  # {answer name: points} declared for partial credit
+    manual: dict = field(default_factory=dict)  # {label: points} of work graded by hand
 
 
 def parse_parts(nb) -> list[Part]:
@@ -291,6 +319,8 @@ def parse_parts(nb) -> list[Part]:
     A part is made of the ``solution`` code cells with ``answers`` of one ``part`` id (a cell without one
     belongs to "q<N>", its question's number). Points: ``points`` of the cell's metadata if given, else
     the "(N points)" of the question cell above, split evenly between the parts sharing that question.
+    A ``solution`` cell (code or markdown) whose metadata has ``manual`` ({label: points}) makes a part too,
+    even without answers (5.2's drawing); ``answer_points`` and ``manual`` are collected per part.
 
     >>> q = {"cell_type": "markdown", "metadata": {"tags": ["question"]}, "source": "**1 (6 points).**"}
     >>> def sol(part, *names):
@@ -313,16 +343,20 @@ def parse_parts(nb) -> list[Part]:
             q_points = points_in(cell_source(cell))
             continue
         meta = cell_meta(cell)
-        names = cell_answers(meta)
-        if not _is(cell, "code") or SOLUTION not in tags or not names:
+        names = cell_answers(meta) if _is(cell, "code") else []
+        manual = _points_map(meta.get("manual"))
+        if SOLUTION not in tags or not (names or manual):
             continue
         pid = cell_part(meta, f"q{q_idx + 1}")
         p = parts.setdefault(pid, Part(pid, q_points if q_points is not None else 0.0, [], {}))
         for name in names:
             if name not in p.answers:
                 p.answers.append(name)
-            p.kinds[name] = answer_kind(meta, name)
-        p.cells.append(code_idx)
+            p.kinds[name] = grading_kind(meta, name)
+        p.answer_points.update(_points_map(meta.get("answer_points")))
+        p.manual.update(manual)
+        if _is(cell, "code"):
+            p.cells.append(code_idx)
         question_of.setdefault(pid, q_idx)
         if "points" in meta:
             explicit[pid] = float(meta["points"])
@@ -337,6 +371,15 @@ def parse_parts(nb) -> list[Part]:
     for pid, pts in explicit.items():
         parts[pid].points = pts
     return list(parts.values())
+
+
+def _points_map(obj) -> dict:
+    """{str: float} of a metadata mapping of points, keeping only finite numbers ≥ 0 (not bools)."""
+    out = {}
+    for k, v in obj.items() if isinstance(obj, dict) else ():
+        if isinstance(v, (int, float)) and not isinstance(v, bool) and v == v and 0 <= v < float("inf"):
+            out[str(k)] = float(v)
+    return out
 
 
 def stash_points(nb) -> dict:
@@ -403,3 +446,85 @@ def is_plain_selfcheck(cell) -> bool:
             continue
         return False
     return True
+
+
+# ----------------------------------------------------------------------------------------- a notebook without metadata
+
+_PART_RE = re.compile(r"(?<![\d.])(\d+\.\d+)(?![\d.])")
+
+
+def assigned_names(nb) -> set:
+    """Names assigned at the top level of the notebook's code cells (``x = …``, ``a, b = …``, ``x += …``,
+    ``x: T = …``); cells that do not parse (magics, syntax errors) are read line by line.
+
+    >>> sorted(assigned_names({"cells": [{"cell_type": "code", "source": "J, d = f()\\n%time x = 1\\ny += 2"}]}))
+    ['J', 'd', 'x', 'y']
+    """
+
+    def targets(node):
+        if isinstance(node, ast.Name):
+            yield node.id
+        elif isinstance(node, (ast.Tuple, ast.List)):
+            for e in node.elts:
+                yield from targets(e)
+        elif isinstance(node, ast.Starred):
+            yield from targets(node.value)
+
+    def scan(src):
+        tree = ast.parse(src)
+        for node in tree.body:
+            if isinstance(node, ast.Assign):
+                for t in node.targets:
+                    out.update(targets(t))
+            elif isinstance(node, (ast.AugAssign, ast.AnnAssign)):
+                out.update(targets(node.target))
+
+    out: set = set()
+    for cell in _cells(nb):
+        if not _is(cell, "code"):
+            continue
+        src = cell_source(cell)
+        try:
+            scan(src)
+        except (SyntaxError, ValueError):
+            for line in src.splitlines():
+                line = line.lstrip("%! ").split(" ", 1)[-1] if line.lstrip().startswith(("%", "!")) else line
+                try:
+                    scan(line.strip())
+                except (SyntaxError, ValueError):
+                    continue
+    return out
+
+
+def match_notebook(nb, references: dict) -> str | None:
+    """The id of the assignment a notebook without ``metadata.kinlib.notebook`` answers (solution cells pasted
+    into a new notebook), recognised by its questions: the answer names its code cells assign and the part
+    numbers ("5.1") its markdown mentions, against ``references`` = {id: [parts as dicts with "part" and
+    "answers"]}. ``None`` unless one assignment fits clearly (at least half of its answers assigned, or half
+    of its parts mentioned and some answer assigned) and better than every other.
+
+    >>> refs = {"02": [{"part": "2.1", "answers": ["M", "S1"]}, {"part": "2.2", "answers": ["Js"]}],
+    ...         "05": [{"part": "5.1", "answers": ["detJ", "singular_theta2"]}]}
+    >>> cell = {"cell_type": "code", "source": "detJ = Jt.det()\\nsingular_theta2 = {th2: S}"}
+    >>> match_notebook({"cells": [cell]}, refs), match_notebook({"cells": []}, refs)
+    ('05', None)
+    """
+    assigned = assigned_names(nb)
+    text = "\n".join(cell_source(c) for c in _cells(nb) if _is(c, "markdown"))
+    mentioned = set(_PART_RE.findall(text))
+    scored = []
+    for nid, parts in (references or {}).items():
+        parts = [p for p in parts or [] if isinstance(p, dict)]
+        answers = {a for p in parts for a in (p.get("answers") or []) if isinstance(a, str)}
+        ids = {str(p.get("part")) for p in parts if p.get("part") is not None}
+        if not answers and not ids:
+            continue
+        hit = len(answers & assigned)
+        cover = hit / len(answers) if answers else 0.0
+        said = len(ids & mentioned) / len(ids) if ids else 0.0
+        if cover >= 0.5 or (said >= 0.5 and hit > 0):
+            scored.append(((round(cover + said, 9), hit), nid))
+    scored.sort(key=lambda t: t[0], reverse=True)
+    if not scored or (len(scored) > 1 and scored[0][0] == scored[1][0]):
+        return None
+    return scored[0][1]

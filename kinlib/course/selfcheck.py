@@ -19,8 +19,14 @@ those of :mod:`kinlib.course.answers`, the normaliser the instructor checker use
   end points;
 - ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector.
 
-In a workbook, ``%load_ext kinlib.course.selfcheck`` adds the cell magic ``%%needs NAME...``: the cell runs
-only once the names it uses from the student's answers are filled in, and says so otherwise.
+A wrong answer is tried against the known mistakes of :mod:`kinlib.course.mistakes` (transposed, wrong
+sign, [v; ω] order, columns swapped, degrees, wrong shape, ...; the instructor checker uses the same):
+each undone version of the student's answer is fingerprinted too, and a match names the mistake ("it is
+transposed"), never the answer.
+
+In a workbook, ``%load_ext kinlib.course.selfcheck`` adds the cell magic ``%%needs NAME...``
+(:mod:`kinlib.course.needs`): the cell runs only once the names it uses from the student's answers are
+filled in, and if it fails while their self-check has not passed, says "fix the answer above first".
 """
 
 from __future__ import annotations
@@ -33,7 +39,8 @@ import sys
 import numpy as np
 import sympy as sp
 
-from . import answers
+from . import answers, mistakes
+from .needs import answer_status, last_results, needs
 from .schema import KINDS
 
 __all__ = [
@@ -198,7 +205,9 @@ def _shape_of(v) -> str:
     return f"{v.shape[0]}x{v.shape[1]}" if isinstance(v, sp.MatrixBase) else ""
 
 
-def _canon_default(value, shape: str | None = None):
+def _default_value(value, shape: str | None = None):
+    """The answer as a SymPy Matrix or expression with the expected ``shape`` ("rxc", "" for a scalar,
+    "dict"; None: any), or, for a yes/no or dict answer, its finished canonical form (a tuple)."""
     if answers.is_bool(value):  # a yes/no answer
         return "bool", "", [str(bool(value))]
     if isinstance(value, dict) or shape == "dict":  # e.g. {configuration name: row of J}
@@ -215,13 +224,32 @@ def _canon_default(value, shape: str | None = None):
             raise WrongForm(f"it should be {_shape_words(shape)}, yours is {_shape_words(mine)}")
     elif shape:
         raise WrongForm(f"it should be {_shape_words(shape)}, yours is {_shape_words('')}")
-    if isinstance(v, sp.MatrixBase):
-        pts = [[_fmt(e) for e in _evaluate(v, k)] for k in range(SAMPLE_POINTS)]
-        return "matrix", _shape_of(v), pts
-    if not isinstance(v, sp.Expr):
+    if not isinstance(v, (sp.MatrixBase, sp.Expr)):
         raise WrongForm(f"it should be a SymPy Matrix, expression or number, yours is {type(v).__name__}")
-    pts = [_fmt(_evaluate(v, k)) for k in range(SAMPLE_POINTS)]
-    return "scalar", "", pts
+    return v
+
+
+def _sampled(v):
+    """``v`` (Matrix or expression) at the sample points: an object array (points, rows, columns)."""
+    if isinstance(v, sp.MatrixBase):
+        return np.array([_evaluate(v, k).tolist() for k in range(SAMPLE_POINTS)], dtype=object).reshape(
+            SAMPLE_POINTS, *v.shape
+        )
+    return np.array([_evaluate(v, k) for k in range(SAMPLE_POINTS)], dtype=object).reshape(SAMPLE_POINTS, 1, 1)
+
+
+def _canon_sampled(arr, scalar: bool) -> tuple:
+    """(form, shape, canonical values) of sampled values ``arr`` (a scalar: 1×1 entries)."""
+    if scalar:
+        return "scalar", "", [_fmt(arr[k, 0, 0]) for k in range(arr.shape[0])]
+    return "matrix", f"{arr.shape[1]}x{arr.shape[2]}", [[_fmt(e) for e in arr[k].ravel()] for k in range(arr.shape[0])]
+
+
+def _canon_default(value, shape: str | None = None):
+    v = _default_value(value, shape)
+    if isinstance(v, tuple):
+        return v
+    return _canon_sampled(_sampled(v), not isinstance(v, sp.MatrixBase))
 
 
 def _choice_canon(x):
@@ -264,11 +292,13 @@ def _angle_point(p, k):
     return _fmt(p.evalf(30))
 
 
-def _canon_one_set(s, k):
+def _canon_one_set(s, k, fmap=None):
     try:
         s = answers.to_set(s)
     except TypeError as e:
         raise WrongForm(str(e).replace("a set should be", "it should be")) from None
+    if fmap is not None:  # a mistake undone (mistakes.SET_MISTAKES)
+        s = fmap(s)
     pt = _point(s, k)
     if pt:
         s = s.subs(pt)
@@ -294,45 +324,57 @@ def _canon_one_set(s, k):
     return sorted(out)
 
 
-def _canon_condition(cond: list) -> list:
+def _canon_condition(cond: list, fmap=None) -> list:
     return [
-        [str(key)] + [_canon_one_set(s, k) for k in range(SAMPLE_POINTS)]
+        [str(key)] + [_canon_one_set(s, k, fmap) for k in range(SAMPLE_POINTS)]
         for key, s in sorted(cond, key=lambda kv: str(kv[0]))
     ]
 
 
-def _canon_set(value):
+def _canon_set(value, fmap=None):
     """A dict {symbol: Set} is shape "dict", a list of several such dicts (a union) "union", the rest ""."""
     conds = answers.set_conditions(value)
     if conds is None:
         raise WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
     if len(conds) == 1 and conds[0] and conds[0][0][0] is None:
-        return "set", "", [_canon_one_set(conds[0][0][1], k) for k in range(SAMPLE_POINTS)]
+        return "set", "", [_canon_one_set(conds[0][0][1], k, fmap) for k in range(SAMPLE_POINTS)]
     if not conds:
         return "set", "", [_canon_one_set(sp.S.EmptySet, k) for k in range(SAMPLE_POINTS)]
     if len(conds) == 1:
-        return "set", "dict", _canon_condition(conds[0])
-    return "set", "union", sorted((_canon_condition(c) for c in conds), key=json.dumps)
+        return "set", "dict", _canon_condition(conds[0], fmap)
+    return "set", "union", sorted((_canon_condition(c, fmap) for c in conds), key=json.dumps)
 
 
-def _canon_subspace(value, shape=None):
+def _subspace_value(value, shape=None):
     v = _as_sympy_value(value, vectors=True)  # a list of spanning vectors: side by side
     if not isinstance(v, sp.MatrixBase):
         raise WrongForm("it should be a Matrix whose columns span the subspace")
     m = str(v.shape[0])
     if shape not in (None, m):
         raise WrongForm(f"its columns should be {shape}-vectors, yours are {m}-vectors")
-    pts = []
+    return v
+
+
+def _subspace_sampled(v) -> np.ndarray:
+    """The spanning vectors at the sample points, as floats (points, m, vectors)."""
+    out = []
     for k in range(SAMPLE_POINTS):
         try:
-            A = np.array(_evaluate(v, k).tolist(), dtype=complex)
+            A = np.array(_evaluate(v, k).tolist(), dtype=complex).reshape(v.shape)
         except TypeError as e:
             raise CannotCheck(f"it does not evaluate to numbers ({e})") from None
         if np.abs(A.imag).max(initial=0.0) > _ZERO:
             raise CannotCheck("it has complex entries")
-        A = A.real
+        out.append(A.real)
+    return np.array(out).reshape(SAMPLE_POINTS, *v.shape)
+
+
+def _canon_spans(As) -> tuple:
+    """(form, ambient dimension, canonical projectors) of the spans of the arrays ``As`` (one per point)."""
+    pts = []
+    for A in As:
         if A.size == 0 or np.abs(A).max() < _ZERO:
-            P = np.zeros((v.shape[0], v.shape[0]))
+            P = np.zeros((A.shape[0], A.shape[0]))
         else:
             U, s, _ = np.linalg.svd(A)
             r = int((s > 1e-9 * max(1.0, s[0])).sum())
@@ -340,7 +382,11 @@ def _canon_subspace(value, shape=None):
             P = Q @ Q.T
         P = np.round(P, _PROJ_DECIMALS) + 0.0
         pts.append([f"{x:.{_PROJ_DECIMALS}f}" for x in P.ravel()])
-    return "subspace", m, pts
+    return "subspace", str(As[0].shape[0]), pts
+
+
+def _canon_subspace(value, shape=None):
+    return _canon_spans(_subspace_sampled(_subspace_value(value, shape)))
 
 
 _CANON = {
@@ -411,9 +457,7 @@ def describe_answer(value, kind: str = "default") -> str:
         return "a dict {" + ", ".join(map(str, value)) + ": ...}"
     if isinstance(v, sp.MatrixBase):
         return f"a {v.shape[0]}×{v.shape[1]} Matrix"
-    if isinstance(v, sp.Expr) and v.free_symbols:
-        return "a SymPy expression"
-    return "a number"
+    return "a SymPy expression or a number"  # the same words for both: whether it is constant is a hint
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -437,15 +481,18 @@ _FORM_KIND = {
     "subspace": "subspace",
 }
 
-last_results: dict = {}
-
 
 def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     """``(status, message)`` for an answer against a spec; status is correct/incorrect/unanswered/error.
 
+    A wrong answer is tried against the known mistakes (:mod:`kinlib.course.mistakes`: the same as the
+    instructor checker's): the message names the mistake, never the answer.
+
     >>> spec = fingerprint(sp.Rational(1, 2), salt="1.1:x")
     >>> verdict(0.5, spec, salt="1.1:x"), verdict(..., spec, salt="1.1:x")[0]
     (('correct', 'correct'), 'unanswered')
+    >>> verdict(-0.5, spec, salt="1.1:x")
+    ('incorrect', 'not right yet: it has the wrong sign')
     """
     form, shape, digest = _parse_spec(spec)
     if answers.is_unanswered(value):
@@ -456,34 +503,119 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     if kind is None:
         raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
     try:
-        if kind == "default":
-            mine_form, mine_shape, canon = _canon_default(value, shape)
-        elif kind == "subspace":
-            mine_form, mine_shape, canon = _canon_subspace(value, shape)
-        else:
-            mine_form, mine_shape, canon = _CANON[kind](value)
-            if kind == "set" and mine_shape != shape:
-                want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(
-                    shape, "a single Set"
-                )
-                raise WrongForm(f"it should be {want}")
+        return _verdict(kind, value, form, shape, digest, salt)
     except WrongForm as e:
         return "incorrect", f"wrong form: {e}"
     except CannotCheck as e:
         return "error", f"cannot check it automatically: {e}"
     except Exception as e:  # anything the student's object throws while being evaluated
         return "error", f"could not evaluate your answer ({type(e).__name__}: {e})"
-    if _hash(mine_form, canon, salt) == digest:
-        return "correct", "correct"
+
+
+_HOW = {
+    "default": "its values differ from the answer's at sample values of its symbols",
+    "subspace": "it spans a different subspace",
+    "set": "it holds different points",
+    "choice": "that is not the right choice",
+}
+
+
+def _verdict(kind, value, form, shape, digest, salt):
+    def right(canon, mine_form=form):
+        return _hash(mine_form, canon, salt) == digest
+
+    def named(says):
+        return "incorrect", f"not right yet: it {says}"
+
     if kind == "default":
-        how = "its values differ from the answer's at sample values of its symbols"
-    elif kind == "subspace":
-        how = "it spans a different subspace"
-    elif kind == "set":
-        how = "it holds different points"
-    else:
-        how = "that is not the right choice"
-    return "incorrect", f"not right yet: {how}"
+        try:
+            v = _default_value(value, shape)
+        except WrongForm:
+            found = _default_mistake(value, form, shape, right)
+            if found is None:
+                raise
+            yours = _shape_words(_shape_of(_as_sympy_value(value)))
+            return "incorrect", f"wrong form: it {found}: yours is {yours}, it should be {_shape_words(shape)}"
+        if isinstance(v, tuple):  # yes/no, dict
+            mine_form, _, canon = v
+            return ("correct", "correct") if right(canon, mine_form) else ("incorrect", f"not right yet: {_HOW[kind]}")
+        arr = _sampled(v)
+        mine_form, _, canon = _canon_sampled(arr, not isinstance(v, sp.MatrixBase))
+        if right(canon, mine_form):
+            return "correct", "correct"
+        found = _default_mistake(v, form, shape, right, arr)
+        return named(found) if found else ("incorrect", f"not right yet: {_HOW[kind]}")
+    if kind == "subspace":
+        try:
+            v = _subspace_value(value, shape)
+        except WrongForm:
+            v = _subspace_value(value)
+            found = _subspace_mistake(_subspace_sampled(v), shape, right)
+            if found is None:
+                raise
+            return named(found)
+        arr = _subspace_sampled(v)
+        if right(_canon_spans(arr)[2]):
+            return "correct", "correct"
+        found = _subspace_mistake(arr, shape, right)
+        return named(found) if found else ("incorrect", f"not right yet: {_HOW[kind]}")
+    if kind == "set":
+        _, mine_shape, canon = _canon_set(value)
+        if mine_shape != shape:
+            want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(shape, "a single Set")
+            raise WrongForm(f"it should be {want}")
+        if right(canon):
+            return "correct", "correct"
+        for m in mistakes.SET_MISTAKES:
+            try:
+                if right(_canon_set(value, lambda s, m=m: next(m.candidates(s))[1])[2]):
+                    return named(m.message())
+            except Exception:  # noqa: BLE001  SymPy may not map this set: not that mistake
+                continue
+        return "incorrect", f"not right yet: {_HOW[kind]}"
+    _, _, canon = _canon_choice(value)
+    if right(canon):
+        return "correct", "correct"
+    for m in mistakes.CHOICE_MISTAKES:
+        try:
+            if right(_choice_canon(next(m.candidates(answers.choice_value(value)))[1])):
+                return "incorrect", f"not right yet: that {m.message()}"
+        except WrongForm:
+            continue
+    return "incorrect", f"not right yet: {_HOW[kind]}"
+
+
+def _default_mistake(v, form, shape, right, arr=None):
+    """The words naming the known mistake that makes ``v`` right, or None."""
+    if isinstance(v, dict) or answers.is_bool(v) or shape == "dict" or form not in ("matrix", "scalar"):
+        return None
+    if not isinstance(v, (sp.MatrixBase, sp.Expr)):
+        v = _as_sympy_value(v)
+    if isinstance(v, sp.MatrixBase) and v.shape == (1, 1) and shape == "":
+        v = v[0, 0]
+    want = tuple(int(x) for x in shape.split("x")) if shape else (1, 1)
+
+    def matches(X):
+        return X.shape[1:] == want and right(_canon_sampled(X, shape == "")[2])
+
+    arr = _sampled(v) if arr is None else arr
+    found = mistakes.search(arr, matches)
+    if found is not None:
+        return found.says
+    fixed = mistakes.trig_degrees(v)
+    if fixed is not None and matches(_sampled(fixed)):
+        return "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
+    return None
+
+
+def _subspace_mistake(arr, shape, right):
+    m = int(shape)
+
+    def matches(As):
+        return all(A.shape[0] == m for A in As) and right(_canon_spans(As)[2])
+
+    found = mistakes.search(arr, matches, mistakes.SUBSPACE_MISTAKES, pairs=False)
+    return found.says if found is not None else None
 
 
 def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
@@ -541,27 +673,13 @@ def emit_fingerprints(specs: dict, ns: dict) -> None:
 
 
 # ---------------------------------------------------------------------------------------------------
-# The %%needs cell magic.
-
-
-def _needs(line: str, cell: str):
-    from IPython import get_ipython
-
-    ip = get_ipython()
-    names = line.split("#", 1)[0].split()
-    missing = [n for n in names if answers.is_unanswered(ip.user_ns.get(n))]
-    if missing:
-        print(
-            f"(skipped: this cell uses {', '.join(missing)} from your answers above; "
-            f"fill {'them' if len(missing) > 1 else 'it'} in, then run this cell again)"
-        )
-        return None
-    ip.run_cell(cell)
-    return None
+# The workbook extension
 
 
 def load_ipython_extension(ip) -> None:
-    """``%load_ext kinlib.course.selfcheck``: registers the ``%%needs NAME...`` cell magic.
+    """``%load_ext kinlib.course.selfcheck``: registers the ``%%needs NAME...`` cell magic
+    (:func:`kinlib.course.needs.needs`: skips a cell until its answers are filled in, and turns an error in
+    it into "fix the answer above first" while the self-check has not passed them).
 
     IPython calls it with the shell; any object with ``register_magic_function`` does here:
 
@@ -571,4 +689,8 @@ def load_ipython_extension(ip) -> None:
     >>> load_ipython_extension(Shell())
     cell needs
     """
+
+    def _needs(line: str, cell: str):
+        return needs(line, cell, ip, status=answer_status)
+
     ip.register_magic_function(_needs, magic_kind="cell", magic_name="needs")

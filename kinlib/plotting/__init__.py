@@ -26,14 +26,16 @@ Functions (each returns an object to update or inspect):
   ``draw_home(chain, ...)``: θ = 0 with each joint's screw axis listed beside the picture (symbols kept);
 * ``draw_velocity(ax, chain, q, qdot, *, rows=None, scale=1)`` → :class:`VelocityArtist` (``.velocity`` = ṗ);
   ``draw_joint_velocities(ax, chain, q, *, rows=None, joints=None, scale=1)`` → :class:`JointVelocitiesArtist`;
-* ``draw_velocity_ellipse(ax, chain, q, *, rows=None, scale=1)`` → :class:`EllipseArtist` (``.semi_axes``);
+* ``draw_velocity_ellipse(ax, chain, q, *, rows=None, scale=1, hold=None)`` → :class:`EllipseArtist`
+  (``.semi_axes``; ``hold=("wz",)``: the ellipse with those rows held at zero, e.g. the orientation);
   ``draw_ellipse(ax, center, lengths, axes)`` for a given (σ, U);
 * ``draw_directions(ax, origin, vectors, labels, *, components=None, length=None, both_ways=False)``;
 * ``plot_joint_contributions(ax, values, *, title=None)`` (bar chart of one row of J);
 * ``plot_manipulability_curve(chain, joint, q_fixed=None, *, rows=None, measure="yoshikawa")`` → :class:`CurvePlot`;
   ``plot_manipulability_map(chain, joints=(1, 2), q_fixed=None, *, rows=None, singular=True)`` → :class:`MapPlot`;
-* ``sweep(chain, joint, values, q_fixed=None)`` and ``animate_singularity(chain, path)`` → FuncAnimation
-  (``.to_jshtml()`` plays in a static page).
+* ``sweep(chain, joint, values, q_fixed=None)`` and ``animate_singularity(chain, path)`` → a FuncAnimation
+  (``.to_jshtml()`` plays in a static page and shows frame 0 at once; as a cell's value it also carries a
+  static image/png of frame 0).
 
 Joints are numbered as in the book, 1…n (``joint=2`` is θ2).  Task rows are those of
 :mod:`kinlib.taskspace`: names ``'wx','wy','wz','vx','vy','vz'`` (indices 0…5 of [ω_s; ṗ]) and presets

@@ -13,6 +13,12 @@ True
 
 from __future__ import annotations
 
+import base64
+import io
+import re
+import struct
+import uuid
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.animation import FuncAnimation
@@ -23,7 +29,151 @@ from ..taskspace import default_task_rows, is_planar, rows_label, task_row_indic
 from .common import checked_numeric
 from .drawing import draw_chain, draw_velocity_ellipse
 
-__all__ = ["animate_singularity"]
+__all__ = ["animate_singularity", "SingularityAnimation", "first_frame_html"]
+
+_FRAME0 = re.compile(r'frames\[0\] = "(data:image/(png|jpeg);base64,(?:[^"\\]|\\.|\\\n)*)"')
+_START = re.compile(r"setTimeout\(function\(\) \{\s*(anim\w+ = new Animation\([^;]*\);)\s*\}, 0\);")
+_FONT_AWESOME = re.compile(r"<link[^>]*font-awesome[^>]*>")
+
+
+def _player_html(frames: list, fps: float, mode: str) -> str:
+    """matplotlib's jshtml player (its HTMLWriter template) around PNG frames given as bytes."""
+    from matplotlib._animation_data import DISPLAY_TEMPLATE, JS_INCLUDE, STYLE_INCLUDE
+
+    fill = "\n" + "".join(
+        f'  frames[{i}] = "data:image/png;base64,{base64.b64encode(f).decode("ascii")}"\n' for i, f in enumerate(frames)
+    )
+    modes = dict(once_checked="", loop_checked="", reflect_checked="")
+    modes[mode + "_checked"] = "checked"
+    return (
+        JS_INCLUDE
+        + STYLE_INCLUDE
+        + DISPLAY_TEMPLATE.format(
+            id=uuid.uuid4().hex, Nframes=len(frames), fill_frames=fill, interval=int(1000 // fps), **modes
+        )
+    )
+
+
+def first_frame_html(html: str) -> str:
+    """matplotlib's ``to_jshtml()`` player made to show frame 0 at once: the ``<img>`` starts with frame 0
+    as its ``src`` and its pixel size (no blank, zero-height picture before the script runs, nor when
+    scripts do not run: an untrusted notebook, a static page), and the player starts once its
+    ``<img>`` is in the page (JupyterLab may render an output before attaching it; matplotlib's
+    ``setTimeout(…, 0)`` then finds no element and the player stays blank until clicked; the new start
+    statement begins with ";" as the line before it, ``frames[N-1] = "…"``, has none).
+    Unchanged if the HTML is not in the expected form.
+
+    >>> first_frame_html('<img id="_anim_imgX">')   # no frames: unchanged
+    '<img id="_anim_imgX">'
+    """
+    m = _FRAME0.search(html)
+    if m is None:
+        return html
+    src = m.group(1).replace("\\\n", "")
+    size = ""
+    try:
+        head = base64.b64decode(src.split(",", 1)[1][:64] + "==")
+        if head[:8] == b"\x89PNG\r\n\x1a\n":
+            w, h = struct.unpack(">II", head[16:24])
+            size = f' width="{w}" height="{h}"'
+    except (ValueError, struct.error):
+        pass
+    html = re.sub(r'<img id="(_anim_img\w+)">', lambda k: f'<img id="{k.group(1)}" src="{src}"{size}>', html, count=1)
+    return _START.sub(
+        lambda k: (
+            ";(function start(tries) {\n"
+            "        if (!document.getElementById(img_id) && tries < 600) { setTimeout(function() { start(tries + 1); }, 50);"
+            " return; }\n        " + k.group(1) + "\n    })(0);"
+        ),
+        html,
+        count=1,
+    )
+
+
+class SingularityAnimation(FuncAnimation):
+    """The FuncAnimation made by :func:`animate_singularity`: ``to_jshtml()`` shows frame 0 at once
+    (:func:`first_frame_html`), and displayed as a cell's value it gives the player (``text/html``, without
+    the Font Awesome link to a CDN: JupyterLab ships the icons), a static ``image/png`` of frame 0 and a
+    line of ``text/plain``. ``values``: the manipulability per step.
+
+    >>> from kinlib.robots import planar_2r
+    >>> anim = animate_singularity(planar_2r(1, 1), [[0.0, 0.5], [0.0, 0.0]])
+    >>> sorted(anim._repr_mimebundle_())
+    ['image/png', 'text/html', 'text/plain']
+    """
+
+    _writing = False
+    _html = None
+
+    def to_jshtml(self, fps=None, embed_frames=True, default_mode=None):
+        """matplotlib's player (same template), its frames drawn by blitting (the static background drawn
+        once, then per frame only the moving artists), frame 0 shown at once (:func:`first_frame_html`)."""
+        if self._html is None:
+            frames = self.render_frames() if embed_frames else None
+            if frames is None:
+                self._writing = True
+                try:
+                    html = super().to_jshtml(fps, embed_frames, default_mode)
+                finally:
+                    self._writing = False
+            else:
+                html = _player_html(
+                    frames, fps or 1000 / self._interval, default_mode or ("loop" if self._repeat else "once")
+                )
+            self._html = first_frame_html(html)
+        return self._html
+
+    def render_frames(self) -> list[bytes] | None:
+        """Every frame as PNG bytes: the figure without the moving artists (``movers``) drawn once, then per
+        frame that background restored and only the movers drawn (None when the canvas cannot blit)."""
+        fig, movers = self._fig, [a for a in getattr(self, "movers", []) if a is not None]
+        canvas = fig.canvas
+        if not hasattr(canvas, "copy_from_bbox"):  # plt.close(fig) left a bare FigureCanvasBase: Agg still draws it
+            from matplotlib.backends.backend_agg import FigureCanvasAgg
+
+            canvas = FigureCanvasAgg(fig)
+        if not movers or not hasattr(canvas, "copy_from_bbox") or not hasattr(canvas, "buffer_rgba"):
+            return None
+        from PIL import Image
+
+        for a in movers:
+            a.set_animated(True)
+        frames = []
+        try:
+            canvas.draw()
+            background = canvas.copy_from_bbox(fig.bbox)
+            for k in range(self.n_frames):
+                canvas.restore_region(background)
+                self.frame_function(k)
+                renderer = canvas.get_renderer()
+                for a in movers:
+                    if hasattr(a, "do_3d_projection") and hasattr(a, "set_segments"):
+                        a.do_3d_projection()
+                    a.draw(renderer)
+                w, h = canvas.get_width_height(physical=True)
+                im = Image.frombuffer("RGBA", (w, h), canvas.buffer_rgba(), "raw", "RGBA", 0, 1).convert("RGB")
+                buf = io.BytesIO()
+                im.save(buf, format="png", compress_level=1)
+                frames.append(buf.getvalue())
+        finally:
+            for a in movers:
+                a.set_animated(False)
+            self.frame_function(0)
+        return frames
+
+    def _post_draw(self, framedata, blit):
+        # while matplotlib writes the HTML itself (a canvas that cannot blit), each frame is drawn by the
+        # writer's savefig right after: skip the extra full canvas draw per frame
+        if not self._writing:
+            super()._post_draw(framedata, blit)
+
+    def _repr_mimebundle_(self, include=None, exclude=None):
+        html = _FONT_AWESOME.sub("", self.to_jshtml())
+        m = _FRAME0.search(html)
+        out = {"text/html": html, "text/plain": self.summary}
+        if m is not None and m.group(2) == "png":
+            out["image/png"] = m.group(1).replace("\\\n", "").split(",", 1)[1]
+        return out
 
 
 def animate_singularity(
@@ -38,17 +188,21 @@ def animate_singularity(
     figsize=(9, 4.2),
     dpi=72,
     title=None,
-) -> FuncAnimation:
+) -> SingularityAnimation:
     """A FuncAnimation of ``chain`` following ``path`` (N×n configurations, e.g. from :func:`sweep`):
-    left, the arm with its velocity ellipse (collapsing to a segment at a singular configuration) and a
+    left, the arm with its velocity ellipse (collapsing to a segment at a singular configuration: when the
+    task ``rows`` hold orientation rows besides the drawn ṗ rows, the ellipse of ṗ with those held, as
+    ``velocity_ellipsoid(J, rows, hold)``, with the all-joints ṗ ellipse as a light dashed outline) and a
     status line; right, the manipulability √det(J Jᵀ) of the task ``rows`` (default: the chain's task space,
     :func:`kinlib.taskspace.default_task_rows`) along the path with a moving marker. ``.values`` holds the
-    manipulability per step. Play it in a static page with ``anim.to_jshtml()`` (``IPython.display.HTML``).
+    manipulability per step. Play it in a static page with ``anim.to_jshtml()`` (``IPython.display.HTML``),
+    or make it a cell's value (:class:`SingularityAnimation`: the player showing frame 0 at once, and a static
+    image/png of frame 0 for a notebook opened without running it).
 
     >>> from kinlib.robots import planar_offset_3r
     >>> anim = animate_singularity(planar_offset_3r(1), np.zeros((3, 3)))
     >>> type(anim).__name__, anim.values.shape
-    ('FuncAnimation', (3,))
+    ('SingularityAnimation', (3,))
     >>> html = anim.to_jshtml()   # plays in a static page
     """
     chain = checked_numeric(chain, params)
@@ -72,7 +226,37 @@ def animate_singularity(
         labels=True,
         title=title or f"{chain.name} along the path",
     )
-    ell = draw_velocity_ellipse(ax, chain, P[0], rows=ellipse_rows, scale=velocity_scale)
+    e_rows = task_row_indices(ellipse_rows) if ellipse_rows is not None else ((3, 4) if planar else (3, 4, 5))
+    hold = tuple(k for k in r if k < 3) if set(e_rows) <= set(r) else ()
+    ells = [
+        draw_velocity_ellipse(
+            ax,
+            chain,
+            P[0],
+            rows=e_rows,
+            scale=velocity_scale,
+            hold=hold or None,
+            label=rf"$\dot p$ with {rows_label(hold, tex=True)} held" if hold else None,
+        )
+    ]
+    if hold:  # the ellipse of ṗ with every joint free, lighter: it need not flatten at the singularity
+        ells.append(
+            draw_velocity_ellipse(
+                ax,
+                chain,
+                P[0],
+                rows=e_rows,
+                scale=velocity_scale,
+                color="0.45",
+                fill=False,
+                axes_lines=False,
+                lw=1.1,
+                ls="--",
+                alpha=0.8,
+                label=r"$\dot p$, all joints free",
+            )
+        )
+        ax.legend(loc="lower right", fontsize=7, framealpha=0.8)
     J = task_rows(chain.jacobian_geometric(P), r)
     w = manipulability_values(J, "yoshikawa")
     ic = manipulability_values(J, "inverse_condition")
@@ -109,13 +293,17 @@ def animate_singularity(
 
     def frame(k):
         arm.update(P[k])
-        ell.update(P[k])
+        for ell in ells:
+            ell.update(P[k])
         mark.set_data([k], [w[k]])
         txt.set_text(f"{w_label} = {w[k]:.3f}   {status(k)}")
         txt.set_color("tab:red" if status(k) else "k")
         return []
 
     frame(0)
-    anim = FuncAnimation(fig, frame, frames=P.shape[0], interval=interval, blit=False)
+    anim = SingularityAnimation(fig, frame, frames=P.shape[0], interval=interval, blit=False)
     anim.values = w
+    anim.frame_function, anim.n_frames = frame, P.shape[0]
+    anim.movers = [*arm.artists, *(a for e in ells for a in e.artists), mark, txt]
+    anim.summary = f"animation of {chain.name} along a path of {P.shape[0]} configurations (frame 0 shown)"
     return anim

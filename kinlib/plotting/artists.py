@@ -32,8 +32,17 @@ __all__ = ["ChainArtist", "VelocityArtist", "JointVelocitiesArtist", "EllipseArt
 class ChainArtist:
     """The matplotlib artists of one drawn chain; ``update(q)`` moves them to a new configuration.
 
+    What is drawn is the forward kinematics (every point from the product of exponentials, via
+    ``chain.skeleton(q)`` and J_s(θ)): with T_k = e^{[S1]θ1} ⋯ e^{[Sk]θk} and p_i joint i's point at home,
+    joint i sits at T_{i−1}(p_i) (where the links before it carry it) and the tool origin at T(θ) = T_n M.
+    A prismatic joint i is a *track* fixed to the link before it, through T_{i−1}(p_i) along its current
+    axis v_i (the v part of column i of J_s), spanning the joint's range, and a *slider* (the link after it,
+    e.g. the cart of the cart-pole) at T_i(p_i) = T_{i−1}(p_i) + θ_i v_i, where the next link starts; the
+    link line is broken along the track (the slide is shown by the slider's place on the track).
+
     Attributes: ``ax``, ``chain`` (numeric), ``q``, ``planar``, ``scale`` (a length for frame arrows),
-    ``links`` (Line through the skeleton), ``revolute``/``prismatic`` (joint markers), ``axes_lines``,
+    ``links`` (Line through the drawn points, NaN where it breaks at a slide), ``revolute`` (joint markers),
+    ``prismatic`` (tracks), ``sliders`` (rectangles in 2-D, square markers in 3-D), ``axes_lines``,
     ``frame_s``/``frame_b`` (arrow sets), ``labels`` (Text θi per joint, placed where they overlap
     neither each other nor the links: at the end of the joint's axis in 3-D, beside the joint in 2-D),
     ``annotations`` (extra Text, e.g. the screw axes of :func:`~kinlib.plotting.draw_home`), ``tool``
@@ -50,7 +59,20 @@ class ChainArtist:
     FRAME = 0.22  # length of a frame arrow, × scale
 
     def __init__(
-        self, ax, chain, q, *, planar, frames=True, axes=True, labels=True, color="0.25", scale=None, lw=4.0, fontsize=9
+        self,
+        ax,
+        chain,
+        q,
+        *,
+        planar,
+        frames=True,
+        axes=True,
+        labels=True,
+        color="0.25",
+        scale=None,
+        lw=4.0,
+        fontsize=9,
+        ranges=None,
     ):
         self.ax, self.chain, self.planar = ax, chain, planar
         self.three_d = is_3d(ax)
@@ -60,9 +82,11 @@ class ChainArtist:
         self.kinds = chain.joint_types
         self.rev = [i for i, k in enumerate(self.kinds) if k == "R"]
         self.pri = [i for i, k in enumerate(self.kinds) if k == "P"]
+        self.ranges = ranges
         sk, T, Js = self._kin(q)
         self._geom = (sk, T, Js)
-        self.links = add_line(ax, sk, color=color, lw=lw, solid_capstyle="round", zorder=2, marker="", label="links")
+        path = self.link_path(sk, Js, q)
+        self.links = add_line(ax, path, color=color, lw=lw, solid_capstyle="round", zorder=2, marker="", label="links")
         self.base = add_line(ax, sk[:, :1], color="k", marker="s", ms=9, ls="", zorder=3)
         self.tool = add_line(ax, sk[:, -1:], color="k", marker="o", ms=4, ls="", zorder=5)
         rp = sk[:, [i + 1 for i in self.rev]]
@@ -79,20 +103,29 @@ class ChainArtist:
             label="revolute joint",
         )
         self.revolute_dot = add_line(ax, rp, ls="", marker=".", ms=5, color="k", zorder=5) if not self.three_d else None
-        self.prismatic = (
-            add_segments(
+        self.prismatic = self.sliders = None
+        if self.pri:
+            self.prismatic = add_segments(
                 ax,
-                self._rails(sk, Js),
+                self._rails(sk, Js, q),
                 colors="tab:gray",
-                linewidths=9,
-                alpha=0.6,
-                zorder=3,
+                linewidths=3,
+                alpha=0.7,
+                zorder=1.5,
                 capstyle="butt",
-                label="prismatic joint",
+                label="prismatic joint (track)",
             )
-            if self.pri
-            else None
-        )
+            if self.three_d:
+                self.sliders = add_line(
+                    ax, self.slider_points(sk, Js, q), ls="", marker="s", ms=11, mfc="0.55", mec="k", zorder=3
+                )
+            else:
+                from matplotlib.collections import PolyCollection
+
+                self.sliders = PolyCollection(
+                    self._slider_boxes(sk, Js, q), facecolors="0.6", edgecolors="k", linewidths=1.2, zorder=3
+                )
+                ax.add_collection(self.sliders)
         self.axes_lines = None
         if axes and (self.three_d or self.pri):
             self.axes_lines = add_segments(
@@ -147,15 +180,55 @@ class ChainArtist:
         A = np.where(np.array([k == "R" for k in self.kinds])[None, :], Js[:3], Js[3:])
         return A / np.maximum(np.linalg.norm(A, axis=0), 1e-12)
 
-    def _rails(self, sk, Js):
-        h = 0.12 * self.scale
+    def _unit_axis(self, Js, i):
+        v = Js[3:, i]
+        return v / (np.linalg.norm(v) or 1.0)
+
+    def _rails(self, sk, Js, q):
+        """The tracks of the prismatic joints: through T_{i−1}(p_i) along v_i, over the joint's range (and
+        the current value and 0, if outside it), a little beyond."""
+        h = 0.08 * self.scale
         segs = []
         for i in self.pri:
-            v = Js[3:, i]
-            v = v / (np.linalg.norm(v) or 1.0)
-            p = sk[:, i + 1]
-            segs.append([p - h * v, p + h * v])
+            v, p, n = self._unit_axis(Js, i), sk[:, i + 1], float(np.linalg.norm(Js[3:, i])) or 1.0
+            lo, hi = self.ranges[i] if self.ranges is not None else (0.0, 0.0)
+            lo, hi = min(lo, q[i], 0.0) * n - h, max(hi, q[i], 0.0) * n + h
+            segs.append([p + lo * v, p + hi * v])
         return segs
+
+    def slider_points(self, sk, Js, q) -> np.ndarray:
+        """Where each prismatic joint's slider is (3, #P): T_i(p_i) = T_{i−1}(p_i) + θ_i v_i."""
+        return np.column_stack([sk[:, i + 1] + q[i] * Js[3:, i] for i in self.pri]) if self.pri else np.zeros((3, 0))
+
+    def _slider_boxes(self, sk, Js, q):
+        """2-D rectangles (0.2 × 0.12 scale) centred on the sliders, aligned with their tracks."""
+        a, b = 0.1 * self.scale, 0.06 * self.scale
+        out = []
+        for k, i in enumerate(self.pri):
+            c = self.slider_points(sk, Js, q)[:2, k]
+            u = self._unit_axis(Js, i)[:2]
+            u = u / (np.linalg.norm(u) or 1.0)
+            w = np.array([-u[1], u[0]])
+            out.append(np.array([c - a * u - b * w, c + a * u - b * w, c + a * u + b * w, c - a * u + b * w]))
+        return out
+
+    def link_path(self, sk, Js, q) -> np.ndarray:
+        """The points the link line runs through (3, k): base, each joint T_{i−1}(p_i) — for a prismatic
+        joint followed by a break (a NaN column) and its slider T_i(p_i) — then the tool origin."""
+        cols = [sk[:, 0]]
+        nan = np.full(3, np.nan)
+        for i, kind in enumerate(self.kinds):
+            cols.append(sk[:, i + 1])
+            if kind == "P":
+                cols += [nan, sk[:, i + 1] + q[i] * Js[3:, i]]
+        cols.append(sk[:, -1])
+        return np.column_stack(cols)
+
+    def _link_pieces(self, sk, Js, q) -> list:
+        """The unbroken pieces of the link line (each 3 × m)."""
+        P = self.link_path(sk, Js, q)
+        pieces = np.split(P, np.flatnonzero(np.isnan(P[0])), axis=1)
+        return [piece[:, ~np.isnan(piece[0])] for piece in pieces]
 
     def axis_segments(self, sk, Js) -> list:
         """The drawn joint axes [[a, b], ...] at the skeleton sk with the space Jacobian Js (2-D: revolute
@@ -174,7 +247,7 @@ class ChainArtist:
     def extent_points(self) -> np.ndarray:
         """Every point the drawing reaches (3, k): skeleton, frame-arrow tips, ends of the joint axes."""
         sk, T, Js = self._geom
-        pts = [sk]
+        pts = [sk, self.slider_points(sk, Js, self.q)] + [np.column_stack(r) for r in self._rails(sk, Js, self.q)]
         L = self.FRAME * self.scale
         if self.frame_s is not None:
             pts += [np.eye(3) * L, T[:3, 3:4] + T[:3, :3] * L]
@@ -191,12 +264,13 @@ class ChainArtist:
         return np.hstack(pts)
 
     # -- labels ---------------------------------------------------------------------------------------
-    def place_labels(self):
+    def place_labels(self, keep: bool = False):
         """Put θ1…θn, {s} and {b} where they overlap neither each other nor the links (in screen space).
 
         Candidates per joint, in order of preference: the two ends of its drawn axis (3-D, prismatic), then
         directions around the joint; the first candidate far enough from the labels already placed and
-        from the drawing wins (else the one with the most room). Moves the Text artists only."""
+        from the drawing wins (else the one with the most room). ``keep`` (as ``update`` does): each label's
+        previous spot is tried first, so labels stay put while they fit. Moves the Text artists only."""
         if not self.labels and not self.frame_texts:
             return
         sk, T, Js = self._geom
@@ -222,25 +296,36 @@ class ChainArtist:
             items.append((self.frame_texts[0], ring))
             items.append((self.frame_texts[1], T[:3, 3:4] + ring))
         L = self.FRAME * self.scale
-        obstacles = [segment_samples(sk)]
+        obstacles = [segment_samples(piece) for piece in self._link_pieces(sk, Js, self.q)]
         if self.frame_s is not None:
             t = np.linspace(0.3, 1.0, 5)
             for o, R in ((np.zeros((3, 1)), np.eye(3)), (T[:3, 3:4], T[:3, :3])):
                 for k in range(3 if self.three_d else 2):
                     obstacles.append(o + L * np.outer(R[:, k], t))
-        for a, b in self._rails(sk, Js) + (self.axis_segments(sk, Js) if self.axes_lines is not None else []):
+        for a, b in self._rails(sk, Js, self.q) + (self.axis_segments(sk, Js) if self.axes_lines is not None else []):
             obstacles.append(segment_samples(np.column_stack([a, b]), 9))
         state = view_state(ax)
         if state is not None and state.chain is self:
             obstacles.append(state.obstacles)
-        O = to_pixels(ax, np.hstack(obstacles))
+        # one projection for every point (obstacles and all candidates): 3-D projections are costly
+        obs = np.hstack(obstacles)
+        sizes = [C.shape[1] for _, C in items]
+        allp = to_pixels(ax, np.hstack([obs] + [C for _, C in items]))
+        O, cuts = allp[: obs.shape[1]], np.cumsum([obs.shape[1]] + sizes)
         need_lab, need_obs = 2.0 * px, 1.4 * px
         placed = np.zeros((0, 2))
-        for t, C in items:
-            Cp = to_pixels(ax, C)
-            k = pick_spot(Cp, O, placed, need_lab, need_obs)
+        prev = getattr(self, "_label_picks", None) if keep else None
+        picks = []
+        for j, (t, C) in enumerate(items):
+            Cp = allp[cuts[j] : cuts[j + 1]]
+            # keep=True (update): the spot chosen last time first (labels stay put while they fit; quicker)
+            k = pick_spot(
+                Cp, O, placed, need_lab, need_obs, prefer=prev[j] if prev and len(prev) == len(items) else None
+            )
+            picks.append(k)
             move_text(t, C[:, k])
             placed = np.vstack([placed, Cp[k]])
+        self._label_picks = picks
 
     # -- update ---------------------------------------------------------------------------------------
     def update(self, q):
@@ -249,28 +334,32 @@ class ChainArtist:
         self.q = q
         sk, T, Js = self._kin(q)
         self._geom = (sk, T, Js)
-        set_line(self.links, sk)
+        set_line(self.links, self.link_path(sk, Js, q))
         set_line(self.tool, sk[:, -1:])
         rp = sk[:, [i + 1 for i in self.rev]]
         set_line(self.revolute, rp)
         if self.revolute_dot is not None:
             set_line(self.revolute_dot, rp)
         if self.prismatic is not None:
-            set_segments(self.prismatic, self._rails(sk, Js), self.three_d)
+            set_segments(self.prismatic, self._rails(sk, Js, q), self.three_d)
+            if self.three_d:
+                set_line(self.sliders, self.slider_points(sk, Js, q))
+            else:
+                self.sliders.set_verts(self._slider_boxes(sk, Js, q))
         if self.axes_lines is not None:
             set_segments(self.axes_lines, self.axis_segments(sk, Js), self.three_d)
         if self.frame_b is not None:
             d = 3 if self.three_d else 2
             L = self.FRAME * self.scale
             self.frame_b.set(np.tile(T[:d, 3], (d, 1)), (T[:d, :d] * L).T)
-        self.place_labels()
+        self.place_labels(keep=True)
         return self
 
     @property
     def artists(self) -> list:
         """The artists that ``update`` moves (for blitting); {s} and the base stay put."""
         out = [self.links, self.revolute, self.tool]
-        out += [a for a in (self.revolute_dot, self.prismatic, self.axes_lines) if a is not None]
+        out += [a for a in (self.revolute_dot, self.prismatic, self.sliders, self.axes_lines) if a is not None]
         if self.frame_b is not None:
             out += [self.frame_b.artist, *self.frame_texts]
         return out + list(self.labels)
@@ -458,6 +547,8 @@ class EllipseArtist:
     ``semi_axes`` (σ_i of the rows, largest first, before ``scale``) and ``directions`` (the unit left
     singular vectors as columns), both from :func:`kinlib.manipulability.velocity_ellipsoid`, describe it; at
     a singular configuration a semi-axis is 0 and the ellipse is drawn as a segment. ``update(q)``.
+    ``hold``: rows kept at zero (e.g. (2,) = ω_z): the ellipse {J_r θ̇ : J_h θ̇ = 0, ‖θ̇‖ ≤ 1} instead
+    (``velocity_ellipsoid(J, rows, hold)``), e.g. the tool velocities reachable with the orientation held.
 
     >>> from kinlib.robots import planar_3r
     >>> from kinlib.plotting import draw_chain, draw_velocity_ellipse
@@ -467,13 +558,14 @@ class EllipseArtist:
     array([3.7417, 0.    ])
     """
 
-    def __init__(self, ax, chain, q, rows, scale, color, axes_lines, label, fill):
+    def __init__(self, ax, chain, q, rows, scale, color, axes_lines, label, fill, hold=None, lw=1.8, ls="-", alpha=1.0):
         self.ax, self.chain, self.rows, self.scale = ax, chain, rows, scale
+        self.hold = tuple(hold) if hold else None
         self.three_d = is_3d(ax)
         self.q = q
         curves, axes = self._compute(q)
         self.curves = [
-            add_line(ax, cv, color=color, lw=1.8, zorder=5, label=label if k == 0 else None)
+            add_line(ax, cv, color=color, lw=lw, ls=ls, alpha=alpha, zorder=5, label=label if k == 0 else None)
             for k, cv in enumerate(curves)
         ]
         self.fill = None
@@ -484,17 +576,21 @@ class EllipseArtist:
         )
         include(ax, np.hstack(curves))
 
-    def _compute(self, q):
-        J = self.chain.jacobian_geometric(q)[list(self.rows)]
-        self.semi_axes, self.directions = velocity_ellipsoid(J)
-        p = self.chain.fk(q)[:3, 3]
+    def _compute(self, q, J=None, p=None):
+        J = self.chain.jacobian_geometric(q) if J is None else J
+        if self.hold:
+            self.semi_axes, self.directions = velocity_ellipsoid(J, list(self.rows), self.hold)
+        else:
+            self.semi_axes, self.directions = velocity_ellipsoid(J[list(self.rows)])
+        p = self.chain.fk(q)[:3, 3] if p is None else p
         return ellipse_outline(p[: len(self.rows)], self.semi_axes, self.directions, self.scale)
 
-    def update(self, q):
-        """Move the ellipse to configuration ``q``."""
+    def update(self, q, J=None, p=None):
+        """Move the ellipse to configuration ``q`` (``J``, ``p``: the geometric Jacobian and the tool origin
+        there, when the caller has them already)."""
         q = as_configuration(self.chain, q)
         self.q = q
-        curves, axes = self._compute(q)
+        curves, axes = self._compute(q, J, p)
         for ln, cv in zip(self.curves, curves):
             set_line(ln, cv)
         if self.fill is not None:

@@ -54,7 +54,9 @@ def draw_chain(
     """Draw ``chain`` at the numeric configuration ``q`` (zeros by default) and return a :class:`ChainArtist`.
 
     Links join ``chain.skeleton(q)`` (base, joint points, tool origin); revolute joints are circles
-    (⊙ in 2-D: the axis leaves the page), prismatic joints grey rails along their axis v_i; ``axes``
+    (⊙ in 2-D: the axis leaves the page), prismatic joints a grey track along their axis v_i (over the
+    joint's range) with a slider at T_i(p_i) = T_{i−1}(p_i) + θ_i v_i carrying the next link (the cart of
+    the cart-pole; see :class:`~kinlib.plotting.artists.ChainArtist`); ``axes``
     adds the current joint axes (dashed, from the columns of J_s(θ)); ``frames`` the space frame {s}
     and the tool frame {b} = T(θ) with x (red), y (green), z (blue) arrows; ``labels`` θ1…θn (placed
     clear of each other and of the links; ``fontsize``).
@@ -95,7 +97,7 @@ def draw_chain(
     scale = max(reach(chain), 1e-6)
     scale = min(scale, size) if size > 0 else scale
     style = dict(frames=frames, axes=axes, labels=labels, color=color, fontsize=fontsize)
-    art = ChainArtist(ax, chain, q, planar=planar, scale=scale, **style)
+    art = ChainArtist(ax, chain, q, planar=planar, scale=scale, ranges=rngs, **style)
     if limits is not None:
         lim = np.asarray(limits, float)
         if lim.shape != ((2, 2) if planar else (3, 2)):
@@ -280,21 +282,34 @@ def draw_velocity_ellipse(
     label="velocity ellipse",
     fill=True,
     params=None,
+    hold=None,
+    lw=1.8,
+    ls="-",
+    alpha=1.0,
 ) -> EllipseArtist:
     """The velocity ellipse at the tool origin: {J_r θ̇ : ‖θ̇‖ = 1} for the rows r of the geometric
     Jacobian (default ṗ_x, ṗ_y on 2-D axes; ṗ_x, ṗ_y, ṗ_z on 3-D axes, drawn as its three principal
     ellipses). Semi-axes σ_i u_i from the SVD J_r = U Σ Vᵀ; a segment at a singular configuration.
     The i-th chosen row is drawn along the axes' i-th coordinate, so use other rows knowingly.
+    ``hold``: rows kept at zero, e.g. ``("wz",)``: {J_r θ̇ : J_h θ̇ = 0, ‖θ̇‖ ≤ 1}, the velocities reachable
+    with the orientation held (:func:`kinlib.manipulability.velocity_ellipsoid`); it collapses to a
+    segment exactly where the rows (hold + drawn) lose rank. ``lw``, ``ls``, ``alpha``: the outline's style.
 
     >>> from kinlib.robots import planar_rpp
     >>> chain = planar_rpp(1)
     >>> art = draw_chain(chain, [0, 0, 0])
     >>> np.round(draw_velocity_ellipse(art.ax, chain, [0, 0, 0]).semi_axes, 6)
     array([1.414214, 1.      ])
+    >>> np.round(draw_velocity_ellipse(art.ax, chain, [0, 0, 0], hold="wz").semi_axes, 6)   # θ̇1 = 0: the slides
+    array([1., 1.])
     """
     chain = checked_numeric(chain, params)
     q = as_configuration(chain, q)
-    return EllipseArtist(ax, chain, q, _velocity_rows(ax, rows), scale, color, axes_lines, label, fill)
+    r = _velocity_rows(ax, rows)
+    h = task_row_indices(hold) if hold is not None else None
+    if h is not None and set(h) & set(r):
+        raise ValueError(f"hold must not share a row with the drawn rows {r}, got {describe(hold)}")
+    return EllipseArtist(ax, chain, q, r, scale, color, axes_lines, label, fill, h, lw, ls, alpha)
 
 
 def draw_ellipse(

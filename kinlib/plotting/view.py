@@ -229,21 +229,31 @@ def to_pixels(ax, P) -> np.ndarray:
     return ax.transData.transform(P[:2].T)
 
 
-def pick_spot(Cp, O, placed, need_lab: float, need_obs: float) -> int:
+def _min_dist(A, B) -> np.ndarray:
+    """For each row of A (m, 2): the distance to the nearest row of B (k, 2) (inf when B is empty)."""
+    if not len(B):
+        return np.full(len(A), np.inf)
+    dx = A[:, None, 0] - B[None, :, 0]
+    dy = A[:, None, 1] - B[None, :, 1]
+    return np.sqrt(np.min(dx * dx + dy * dy, axis=1))
+
+
+def pick_spot(Cp, O, placed, need_lab: float, need_obs: float, prefer: int | None = None) -> int:
     """Index of the first candidate (pixels, (m, 2)) at least need_lab from the labels already placed and
-    need_obs from the obstacles O (pixels, (k, 2)); else the candidate with the most room.
+    need_obs from the obstacles O (pixels, (k, 2)); else the candidate with the most room. ``prefer``: a
+    candidate tried first (kept if it fits: e.g. last frame's choice, so labels do not jump).
 
     >>> pick_spot(np.array([[0.0, 0], [10, 0]]), np.array([[1.0, 0]]), np.zeros((0, 2)), 5, 5)
     1
+    >>> pick_spot(np.array([[20.0, 0], [10, 0]]), np.array([[1.0, 0]]), np.zeros((0, 2)), 5, 5, prefer=1)
+    1
     """
-    d_obs = (
-        np.min(np.linalg.norm(Cp[:, None, :] - O[None, :, :], axis=2), axis=1) if len(O) else np.full(len(Cp), np.inf)
-    )
-    d_lab = (
-        np.min(np.linalg.norm(Cp[:, None, :] - placed[None, :, :], axis=2), axis=1)
-        if len(placed)
-        else np.full(len(Cp), np.inf)
-    )
+    if prefer is not None and 0 <= prefer < len(Cp):
+        c = Cp[prefer : prefer + 1]
+        if _min_dist(c, placed)[0] >= need_lab and _min_dist(c, O)[0] >= need_obs:
+            return int(prefer)
+    d_obs = _min_dist(Cp, O)
+    d_lab = _min_dist(Cp, placed)
     ok = np.flatnonzero((d_lab >= need_lab) & (d_obs >= need_obs))
     return int(ok[0]) if ok.size else int(np.argmax(np.minimum(d_lab, 2.0 * d_obs)))
 
