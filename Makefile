@@ -58,12 +58,12 @@ test-fast: $(STAMP) bubblewrap
 
 # JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
 # The course notebooks are trusted first (JupyterLab draws saved widgets only in trusted notebooks; otherwise
-# it shows their text or static image), and lab-settings/overrides.json is used (widget state saved with
+# it shows their text or static image), and notebooks/.lab-settings/overrides.json is used (widget state saved with
 # the notebook, so a saved notebook reopens with its pictures).
 LAB_ARGS ?=
 lab: $(STAMP)
 	@$(VENV)/bin/jupyter trust $(NOTEBOOKS) >/dev/null
-	$(VENV)/bin/jupyter lab --notebook-dir=notebooks --LabApp.app_settings_dir=$(CURDIR)/lab-settings \
+	$(VENV)/bin/jupyter lab --notebook-dir=notebooks --LabApp.app_settings_dir=$(CURDIR)/notebooks/.lab-settings \
 	    $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
 
 # Execute notebooks in place (fresh kernel each, outputs + widget state, stable ids): after editing a

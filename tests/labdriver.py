@@ -3,7 +3,7 @@ browser section of ``make bench`` (bench/bench.py imports this module).
 
 * :func:`jupyterlab` starts JupyterLab on a copy of ``notebooks/`` as ``make lab`` does: the notebooks trusted
   (``jupyter trust``: JupyterLab renders widget outputs only in trusted notebooks) and the project's settings
-  (``lab-settings/overrides.json``), with every Jupyter directory (config, data, settings, workspaces) private to
+  (``notebooks/.lab-settings/overrides.json``), with every Jupyter directory (config, data, settings, workspaces) private to
   the run, on a free loopback port.
 * :func:`open_notebook` opens a notebook fresh in a new page with the network blocked except loopback.
 * :func:`run_all` runs every cell (Run → Run All Cells) and returns the seconds until the kernel's last reply.
@@ -29,7 +29,9 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
-LAB_SETTINGS = ROOT / "lab-settings"  # `make lab` passes --LabApp.app_settings_dir=lab-settings
+LAB_SETTINGS = (
+    ROOT / "notebooks" / ".lab-settings"
+)  # `make lab` passes --LabApp.app_settings_dir=notebooks/.lab-settings
 CHROMIUM = "/usr/bin/chromium"
 CHROMIUM_ARGS = [
     "--no-sandbox",
@@ -159,6 +161,12 @@ class Watch:
         page.on("requestfailed", lambda r: self.failed.append(f"{r.url} ({r.failure})"))
         page.on("pageerror", lambda e: self.errors.append(str(e)))
         page.on("console", lambda m: self.console.append(m.text) if m.type == "error" else None)
+
+    def assert_clean(self, what):
+        assert not self.blocked, f"{what} tried to reach the network: {self.blocked[:5]}"
+        assert not self.failed, f"{what}: failed requests {self.failed[:5]}"
+        assert not self.errors, f"{what}: page errors {self.errors[:5]}"
+        assert not self.console, f"{what}: console errors {self.console[:5]}"
 
 
 _NOTEBOOK_READY = """(path) => {

@@ -6,7 +6,7 @@ downloaded browser, with the network blocked.
    page error and no failed request, shows typeset math (MathJax output, no raw TeX) and its figures
    (every image decoded), and the saved widgets; a screenshot of each goes to build/screenshots/.
    An animation (matplotlib ``to_jshtml``) plays in the static page.
-2. JupyterLab as ``make lab`` starts it (tests/labdriver.py: notebooks trusted, lab-settings/), on a free
+2. JupyterLab as ``make lab`` starts it (tests/labdriver.py: notebooks trusted, notebooks/.lab-settings/), on a free
    loopback port: every notebook opened fresh shows its widgets' and animation's pictures before running,
    runs all cells (the time is printed, not asserted), and a slider of each explorer (a button of a picker)
    gives a new picture; in notebook 05 the explorer at θ2 = −π/4 says "singular" (``kinlib-status``), shows
@@ -257,7 +257,7 @@ def _lab_notebooks() -> Path:
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
-    """JupyterLab on a copy of the notebooks, trusted and with lab-settings/ (what `make lab` does)."""
+    """JupyterLab on a copy of the notebooks, trusted and with notebooks/.lab-settings/ (what `make lab` does)."""
     with labdriver.jupyterlab(tmp_path_factory.mktemp("lab"), _lab_notebooks(), trust=True) as url:
         yield url
 
@@ -271,10 +271,10 @@ def lab_untrusted(tmp_path_factory):
 
 def test_make_lab_trusts_the_notebooks_and_uses_the_project_settings():
     """`make lab` trusts the notebooks (JupyterLab renders saved widgets only in trusted notebooks) and starts
-    JupyterLab with lab-settings/, whose overrides save the widget state with the notebook."""
+    JupyterLab with notebooks/.lab-settings/, whose overrides save the widget state with the notebook."""
     out = subprocess.run(["make", "-n", "lab"], cwd=ROOT, capture_output=True, text=True, check=True).stdout
     assert re.search(r"jupyter trust .*notebooks/\d\d_", out), out
-    assert f"--LabApp.app_settings_dir={ROOT / 'lab-settings'}" in out, out
+    assert f"--LabApp.app_settings_dir={ROOT / 'notebooks' / '.lab-settings'}" in out, out
     overrides = json.loads((labdriver.LAB_SETTINGS / "overrides.json").read_text())
     assert overrides["@jupyter-widgets/jupyterlab-manager:plugin"]["saveState"] is True
 

@@ -470,3 +470,26 @@ def test_a_slow_kernel_start_is_waited_for_not_judged_dead(tmp_path):
     finally:
         k.kill()
     assert sandbox.namespace_processes([k.record]) == []
+
+
+@pytest.mark.skipif(not sandbox.check()[0], reason="bubblewrap cannot run here")
+def test_an_environment_under_tmp_stays_visible(tmp_path, monkeypatch):
+    """The private /tmp must not cover what is bound read-only: a checkout (its .venv and kinlib) in a
+    ``mktemp -d`` folder, as CI's fresh clone can be. Here a folder under the host's /tmp stands in for it."""
+    env_dir = tmp_path / "fresh" / ".venv"
+    env_dir.mkdir(parents=True)
+    (env_dir / "marker").write_text("visible")
+    real = sandbox.system_binds
+    monkeypatch.setattr(sandbox, "system_binds", lambda: real() + ["--ro-bind", str(env_dir), str(env_dir)])
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    argv = sandbox.Sandbox().command(
+        [os.path.realpath(sys.executable), "-I", "-c", f"print(open({str(env_dir / 'marker')!r}).read())"],
+        cwd=str(scratch),
+        rw=[str(scratch)],
+        env=sandbox.Sandbox().environment({}),
+    )
+    import subprocess
+
+    p = subprocess.run(argv, capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and p.stdout.strip() == "visible", p.stderr

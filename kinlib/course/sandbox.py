@@ -130,8 +130,10 @@ class Sandbox:
                     raise SandboxUnavailable(f"the sandbox would expose {h} (inside {b}); move it elsewhere")
         cmd = [shutil.which("bwrap") or "bwrap", "--unshare-all", "--die-with-parent", "--new-session"]
         cmd += ["--cap-drop", "ALL", "--proc", "/proc", "--dev", "/dev"]
-        cmd += binds
+        # the private /tmp first: binds after it land on top of it (an environment or checkout that lives under
+        # the host's /tmp, e.g. a fresh clone in mktemp -d, stays visible instead of being covered by the tmpfs)
         cmd += ["--size", str(int(self.tmpfs_bytes)), "--tmpfs", "/tmp", "--dir", "/tmp/home"]
+        cmd += binds
         for d in rw:
             cmd += ["--bind", _real(d), _real(d)]
         cmd += ["--remount-ro", "/", "--chdir", _real(cwd), "--clearenv"]  # bwrap's own root: read-only too
@@ -177,8 +179,9 @@ def check() -> tuple[bool, str]:
         try:
             p = subprocess.run(
                 [exe, "--unshare-all", "--die-with-parent", "--cap-drop", "ALL", "--proc", "/proc", "--dev", "/dev"]
+                + ["--tmpfs", "/tmp"]
                 + system_binds()
-                + ["--tmpfs", "/tmp", "--", _real(sys.executable), "-I", "-c", "import sys; print(sys.version)"],
+                + ["--", _real(sys.executable), "-I", "-c", "import sys; print(sys.version)"],
                 capture_output=True,
                 text=True,
                 timeout=60,
