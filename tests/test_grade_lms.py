@@ -277,6 +277,9 @@ def _simulate(mount: str, scratch: Path, entry: str) -> subprocess.CompletedProc
     cmd = [
         "bwrap", *_system_binds(),
         "--dev", "/dev", "--bind", "/proc", "/proc", "--tmpfs", "/tmp",
+        # the Python environment (the platform's image has its packages installed): bound after the private
+        # /tmp, so a checkout in a mktemp folder (CI's fresh clone) stays visible
+        "--ro-bind", os.path.realpath(sys.prefix), os.path.realpath(sys.prefix),
         "--bind", str(scratch), mount,
         "--die-with-parent",
         "--setenv", "HOME", "/tmp", "--setenv", "KINLIB_PYTHON", sys.executable,
