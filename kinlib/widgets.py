@@ -3,7 +3,8 @@
 How the picture updates: each widget owns one matplotlib ``Figure`` that is *not* registered with
 pyplot (so the inline backend never prints a second, static copy). A slider move moves the existing
 artists (``ChainArtist.update`` etc., no figure rebuilt), renders the figure once with Agg and puts the
-PNG into an ``ipywidgets.Image``. This works with the plain inline backend in JupyterLab, Notebook and
+PNG, as a data URL, into an ``ipywidgets.Image(format="url")`` (a data URL loads ≈ 10 ms sooner than the Blob URL
+of ``format="png"`` in Chromium). This works with the plain inline backend in JupyterLab, Notebook and
 VS Code (no ipympl needed), and the last picture is kept in the saved widget state.
 
 Velocities come from the **geometric Jacobian** J(θ) = blockdiag(R, R) J_b, rows [ω_s; ṗ].
@@ -60,12 +61,12 @@ from .plotting import (
     draw_chain,
     draw_joint_velocities,
     draw_velocity,
-    draw_velocity_ellipse,
+    draw_velocity_ellipses,
 )
 from .plotting.common import as_configuration, checked_numeric, theta_tex
 from .plotting.primitives import add_line, set_line
 from .taskspace import ROW_LABELS, ROW_TEX, default_task_rows, is_planar, rows_label, task_row_indices, task_rows
-from .widgets_render import Blitter, display_bundle, new_figure, render_png
+from .widgets_render import Blitter, data_url, display_bundle, new_figure, render_png
 
 __all__ = [
     "explorer",
@@ -175,7 +176,7 @@ class Explorer(W.VBox):
     State for tests and scripts: ``sliders``, ``rate_sliders``, ``status`` (HTML widget: contains
     "singular" exactly when at or near a singular configuration; ``<div class='kinlib-status'
     data-state=…>``), ``readout`` (HTML, with ``kinlib-det`` and ``kinlib-held`` spans), ``image``
-    (the rendered PNG), ``fig``/``ax``, ``arm``/``velocity``/``ellipse``/``held_ellipse`` artists, ``q``,
+    (the Image widget; its value is a data URL of ``picture``, the rendered PNG or JPEG), ``fig``/``ax``, ``arm``/``velocity``/``ellipse``/``held_ellipse`` artists, ``q``,
     ``qdot``, ``info`` (the last :func:`classify` result), ``update(q=None, qdot=None)``.
 
     >>> from kinlib.robots import planar_offset_3r
@@ -210,30 +211,14 @@ class Explorer(W.VBox):
         self.arm = draw_chain(chain, q0, self.ax, ranges=self.ranges, title=title or chain.name)
         ell_rows = task_row_indices(ellipse_rows) if ellipse_rows is not None else ((3, 4) if self.planar else (3, 4, 5))
         self.ellipse_rows = ell_rows
-        angular = tuple(r for r in self.rows if r < 3)
-        # the orientation rows of the task are held when the task also holds the drawn ṗ rows
-        self.hold = angular if show_ellipse and angular and set(ell_rows) <= set(self.rows) else ()
-        self.held_ellipse = self.cannot_move = self.cannot_move_direction = None
-        if self.hold:
-            held = rows_label(self.hold, tex=True)
-            self.held_ellipse = draw_velocity_ellipse(
-                self.ax, chain, q0, rows=ell_rows, scale=velocity_scale, hold=self.hold, color="tab:green",
-                label=rf"$\dot p$ with {held} held (×{velocity_scale:g})",
+        self.held_ellipse = self.ellipse = self.cannot_move = self.cannot_move_direction = None
+        self.hold = ()
+        if show_ellipse:  # the ṗ ellipse with the task's orientation held (it flattens where the task is singular)
+            ells = draw_velocity_ellipses(
+                self.ax, chain, q0, task=self.rows, rows=ell_rows, scale=velocity_scale,
+                label_suffix=f" (×{velocity_scale:g})",
             )  # fmt: skip
-        self.ellipse = (
-            draw_velocity_ellipse(
-                self.ax,
-                chain,
-                q0,
-                rows=ell_rows,
-                scale=velocity_scale,
-                label=rf"$\dot p$, all joints free (×{velocity_scale:g})" if self.hold else
-                f"velocity ellipse (×{velocity_scale:g})",
-                **(dict(color="0.45", fill=False, axes_lines=False, lw=1.1, ls="--", alpha=0.8) if self.hold else {}),
-            )  # fmt: skip
-            if show_ellipse
-            else None
-        )
+            self.held_ellipse, self.ellipse, self.hold = ells
         main = self.held_ellipse or self.ellipse
         if main is not None:
             d = len(ell_rows)
@@ -297,7 +282,8 @@ class Explorer(W.VBox):
         self.w_max = self._max_manipulability()
         self.status = W.HTML(value="")
         self.readout = W.HTML(value="")
-        self.image = W.Image(format=image_format, layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
+        self.picture_format, self.picture = image_format, b""  # the encoded picture; the widget shows it as a data URL
+        self.image = W.Image(format="url", layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
         self._hold = False
         for s in self.sliders + self.rate_sliders:
             s.observe(self._on_change, names="value")
@@ -352,7 +338,8 @@ class Explorer(W.VBox):
         for w, v in ((self.readout, self._readout_html(info)), (self.status, self._status_html(info))):
             if w.value != v:  # an unchanged text sends no message to the browser
                 w.value = v
-        self.image.value = self._blit.render()
+        self.picture = self._blit.render()
+        self.image.value = data_url(self.picture, self.picture_format)
 
     def _show_cannot_move(self, info, p):
         """The red dashed line through the tool along the direction it cannot move (the smallest axis u_min of
@@ -443,7 +430,7 @@ class Explorer(W.VBox):
         """The live widget view, plus a static ``image/png`` of the current picture and a one-line text
         (see :func:`kinlib.widgets_render.display_bundle`): a notebook opened without a widget manager shows
         the picture, not ``Explorer(children=…``."""
-        png = self.image.value if self.image.format == "png" else render_png(self.fig)
+        png = self.picture if self.picture_format == "png" else render_png(self.fig)
         q = ", ".join(f"{x:.3f}" for x in self.q)
         text = f"explorer of {self.chain.name} at θ = ({q}): {self.state} configuration (run the cell for sliders)"
         return display_bundle(super()._repr_mimebundle_(**kwargs), png, text)
@@ -477,7 +464,7 @@ class ConfigPicker(W.VBox):
     (ties within 10⁻⁹ relative are reported as ties).
 
     ``rows``: one row for all configurations ('vx', 'vy', …) or a dict {name: row}.
-    State: ``buttons``, ``table`` (HTML), ``image``, ``contributions`` (n values of the current row),
+    State: ``buttons``, ``table`` (HTML), ``image`` (its value a data URL of the PNG ``picture``), ``contributions`` (n values of the current row),
     ``best`` (1-based joints with the largest |contribution|, from
     :func:`kinlib.manipulability.strongest_joints`), ``select(name)``.
 
@@ -537,7 +524,8 @@ class ConfigPicker(W.VBox):
         self.fig.tight_layout()
         self.buttons = W.ToggleButtons(options=list(self.configs), value=name0, description="configuration")
         self.table = W.HTML()
-        self.image = W.Image(format="png", layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
+        self.picture = b""  # the PNG; the widget shows it as a data URL
+        self.image = W.Image(format="url", layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
         self.buttons.observe(lambda ch: self.select(ch["new"]), names="value")
         super().__init__([self.buttons, self.image, self.table])
         self.select(name0)
@@ -545,7 +533,7 @@ class ConfigPicker(W.VBox):
     def _repr_mimebundle_(self, **kwargs):
         """The live widget view, plus a static ``image/png`` of the current picture and a one-line text."""
         text = f"configuration picker for {self.chain.name}: {self.name} (run the cell for the buttons)"
-        return display_bundle(super()._repr_mimebundle_(**kwargs), self.image.value, text)
+        return display_bundle(super()._repr_mimebundle_(**kwargs), self.picture, text)
 
     @staticmethod
     def _one_row(r) -> int:
@@ -592,7 +580,8 @@ class ConfigPicker(W.VBox):
             f"<tr><td>θ = ({', '.join(f'{x:.4f}' for x in q)})</td>{cells}</tr></table>"
             f"<div>largest |{html.escape(lab)}|: {who}</div>"
         )
-        self.image.value = render_png(self.fig)
+        self.picture = render_png(self.fig)
+        self.image.value = data_url(self.picture)
         return self
 
 

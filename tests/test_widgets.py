@@ -47,7 +47,7 @@ def test_explorer_builds_for_every_robot(make):
     chain = make()
     ex = widgets.explorer(chain)
     assert len(ex.sliders) == chain.n and len(ex.rate_sliders) == chain.n
-    assert bytes(ex.image.value).startswith(PNG)
+    assert bytes(ex.picture).startswith(PNG)
     for i, s in enumerate(ex.sliders):
         assert s.description.startswith(f"θ{i + 1} (")
         assert ("rad" in s.description) == (chain.joint_types[i] == "R")
@@ -62,13 +62,13 @@ def test_status_at_a_singular_and_a_regular_configuration(r3):
     ex = widgets.explorer(r3, q=[0.3, math.pi / 4, 0.2])
     assert ex.state == "regular"
     assert "singular" not in ex.status.value.lower()
-    img = bytes(ex.image.value)
+    img = bytes(ex.picture)
     # a slider move (as in the browser) to θ2 = −π/4: problem 5.1's singular configuration
     ex.sliders[1].value = -math.pi / 4
     assert ex.state == "singular"
     assert "SINGULAR configuration" in ex.status.value
     assert ex.info["rank"] == 2 and abs(ex.info["det"]) < 1e-9
-    assert bytes(ex.image.value) != img
+    assert bytes(ex.picture) != img
     # close to it, but not at it
     ex.sliders[1].value = -math.pi / 4 + 0.05
     assert ex.state == "near" and "near a singular configuration" in ex.status.value
@@ -119,7 +119,7 @@ def test_explorer_updates_artists_in_place(r3):
 
     from PIL import Image
 
-    fast = np.asarray(Image.open(io.BytesIO(ex.image.value)).convert("RGB"), float)  # 8-bit (palette) PNG
+    fast = np.asarray(Image.open(io.BytesIO(ex.picture)).convert("RGB"), float)  # 8-bit (palette) PNG
     for a in ex._blit.artists:
         a.set_animated(False)
     full = np.asarray(Image.open(io.BytesIO(widgets_render.render_png(ex.fig))).convert("RGB"), float)
@@ -172,7 +172,7 @@ def test_config_picker_problem_4_1():
         np.testing.assert_allclose(cp.contributions, fd, atol=1e-6)
         np.testing.assert_allclose([b.get_height() for b in cp.bars], fd, atol=1e-6)
         assert cp.best == expected_best[name]
-        assert cp.name == name and bytes(cp.image.value).startswith(PNG)
+        assert cp.name == name and bytes(cp.picture).startswith(PNG)
     assert "tie between joints 1 and 2" in cp.table.value
     cp.select(names[0])
     assert cp.buttons.value == names[0] and "joint 2" in cp.table.value
@@ -193,9 +193,27 @@ def test_config_picker_bad_input():
         cp.select("b")
 
 
+def test_the_image_widget_carries_the_picture_as_a_data_url(r3):
+    """The browser gets a data URL (decoded in the page; a Blob URL costs a round trip through the browser
+    process): it must decode to exactly the rendered picture, for PNG and JPEG explorers and the picker."""
+    import base64
+
+    for ex, mime in ((widgets.explorer(r3), "png"), (widgets.explorer(r3, image_format="jpeg"), "jpeg")):
+        ex.sliders[0].value = 0.4
+        assert ex.image.format == "url"
+        head, _, body = bytes(ex.image.value).partition(b",")
+        assert head == f"data:image/{mime};base64".encode()
+        assert base64.b64decode(body, validate=True) == bytes(ex.picture)
+    cp = widgets.config_picker(r3, {"a": [0, 0, 0], "b": [0.3, 0.2, 0.1]}, rows="vx")
+    cp.select("b")
+    head, _, body = bytes(cp.image.value).partition(b",")
+    assert head == b"data:image/png;base64" and base64.b64decode(body) == bytes(cp.picture)
+    assert bytes(cp.picture).startswith(PNG)
+
+
 def test_jpeg_pictures_and_bad_format(r3):
     ex = widgets.explorer(r3, image_format="jpeg")
-    assert bytes(ex.image.value).startswith(b"\xff\xd8") and ex.image.format == "jpeg"
+    assert bytes(ex.picture).startswith(b"\xff\xd8") and ex.picture_format == "jpeg"
     with pytest.raises(ValueError, match="image_format"):
         widgets.explorer(r3, image_format="gif")
 
@@ -344,7 +362,7 @@ def test_display_bundles_carry_a_static_picture(r3):
     assert "application/vnd.jupyter.widget-view+json" in b
     assert not b["text/plain"].startswith("Explorer(") and r3.name in b["text/plain"]
     im = Image.open(io.BytesIO(base64.b64decode(b["image/png"])))
-    assert im.format == "PNG" and im.size == Image.open(io.BytesIO(ex.image.value)).size
+    assert im.format == "PNG" and im.size == Image.open(io.BytesIO(ex.picture)).size
     cp = widgets.config_picker(r3, {"a": [0.1, 0.2, 0.3]})
     b = cp._repr_mimebundle_()
     assert "application/vnd.jupyter.widget-view+json" in b and not b["text/plain"].startswith("ConfigPicker(")
@@ -359,7 +377,7 @@ def test_indexed_png_keeps_the_picture(r3):
 
     ex = widgets.explorer(r3, q=[0.3, -0.6, 0.4])
     ex.update([0.5, -0.7, 0.2])
-    fast = np.asarray(Image.open(io.BytesIO(ex.image.value)).convert("RGB"), float)
+    fast = np.asarray(Image.open(io.BytesIO(ex.picture)).convert("RGB"), float)
     for a in ex._blit.artists:
         a.set_animated(False)
     full = np.asarray(Image.open(io.BytesIO(widgets_render.render_png(ex.fig))).convert("RGB"), float)

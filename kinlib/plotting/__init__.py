@@ -28,6 +28,8 @@ Functions (each returns an object to update or inspect):
   ``draw_joint_velocities(ax, chain, q, *, rows=None, joints=None, scale=1)`` → :class:`JointVelocitiesArtist`;
 * ``draw_velocity_ellipse(ax, chain, q, *, rows=None, scale=1, hold=None)`` → :class:`EllipseArtist`
   (``.semi_axes``; ``hold=("wz",)``: the ellipse with those rows held at zero, e.g. the orientation);
+  ``draw_velocity_ellipses(ax, chain, q, *, task=None, rows=None, scale=1)`` → :class:`VelocityEllipses`
+  (the task's held-orientation ellipse, which flattens at its singularities, and the all-joints ṗ outline);
   ``draw_ellipse(ax, center, lengths, axes)`` for a given (σ, U);
 * ``draw_directions(ax, origin, vectors, labels, *, components=None, length=None, both_ways=False)``;
 * ``plot_joint_contributions(ax, values, *, title=None)`` (bar chart of one row of J);
@@ -61,7 +63,16 @@ from ..taskspace import ROW_LABELS, ROW_NAMES, ROW_TEX, is_planar, task_row_indi
 from .animation import animate_singularity
 from .artists import ChainArtist, EllipseArtist, JointVelocitiesArtist, VelocityArtist
 from .common import FRAME_COLORS, JOINT_COLORS, default_ranges
-from .drawing import draw_chain, draw_ellipse, draw_home, draw_joint_velocities, draw_velocity, draw_velocity_ellipse
+from .drawing import (
+    VelocityEllipses,
+    draw_chain,
+    draw_ellipse,
+    draw_home,
+    draw_joint_velocities,
+    draw_velocity,
+    draw_velocity_ellipse,
+    draw_velocity_ellipses,
+)
 from .plots import (
     CurvePlot,
     MapPlot,
@@ -86,6 +97,8 @@ __all__ = [
     "draw_joint_velocities",
     "JointVelocitiesArtist",
     "draw_velocity_ellipse",
+    "draw_velocity_ellipses",
+    "VelocityEllipses",
     "EllipseArtist",
     "draw_ellipse",
     "draw_directions",

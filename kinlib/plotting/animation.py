@@ -27,7 +27,7 @@ from .._backend import describe
 from ..manipulability import manipulability_values, measure_label
 from ..taskspace import default_task_rows, is_planar, rows_label, task_row_indices, task_rows
 from .common import checked_numeric
-from .drawing import draw_chain, draw_velocity_ellipse
+from .drawing import draw_chain, draw_velocity_ellipses
 
 __all__ = ["animate_singularity", "SingularityAnimation", "first_frame_html"]
 
@@ -227,35 +227,8 @@ def animate_singularity(
         title=title or f"{chain.name} along the path",
     )
     e_rows = task_row_indices(ellipse_rows) if ellipse_rows is not None else ((3, 4) if planar else (3, 4, 5))
-    hold = tuple(k for k in r if k < 3) if set(e_rows) <= set(r) else ()
-    ells = [
-        draw_velocity_ellipse(
-            ax,
-            chain,
-            P[0],
-            rows=e_rows,
-            scale=velocity_scale,
-            hold=hold or None,
-            label=rf"$\dot p$ with {rows_label(hold, tex=True)} held" if hold else None,
-        )
-    ]
-    if hold:  # the ellipse of ṗ with every joint free, lighter: it need not flatten at the singularity
-        ells.append(
-            draw_velocity_ellipse(
-                ax,
-                chain,
-                P[0],
-                rows=e_rows,
-                scale=velocity_scale,
-                color="0.45",
-                fill=False,
-                axes_lines=False,
-                lw=1.1,
-                ls="--",
-                alpha=0.8,
-                label=r"$\dot p$, all joints free",
-            )
-        )
+    ells = draw_velocity_ellipses(ax, chain, P[0], task=r, rows=e_rows, scale=velocity_scale)
+    if ells.hold:
         ax.legend(loc="lower right", fontsize=7, framealpha=0.8)
     J = task_rows(chain.jacobian_geometric(P), r)
     w = manipulability_values(J, "yoshikawa")
@@ -293,8 +266,7 @@ def animate_singularity(
 
     def frame(k):
         arm.update(P[k])
-        for ell in ells:
-            ell.update(P[k])
+        ells.update(P[k])
         mark.set_data([k], [w[k]])
         txt.set_text(f"{w_label} = {w[k]:.3f}   {status(k)}")
         txt.set_color("tab:red" if status(k) else "k")
@@ -304,6 +276,6 @@ def animate_singularity(
     anim = SingularityAnimation(fig, frame, frames=P.shape[0], interval=interval, blit=False)
     anim.values = w
     anim.frame_function, anim.n_frames = frame, P.shape[0]
-    anim.movers = [*arm.artists, *(a for e in ells for a in e.artists), mark, txt]
+    anim.movers = [*arm.artists, *ells.artists, mark, txt]
     anim.summary = f"animation of {chain.name} along a path of {P.shape[0]} configurations (frame 0 shown)"
     return anim

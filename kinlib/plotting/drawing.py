@@ -11,11 +11,13 @@ velocity ṗ, each joint's column of J, the velocity ellipse (or any ellipse giv
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 import sympy as sp
 
 from .._backend import describe
-from ..taskspace import is_planar, task_row_indices
+from ..taskspace import default_task_rows, is_planar, rows_label, task_row_indices
 from .artists import ChainArtist, EllipseArtist, JointVelocitiesArtist, VelocityArtist, ellipse_outline
 from .common import (
     JOINT_COLORS,
@@ -310,6 +312,64 @@ def draw_velocity_ellipse(
     if h is not None and set(h) & set(r):
         raise ValueError(f"hold must not share a row with the drawn rows {r}, got {describe(hold)}")
     return EllipseArtist(ax, chain, q, r, scale, color, axes_lines, label, fill, h, lw, ls, alpha)
+
+
+class VelocityEllipses(NamedTuple):
+    """What :func:`draw_velocity_ellipses` drew: ``held`` (the ṗ ellipse with the task's orientation rows held,
+    or None), ``free`` (the ṗ ellipse with every joint free) and ``hold`` (the held row indices, maybe empty)."""
+
+    held: EllipseArtist | None
+    free: EllipseArtist
+    hold: tuple
+
+    @property
+    def main(self) -> EllipseArtist:
+        """The ellipse that flattens at the task's singular configurations: ``held`` if any, else ``free``."""
+        return self.held if self.held is not None else self.free
+
+    @property
+    def artists(self) -> list:
+        """Every matplotlib artist of both ellipses (for blitting and animation)."""
+        return [*(self.held.artists if self.held is not None else []), *self.free.artists]
+
+    def update(self, q, J=None, p=None) -> None:
+        """Recompute both at configuration ``q`` (``J``: the geometric Jacobian there, ``p``: the tool position)."""
+        for e in (self.held, self.free):
+            if e is not None:
+                e.update(q, J, p)
+
+
+def draw_velocity_ellipses(ax, chain, q, *, task=None, rows=None, scale=1.0, label_suffix="", params=None):
+    """The velocity ellipses that show a task's singularities: when the task rows ``task`` (default
+    :func:`kinlib.taskspace.default_task_rows`) contain the drawn ṗ rows ``rows`` and some orientation
+    rows ω, the ellipse {ṗ_r : ω_task = 0, ‖θ̇‖ ≤ 1} with those orientation rows **held** (it collapses to a
+    segment exactly where the task's Jacobian rows lose rank), filled, and the ellipse of ṗ with every joint
+    free as a light dashed outline (it need not flatten there); otherwise only the plain velocity ellipse.
+    ``label_suffix`` is appended to both legend labels (e.g. the drawing scale).
+
+    >>> from kinlib.robots import planar_offset_3r
+    >>> chain = planar_offset_3r(1)
+    >>> art = draw_chain(chain, [0, -np.pi / 4, 0])
+    >>> ells = draw_velocity_ellipses(art.ax, chain, [0, -np.pi / 4, 0])
+    >>> ells.hold, np.round(ells.held.semi_axes, 6) + 0.0, ells.main is ells.held
+    ((2,), array([1.715462, 0.      ]), True)
+    """
+    chain = checked_numeric(chain, params)
+    r = _velocity_rows(ax, rows)
+    t = task_row_indices(task, default=default_task_rows(chain))
+    hold = tuple(k for k in t if k < 3) if set(r) <= set(t) else ()
+    if not hold:
+        free = draw_velocity_ellipse(ax, chain, q, rows=r, scale=scale, label=f"velocity ellipse{label_suffix}")
+        return VelocityEllipses(None, free, ())
+    held = draw_velocity_ellipse(
+        ax, chain, q, rows=r, scale=scale, hold=hold, color="tab:green",
+        label=rf"$\dot p$ with {rows_label(hold, tex=True)} held{label_suffix}",
+    )  # fmt: skip
+    free = draw_velocity_ellipse(
+        ax, chain, q, rows=r, scale=scale, color="0.45", fill=False, axes_lines=False, lw=1.1, ls="--", alpha=0.8,
+        label=rf"$\dot p$, all joints free{label_suffix}",
+    )  # fmt: skip
+    return VelocityEllipses(held, free, hold)
 
 
 def draw_ellipse(
