@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed
 NOTEBOOKS := $(sort $(wildcard notebooks/[0-9][0-9]_*.ipynb))
 PYTEST_ARGS ?=
 
-.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium bubblewrap clean
+.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium poppler bubblewrap clean
 
 all: test
 
@@ -39,6 +39,13 @@ chromium:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; }
 
+# Debian's poppler-utils (pdftotext, pdfinfo, pdftoppm): tests/test_print.py reads the handout PDFs with them.
+poppler:
+	@command -v pdftotext >/dev/null 2>&1 || { \
+	  echo "installing Debian's poppler-utils for the PDF tests"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq poppler-utils >/dev/null; }
+
 # Debian's bubblewrap: the sandbox every student kernel runs in (kinlib.course.sandbox); `kinlib grade`
 # refuses to grade without it unless given --no-sandbox.
 bubblewrap:
@@ -48,7 +55,7 @@ bubblewrap:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq bubblewrap >/dev/null; }
 
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
-test: $(STAMP) lint chromium bubblewrap
+test: $(STAMP) lint chromium poppler bubblewrap
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
 	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider $(PYTEST_ARGS)
 
@@ -73,8 +80,17 @@ notebooks: $(STAMP)
 	$(VENV)/bin/kinlib execute $(NB)
 
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
-handouts: $(STAMP)
+handouts: $(STAMP) chromium
 	$(VENV)/bin/kinlib handouts notebooks --out build/handouts
+
+# A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
+# http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.
+# To publish, copy build/handouts to any static web host: no server-side Python.
+.PHONY: site
+PORT ?= 8000
+site: $(STAMP)
+	@test -f build/handouts/index.html -a -f build/handouts/lite/jupyter-lite.json || $(MAKE) handouts
+	$(VENV)/bin/python -c "from kinlib.course.lite import serve; serve('build/handouts', $(PORT))"
 
 # Grade a class: make grade SUBMISSIONS=path/to/folder [JOBS=2] [OUT=build/grades]
 SUBMISSIONS ?= submissions

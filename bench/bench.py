@@ -58,6 +58,7 @@ T_NOTEBOOK = 10.0
 T_REDRAW = 0.050
 T_LAB_RUN_ALL = 8.0  # Run All Cells of a notebook in JupyterLab (issue 13)
 T_LAB_SLIDER = 0.060  # key press on a slider → new picture loaded in the browser, median of 20 moves
+T_LITE_FIRST = 30.0  # JupyterLite: opening workbook 05 and running all → its first picture (issue 15)
 T_IMPORT = 0.6
 T_FIRST_CALL = 2.0  # first numeric call (code generation) of any chain of <= 7 joints
 T_EXACT_RANK = 30.0  # exact rank / column space / left null space at a configuration of a 6-joint arm
@@ -891,6 +892,60 @@ def browser_section(args, targets: Targets) -> list[str]:
     )
 
 
+def lite_section(args, targets: Targets) -> list[str]:
+    """The in-browser site (JupyterLite on Pyodide, `make handouts` → build/handouts/lite): workbook 05 opened in
+    Debian's chromium from a loopback server with every other request blocked, Run All as soon as the kernel is
+    ready, until its first picture (page clock from the page load; tests/test_lite.py time_to_first_result)."""
+    lines = [
+        "## In the browser with nothing installed (JupyterLite site of `make handouts`)",
+        "",
+        "Time to first result: open workbook 05 of the site (served on loopback, every other request blocked), "
+        "Run All as soon as the kernel is ready, until the first picture is drawn; page clock from the page load. "
+        "Three fresh pages (each a cold Pyodide start: nothing kept between them).",
+        "",
+    ]
+    if args.quick:
+        return lines + ["skipped (--quick)"]
+    sys.path.insert(0, str(ROOT / "tests"))
+    try:
+        import labdriver
+        import test_lite
+        from kinlib.course import handouts, lite
+        from kinlib.course.pages import build_assets
+    except ImportError as exc:
+        targets.upper("JupyterLite: time to first result", None, T_LITE_FIRST)
+        return lines + [f"{NA} ({exc})"]
+    if not Path(labdriver.CHROMIUM).exists():
+        targets.upper("JupyterLite: time to first result", None, T_LITE_FIRST)
+        return lines + [f"{NA} ({labdriver.CHROMIUM} is missing: `make chromium`)"]
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / "handouts"
+        t0 = time.perf_counter()
+        try:
+            nb = ROOT / "notebooks" / "05_singularities_planar.ipynb"
+            urls = build_assets(out / "assets", ROOT / "build" / "vendor")
+            handouts.build_one(nb, out, urls, 300, False, log=lambda s: None)
+            lite.build_lite(out, sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb")), log=lambda s: None)
+        except Exception as exc:  # a failed build is a result too (e.g. no network for the first download)
+            targets.upper("JupyterLite: time to first result", None, T_LITE_FIRST)
+            return lines + [f"site build failed: {type(exc).__name__}: {' '.join(str(exc).split())[:200]}"]
+        built = time.perf_counter() - t0
+        size = sum(p.stat().st_size for p in (out / "lite").rglob("*") if p.is_file())
+        with labdriver.chromium() as browser:
+            times = [test_lite.time_to_first_result(out, browser) for _ in range(3)]
+    med = statistics.median(times)
+    status = targets.upper("JupyterLite: time to first result (median of 3)", med, T_LITE_FIRST)
+    return lines + table(
+        ["what", "min", "median", "max", "target (median)", "status"],
+        [
+            ["workbook 05: page load → first picture", fmt_t(min(times)), fmt_t(med), fmt_t(max(times)), "≤ 30 s"]
+            + [status],
+            [f"site build (notebook 05's workbook + site, warm cache), {size / 1e6:.0f} MB", "—", fmt_t(built), "—"]
+            + ["—", "(reported)"],
+        ],
+    )
+
+
 def grader_section(args, targets: Targets) -> list[str]:
     """``kinlib grade`` with the sandbox on: a batch of copies of the solution notebooks (every cell runs, as in
     a completed workbook), its wall time here, and 200 workbooks extrapolated two ways: from this wall time
@@ -1032,6 +1087,7 @@ def main(argv=None) -> int:
         notebook_section,
         explorer_section,
         browser_section,
+        lite_section,
         grader_section,
         import_section,
     ):

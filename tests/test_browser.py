@@ -79,7 +79,9 @@ def sites(tmp_path_factory):
 
     base = tmp_path_factory.mktemp("browser")
     out = {}
-    handouts.build(FIXTURES, base / "fixture", vendor=VENDOR, jobs=1, verify=False, log=lambda s: None)
+    handouts.build(
+        FIXTURES, base / "fixture", vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=lambda s: None
+    )
     out["fixture"] = base / "fixture"
     if os.environ.get("KINLIB_HANDOUTS_DIR"):
         out["handouts"] = Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()

@@ -39,7 +39,10 @@ def test_help_lists_the_subcommands(capsys):
 @pytest.mark.parametrize(
     "command, options",
     [
-        ("handouts", ["--out", "--vendor", "--jobs", "--timeout", "--no-verify", "--only"]),
+        (
+            "handouts",
+            ["--out", "--vendor", "--jobs", "--timeout", "--no-verify", "--only", "--no-site", "--no-pdf", "--serve"],
+        ),
         ("grade", ["--out", "--timeout", "--cell-timeout", "--jobs", "--notebooks", "--cache", "--quiet"]),
     ],
 )
@@ -98,7 +101,24 @@ def test_handouts_on_a_folder(capsys, tmp_path):
     nbs.mkdir()
     shutil.copy(HANDOUTS_FIXTURES / "01_fixture_jacobians.ipynb", nbs)
     out = tmp_path / "handouts"
-    assert main(["handouts", str(nbs), "--out", str(out), "--vendor", str(VENDOR), "--jobs", "1", "--no-verify"]) == 0
+    assert (
+        main(
+            [
+                "handouts",
+                str(nbs),
+                "--out",
+                str(out),
+                "--vendor",
+                str(VENDOR),
+                "--jobs",
+                "1",
+                "--no-verify",
+                "--no-site",
+                "--no-pdf",
+            ]
+        )
+        == 0
+    )
     for rel in (
         "index.html",
         "problems/01_fixture_jacobians.html",

@@ -125,12 +125,26 @@ def test_check_prints_a_line_per_answer(capsys):
 def built(tmp_path_factory):
     out = tmp_path_factory.mktemp("handouts") / "handouts"
     log = []
-    entries = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, log=log.append)
+    entries = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=log.append)
     return out, entries[0], log
 
 
 def _solution_cells(nb):
     return [c for c in nb.cells if "solution" in c.metadata.get("tags", [])]
+
+
+def test_pages_link_only_what_was_built(built):
+    """Built without the site and the PDFs (site=False, pdfs=False): no page and not the index links to them
+    (every relative link of every page resolves to a file of the build)."""
+    import re
+
+    out, _entry, _log = built
+    assert not (out / "lite").exists() and not (out / "pdf").exists()
+    pages = [out / "index.html", *(out / "problems").glob("*.html"), *(out / "solutions").glob("*.html")]
+    for page in pages:
+        for href in re.findall(r'<a href="([^"#:]+)"', page.read_text(encoding="utf-8")):
+            target = (page.parent / href.split("?")[0]).resolve()
+            assert target.is_file(), f"{page.relative_to(out)} links {href}, which was not built"
 
 
 def test_writes_every_handout_and_the_index(built):

@@ -88,6 +88,12 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-verify", dest="verify", action="store_false", help="do not run the workbooks after writing them"
     )
     h.add_argument("--only", nargs="*", help="only notebooks whose name starts with these (e.g. 05)")
+    h.add_argument(
+        "--no-site", dest="site", action="store_false", help="do not build the in-browser site (OUT/lite, JupyterLite)"
+    )
+    h.add_argument("--no-pdf", dest="pdfs", action="store_false", help="do not print the PDFs (OUT/pdf, chromium)")
+    h.add_argument("--serve", action="store_true", help="then serve OUT on http://127.0.0.1:PORT/ (Ctrl-C stops)")
+    h.add_argument("--port", type=int, default=8000, help="port for --serve (default 8000; loopback only)")
     h.set_defaults(run=_handouts, parser=h)
 
     x = sub.add_parser(
@@ -300,6 +306,8 @@ def _handouts(args) -> int:
             timeout=args.timeout,
             verify=args.verify,
             only=args.only,
+            site=args.site,
+            pdfs=args.pdfs,
             log=lambda s: print(s, flush=True),
         )
     except NotebookFailed as e:  # names the notebook and the cell, with the cell's first lines
@@ -308,6 +316,10 @@ def _handouts(args) -> int:
     except (RuntimeError, FileNotFoundError, ValueError) as e:
         print(f"{PROG} handouts: error: {_one_line(e)}", file=sys.stderr)
         return 2
+    if args.serve:  # a local look at the site: loopback only; any static web host serves the folder as well
+        from .lite import serve
+
+        serve(args.out, args.port)
     return 0
 
 

@@ -44,7 +44,7 @@ from pathlib import Path
 import nbformat
 
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
-from .pages import HTML_MANAGER, REQUIREJS, build_assets, export_html, write_index
+from .pages import HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_index
 from .schema import (
     ANSWER_TAGS,
     CHECK,
@@ -521,7 +521,7 @@ def run_workbook(path: Path, timeout: int = 120):
 # The job
 
 
-def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log=print) -> dict:
+def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log=print, links=LINKS) -> dict:
     """Execute one notebook and write its three handouts; return its index entry.
 
     It runs the notebook (and, with ``verify``, the workbook) in a Jupyter kernel (seconds;
@@ -539,9 +539,13 @@ def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log
     executed, groups, fps = execute_notebook(path, timeout)
     t_exec = time.perf_counter() - t0
     title = notebook_title(executed, stem.replace("_", " "))
-    export_html(executed, out / "solutions" / f"{stem}.html", urls, title=f"{title} (solutions)", problems=False)
+    export_html(
+        executed, out / "solutions" / f"{stem}.html", urls, title=f"{title} (solutions)", problems=False, links=links
+    )
     problems, notes = make_problems(executed)
-    export_html(problems, out / "problems" / f"{stem}.html", urls, title=f"{title} (problems)", problems=True)
+    export_html(
+        problems, out / "problems" / f"{stem}.html", urls, title=f"{title} (problems)", problems=True, links=links
+    )
     wb = make_workbook(source, groups, fps)
     wpath = out / "workbooks" / f"{stem}.ipynb"
     wpath.parent.mkdir(parents=True, exist_ok=True)
@@ -579,9 +583,14 @@ def build(
     timeout: int = 120,
     verify: bool = True,
     only: list | None = None,
+    site: bool = True,
+    pdfs: bool = True,
     log=print,
 ) -> list:
-    """The whole job; raises NotebookFailed naming the notebook and cell when one fails.
+    """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
+    ``index.html``, ``problems/`` and ``solutions/`` (HTML), ``workbooks/`` (.ipynb), and unless switched off
+    ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.lite.build_lite`) and ``pdf/`` (``pdfs``:
+    every page printed by Chromium, :func:`kinlib.course.printing.print_pdfs`); the pages link only what is built.
 
     A folder without ``NN_*.ipynb`` notebooks is refused before anything is written:
 
@@ -601,6 +610,7 @@ def build(
     """
     t0 = time.perf_counter()
     notebooks, out = Path(notebooks), Path(out)
+    links = tuple(k for k, on in (("pdf", pdfs), ("lite", site)) if on)
     paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
     if only:
         paths = [p for p in paths if any(p.stem.startswith(o) for o in only)]
@@ -617,10 +627,10 @@ def build(
     if jobs <= 1:
         for k, p in enumerate(paths, 1):
             log(f"[{k}/{len(paths)}] {p.name} ...")
-            entries[p] = build_one(p, out, urls, timeout, verify, log)
+            entries[p] = build_one(p, out, urls, timeout, verify, log, links)
     else:
         with ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = {p: pool.submit(build_one, p, out, urls, timeout, verify, log) for p in paths}
+            futures = {p: pool.submit(build_one, p, out, urls, timeout, verify, log, links) for p in paths}
             log(f"  running {len(paths)} notebooks, {jobs} at a time")
             try:
                 for p, f in futures.items():
@@ -629,7 +639,15 @@ def build(
                 for f in futures.values():
                     f.cancel()
                 raise
-    write_index(out, [entries[p] for p in paths])
+    write_index(out, [entries[p] for p in paths], links)
+    if site:
+        from .lite import build_lite  # the notebooks in the browser (JupyterLite, offline): out/lite/
+
+        build_lite(out, paths, log=log)
+    if pdfs:
+        from .printing import print_pdfs  # the PDFs of the pages (chromium, offline): out/pdf/
+
+        print_pdfs(out, log=log)
     log(
         f"kinlib handouts: wrote {out / 'index.html'} and {3 * len(paths)} handouts in {time.perf_counter() - t0:.1f} s"
     )

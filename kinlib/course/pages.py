@@ -11,12 +11,25 @@ import copy
 import html
 import re
 import shutil
-import subprocess
-import tarfile
 import time
 from pathlib import Path
 
-__all__ = ["build_assets", "export_html", "write_index", "HTML_MANAGER", "REQUIREJS", "FONT_AWESOME", "MATHJAX_CONFIG"]
+from .npm import npm_pack
+
+__all__ = [
+    "build_assets",
+    "npm_pack",
+    "export_html",
+    "write_index",
+    "LINKS",
+    "print_header",
+    "contrast_ratio",
+    "COURSE",
+    "HTML_MANAGER",
+    "REQUIREJS",
+    "FONT_AWESOME",
+    "MATHJAX_CONFIG",
+]
 
 HTML_MANAGER = ("@jupyter-widgets/html-manager", "1.0.15")  # the embedder for ipywidgets 8.1 (controls 5)
 REQUIREJS = ("requirejs", "2.3.8")
@@ -56,34 +69,10 @@ MathJax.Ajax.loadComplete("[MathJax]/config/kinlib.js");
 """
 
 
-def _npm_pack(name: str, version: str, vendor: Path) -> Path:
-    """The unpacked npm package ``name@version`` under ``vendor`` (``npm pack`` from the registry once)."""
-    vendor.mkdir(parents=True, exist_ok=True)
-    stem = name.lstrip("@").replace("/", "-") + "-" + version
-    unpacked = vendor / stem
-    if (unpacked / "package" / "package.json").exists():
-        return unpacked / "package"
-    tgz = vendor / f"{stem}.tgz"
-    if not tgz.exists():
-        if shutil.which("npm") is None:
-            raise RuntimeError(
-                f"npm is needed once to fetch {name}@{version} (the offline widget renderer) "
-                f"into {vendor}; install node/npm or copy {tgz.name} there"
-            )
-        r = subprocess.run(
-            ["npm", "pack", f"{name}@{version}", "--silent", "--pack-destination", str(vendor)],
-            capture_output=True,
-            text=True,
-        )
-        if r.returncode != 0 or not tgz.exists():
-            raise RuntimeError(f"npm pack {name}@{version} failed (exit {r.returncode}):\n{r.stderr.strip()[-2000:]}")
-    tmp = vendor / (stem + ".tmp")
-    shutil.rmtree(tmp, ignore_errors=True)
-    with tarfile.open(tgz) as tf:
-        tf.extractall(tmp, filter="data")
-    shutil.rmtree(unpacked, ignore_errors=True)
-    tmp.rename(unpacked)
-    return unpacked / "package"
+_npm_pack = npm_pack  # the old private name, used below
+
+
+LINKS = ("pdf", "lite")  # the other forms a handout links to when they are built (PDF, the in-browser site)
 
 
 def build_assets(assets: Path, vendor: Path) -> dict:
@@ -124,8 +113,9 @@ def build_assets(assets: Path, vendor: Path) -> dict:
     }
 
 
-def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool) -> None:
+def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool, links=LINKS) -> None:
     """Write ``nb`` as a page ``dest`` using the offline assets ``urls``; ``problems`` drops prompt numbers.
+    ``links``: which of the other forms the page links to, of ``("pdf", "lite")`` (those that are built).
 
     The assets need not be there to write the page (``urls`` are only links):
 
@@ -146,6 +136,7 @@ def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool) -> No
             h = o.get("data", {}).get("text/html")
             if h:
                 h = _FA_CDN.sub(_FA_LOCAL, h if isinstance(h, str) else "".join(h))
+                h = h.replace('<input id="_anim_slider', '<input aria-label="animation frame" id="_anim_slider')
                 if "_anim_img" in h and _FA_LOCAL not in h:  # an animation whose CDN link was dropped
                     h = f'<link rel="stylesheet" href="{_FA_LOCAL}">\n' + h
                 o["data"]["text/html"] = h
@@ -156,46 +147,250 @@ def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool) -> No
     if _REQUIRE_TAG not in body:
         raise RuntimeError(f"nbconvert's lab template changed: no {_REQUIRE_TAG} in {dest.name}")
     body = body.replace(_REQUIRE_TAG, _REQUIRE_TAG + "\n" + _WIDGET_PATHS, 1)
+    body = _print_and_links(body, nb, dest, title=title, problems=problems, links=links)
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(body, encoding="utf-8")
 
 
+# ---------------------------------------------------------------------------------------------------
+# What export_html adds to nbconvert's page: the print stylesheet and header (kinlib.course.printing), a bar
+# of links (index, PDF, workbook, "open in the browser"), and a text alternative for every figure.
+
+COURSE = "Problem Set 4"  # the course name in the PDF page headers
+_NO_ALT = 'alt="No description has been provided for this image"'  # what nbconvert puts on every figure
+_LINKS_CSS = """<style>/* kinlib: the links bar, and contrast (WCAG AA) for the prompts */
+.kinlib-links { font: 14px/1.5 system-ui, sans-serif; margin: 0 0 1rem; padding: .5rem 0; border-bottom: 1px solid #ccc; }
+.kinlib-links a { color: #0b4fa8; margin-right: 1.2rem; }
+.jp-InputPrompt, .jp-OutputPrompt { opacity: 1 !important; }
+.jp-InputPrompt { color: #245e91 !important; } .jp-OutputPrompt { color: #9c3f22 !important; }
+</style>
+"""
+
+
+def _luminance(hexcolor: str) -> float:
+    h = hexcolor.lstrip("#")
+    if len(h) == 3:
+        h = "".join(c * 2 for c in h)
+    channels = [int(h[i : i + 2], 16) / 255 for i in (0, 2, 4)]
+    lin = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in channels]
+    return 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+
+
+def contrast_ratio(fg: str, bg: str) -> float:
+    """WCAG 2 contrast ratio (L1 + 0.05) / (L2 + 0.05) of two ``#rgb``/``#rrggbb`` colours.
+
+    >>> round(contrast_ratio("#408080", "#f5f5f5"), 2), round(contrast_ratio("#000", "#fff"), 1)
+    (4.17, 21.0)
+    """
+    a, b = sorted((_luminance(fg), _luminance(bg)), reverse=True)
+    return (a + 0.05) / (b + 0.05)
+
+
+def _code_colours(body: str, background: str = "#f5f5f5", target: float = 4.6) -> str:
+    """CSS overriding the syntax colours of JupyterLab's light theme (``--jp-mirror-editor-*-color``) that
+    have less than WCAG AA contrast on the code background: each is darkened until it has ``target``."""
+    fixes = {}
+    for name, colour in re.findall(r"(--jp-mirror-editor-[\w-]+-color):\s*(#[0-9a-fA-F]{3}(?:[0-9a-fA-F]{3})?);", body):
+        h = colour.lstrip("#")
+        rgb = [int((h[i] * 2) if len(h) == 3 else h[2 * i : 2 * i + 2], 16) for i in range(3)]
+        new = colour
+        while contrast_ratio(new, background) < target:
+            rgb = [int(c * 0.92) for c in rgb]
+            new = "#" + "".join(f"{c:02x}" for c in rgb)
+        if new != colour:
+            fixes.setdefault(name, new)
+    if not fixes:
+        return ""
+    return (
+        "<style>/* kinlib: syntax colours with WCAG AA contrast */ :root { "
+        + " ".join(f"{k}: {v};" for k, v in fixes.items())
+        + " }</style>\n"
+    )
+
+
+def _lite_link(relpath: str) -> str:
+    from .lite import lite_link  # kinlib.course.lite imports this module: import it when used
+
+    return lite_link(relpath)
+
+
+def print_header(stem: str, title: str, problems: bool) -> str:
+    """The header of each printed page of a handout: course, section number, title and which handout.
+
+    >>> print_header("05_singularities_planar", "Singularities: the planar robot (solutions)", False)
+    'Problem Set 4 · 5 Singularities: the planar robot — solutions'
+    """
+    kind = "problems" if problems else "solutions"
+    base = re.sub(r"\s*\((?:problems|solutions)\)\s*$", "", title)
+    number = f"{int(stem[:2])} " if stem[:2].isdigit() else ""
+    return f"{COURSE} · {number}{base} — {kind}"
+
+
+def _plain(text: str) -> str:
+    """Markdown/TeX to a short plain sentence for alt text."""
+    text = re.sub(r"!\[[^\]]*\]\([^)]*\)|<[^>]+>", "", text)
+    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", text)
+    text = re.sub(r"\\(?:bigl|bigr|Bigl|Bigr|left|right|,|;|!)", "", text)
+    greek = {"theta": "θ", "pi": "π", "omega": "ω", "sigma": "σ", "mu": "μ", "lambda": "λ", "phi": "φ", "alpha": "α"}
+    text = re.sub(r"\\(theta|pi|omega|sigma|mu|lambda|phi|alpha)(?![A-Za-z])", lambda m: greek[m.group(1)], text)
+    text = re.sub(r"[*_`#${}]|\\(?:mathrm|text|operatorname|boldsymbol|mathbf)|\\", "", text)
+    return " ".join(text.split())
+
+
+def _figure_alts(nb, section_default: str) -> dict:
+    """{cell id: alt text} for the code cells with figures: "Figure k of <section>: <caption>", the caption
+    being the figure's ``title="…"`` in the cell's code, else the first sentence of the markdown just above; a
+    cell's ``metadata.kinlib.alt`` (a string) wins."""
+    alts, heading, k, prev_md = {}, section_default, 0, ""
+    for c in nb.cells:
+        if c.cell_type == "markdown":
+            m = re.search(r"^#{1,3}\s+(.+)$", c.source, re.M)
+            if m:
+                heading, k = _plain(m.group(1)), 0
+            prev_md = _plain(re.sub(r"^#{1,6}\s+.*$", "", c.source, flags=re.M))
+            continue
+        n_img = sum(
+            1
+            for o in c.get("outputs", [])
+            if {"image/png", "image/jpeg"} & set(o.get("data", {})) or "_anim_img" in str(o.get("data", {}))
+        )
+        if n_img and c.get("id"):
+            k += 1
+            given = c.get("metadata", {}).get("kinlib", {}).get("alt")
+            title = re.search(r"""\btitle\s*=\s*f?(["'])(.+?)\1""", c.source)
+            sentence = re.sub(r"^\d+(?:\.\d+)*\s*\(\d+ points?\)\.?\s*", "", prev_md).split(". ")[0]
+            if title and "{" not in title.group(2):  # the figure's own title (an f-string's varies: not that)
+                caption = _plain(title.group(2))
+            else:
+                caption = sentence[:160] if len(sentence) >= 20 else ""
+            alts[c["id"]] = (
+                given
+                if isinstance(given, str) and given.strip()
+                else f"Figure {k} of “{heading}”" + (f": {caption}" if caption else "")
+            )
+        prev_md = ""
+    return alts
+
+
+def _print_and_links(body: str, nb, dest: Path, *, title: str, problems: bool, links=LINKS) -> str:
+    from .printing import HEADER_META, PRINT_HEAD
+
+    stem, kind = dest.stem, dest.parent.name
+    header = print_header(stem, title, problems)
+    head = f'<meta name="{HEADER_META}" content="{html.escape(header)}">\n{_LINKS_CSS}{_code_colours(body)}{PRINT_HEAD}'
+    if "</head>" not in body:
+        raise RuntimeError(f"nbconvert's lab template changed: no </head> in {dest.name}")
+    body = body.replace("</head>", head + "</head>", 1)
+    notebook = f"{'workbooks' if problems else 'solutions'}/{stem}.ipynb"
+    which = "the workbook" if problems else "this notebook"
+    bar_links = [("../index.html", "All handouts (course index)")]
+    if "pdf" in links:
+        bar_links.append((f"../pdf/{kind}/{stem}.pdf", f"PDF of this page ({kind})"))
+    if "lite" in links:
+        bar_links.append(
+            ("../" + _lite_link(notebook), f"Open {which} in the browser (JupyterLite, nothing to install)")
+        )
+    if problems:
+        bar_links.append((f"../workbooks/{stem}.ipynb", "Download the workbook (.ipynb)"))
+    bar = '<nav class="kinlib-links" aria-label="This handout">' + "".join(
+        f'<a href="{html.escape(href)}">{html.escape(text)}</a>' for href, text in bar_links
+    )
+    bar += "</nav>\n"
+    m = re.search(r"<main>", body)
+    if m is None:
+        raise RuntimeError(f"nbconvert's lab template changed: no <main> in {dest.name}")
+    body = body[: m.end()] + "\n" + bar + body[m.end() :]
+    alts = _figure_alts(nb, html.unescape(header))
+    pieces = re.split(r'(id="cell-id=[^"]*")', body)
+    for i in range(1, len(pieces), 2):
+        alt = alts.get(pieces[i][len('id="cell-id=') : -1])
+        if alt:
+            pieces[i + 1] = pieces[i + 1].replace(_NO_ALT, f'alt="{html.escape(alt)}"')
+    return "".join(pieces).replace(_NO_ALT, f'alt="{html.escape("Figure in " + header)}"')
+
+
 _INDEX = """<!DOCTYPE html>
-<html lang="en"><head><meta charset="utf-8"><title>kinlib handouts</title>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{course} handouts: Jacobians, singularities and manipulability</title>
 <style>
-body {{ font-family: system-ui, sans-serif; max-width: 60rem; margin: 2rem auto; padding: 0 1rem; color: #222; }}
-table {{ border-collapse: collapse; width: 100%; }} th, td {{ text-align: left; padding: .5rem; border-bottom: 1px solid #ddd; }}
-td.sections {{ color: #666; font-size: .9em; }} a {{ margin-right: .8rem; }}
+body {{ font: 16px/1.5 system-ui, sans-serif; max-width: 52rem; margin: 2rem auto; padding: 0 1rem;
+  color: #1f1f1f; background: #fff; }}
+a {{ color: #0b4fa8; }} a:visited {{ color: #5b2a86; }} a:focus {{ outline: 2px solid #0b4fa8; outline-offset: 2px; }}
+section {{ border-top: 1px solid #ccc; padding: .2rem 0 .6rem; }}
+h2 {{ font-size: 1.25rem; margin: .8rem 0 .2rem; }}
+.sections, footer {{ color: #595959; font-size: .9em; margin: 0 0 .3rem; }}
+ul.links {{ margin: .2rem 0; padding-left: 1.2rem; }} ul.links li {{ margin: .15rem 0; }}
+.sep {{ color: #595959; padding: 0 .4rem; }}
 </style></head><body>
-<h1>kinlib: Jacobians, singularities and manipulability</h1>
-<p>Problems (no answers), solutions (worked, with outputs) and workbooks (Jupyter notebooks to fill in, with self-checks)
-for each notebook. Everything here works offline.</p>
-<table><thead><tr><th>#</th><th>Notebook</th><th>Sections</th><th>Handouts</th></tr></thead><tbody>
+<header>
+<h1>{course}: Jacobians, singularities and manipulability</h1>
+<p>For each notebook of the course: the <strong>problems</strong> (questions, no answers) and the worked
+<strong>solutions</strong>, as web pages and as PDFs; the <strong>workbook</strong>, a Jupyter notebook to fill
+in with self-checks, to download or to <strong>open in the browser</strong> (JupyterLite: Python runs in the
+browser tab, nothing to install; it needs this folder served over http, for example by <code>make site</code>
+or any static web host, and its first start takes a while).</p>
+<p>These pages load nothing from the internet: every script, font and picture is in this folder.</p>
+</header>
+<main>
 {rows}
-</tbody></table>
-<p><small>Built by <code>make handouts</code> ({when}).</small></p>
+</main>
+<footer><p>Built by <code>make handouts</code> ({when}).</p></footer>
 </body></html>
 """
 
 
-def write_index(out: Path, entries: list) -> None:
-    """Write ``out/index.html`` linking each entry's problems, solutions and workbook.
+def write_index(out: Path, entries: list, links=LINKS) -> None:
+    """Write ``out/index.html``, the course front page: for each entry (a section of the course) its
+    problems and solutions (web page and PDF), its workbook (download, and "open in the browser" with
+    JupyterLite) and its solution notebook in the browser (``links``: which of ``("pdf", "lite")`` were built; the
+    others are left out). Offline (no external URL), ``lang="en"``, one h1
+    then an h2 per section, link texts that name the section and the target.
 
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as d:
     ...     write_index(Path(d), [{"stem": "01_x", "title": "X", "sections": ["1.1"]}])
-    ...     'href="problems/01_x.html"' in (Path(d) / "index.html").read_text()
-    True
+    ...     page = (Path(d) / "index.html").read_text()
+    >>> 'href="problems/01_x.html"' in page, 'href="pdf/solutions/01_x.pdf"' in page, "://" in page
+    (True, True, False)
     """
     rows = []
+    pdf, lite = "pdf" in links, "lite" in links
     for e in entries:
         stem = e["stem"]
+        num = str(int(stem[:2])) if stem[:2].isdigit() else stem
+        title = html.escape(e["title"])
+        sections = ", ".join(e.get("sections") or [])
+
+        def a(href, text, extra=""):
+            return f'<a href="{html.escape(href)}"{extra}>{html.escape(text)}</a>'
+
+        sep = '<span class="sep" aria-hidden="true">·</span>'
         rows.append(
-            f"<tr><td>{html.escape(stem[:2])}</td><td>{html.escape(e['title'])}</td>"
-            f'<td class="sections">{html.escape(", ".join(e["sections"]))}</td>'
-            f'<td><a href="problems/{stem}.html">problems</a><a href="solutions/{stem}.html">solutions</a>'
-            f'<a href="workbooks/{stem}.ipynb" download>workbook (.ipynb)</a></td></tr>'
+            f'<section aria-labelledby="s{stem}"><h2 id="s{stem}">{html.escape(num)} · {title}</h2>\n'
+            + (f'<p class="sections">Problem set sections {html.escape(sections)}</p>\n' if sections else "")
+            + '<ul class="links">\n'
+            + f"<li>{a(f'problems/{stem}.html', f'Problems {num} (web page)')}"
+            + (f"{sep}{a(f'pdf/problems/{stem}.pdf', f'Problems {num} (PDF)')}" if pdf else "")
+            + "</li>\n"
+            + f"<li>{a(f'solutions/{stem}.html', f'Solutions {num} (web page)')}"
+            + (f"{sep}{a(f'pdf/solutions/{stem}.pdf', f'Solutions {num} (PDF)')}" if pdf else "")
+            + (
+                f"{sep}{a(_lite_link(f'solutions/{stem}.ipynb'), f'Solutions {num}: open the notebook in the browser')}"
+                if lite
+                else ""
+            )
+            + "</li>\n"
+            + f"<li>{a(f'workbooks/{stem}.ipynb', f'Workbook {num} (download .ipynb)', ' download')}"
+            + (
+                f"{sep}{a(_lite_link(f'workbooks/{stem}.ipynb'), f'Workbook {num}: open in the browser')}"
+                if lite
+                else ""
+            )
+            + "</li>\n"
+            "</ul></section>"
         )
     (out / "index.html").write_text(
-        _INDEX.format(rows="\n".join(rows), when=time.strftime("%Y-%m-%d")), encoding="utf-8"
+        _INDEX.format(rows="\n".join(rows), when=time.strftime("%Y-%m-%d"), course=html.escape(COURSE)),
+        encoding="utf-8",
     )

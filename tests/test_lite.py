@@ -1,0 +1,525 @@
+"""The JupyterLite site (kinlib/course/lite.py): pinned sources, sha256 verification that fails closed, links,
+serving; and (marked ``browser``, ``slow``) the site built as ``make handouts`` builds it, opened in Debian's
+chromium with every request that is not to the loopback server blocked: workbook 05 runs, a self-check answers,
+an explorer's picture follows its slider.
+
+:func:`time_to_first_result` is what ``make bench`` reports (bench/bench.py can import it from here).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import re
+import shutil
+import time
+import urllib.request
+from pathlib import Path
+
+import pytest
+
+from kinlib.course import lite
+
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOKS = ROOT / "notebooks"
+VENDOR = ROOT / "build" / "vendor"
+SCREENSHOTS = ROOT / "build" / "screenshots"
+WORKBOOK = "workbooks/05_singularities_planar.ipynb"
+
+
+# ---------------------------------------------------------------------------------------------------
+# sha256 verification fails closed
+
+
+def _sha(b: bytes) -> str:
+    return hashlib.sha256(b).hexdigest()
+
+
+def _fake_lock(tmp_path):
+    """Two fake package files, one plain and one inside a zip (as the wheel archive holds them), and a lock."""
+    plain = tmp_path / "six-1.0-py3-none-any.whl"
+    plain.write_bytes(b"six wheel")
+    import zipfile
+
+    archive = tmp_path / "bundle.whl"
+    with zipfile.ZipFile(archive, "w") as z:
+        z.writestr("bundle/pyodide/numpy-2.0.2-wasm32.whl", b"numpy wheel")
+    entries = {
+        "six": {"file_name": plain.name, "sha256": _sha(b"six wheel")},
+        "numpy": {"file_name": "numpy-2.0.2-wasm32.whl", "sha256": _sha(b"numpy wheel")},
+    }
+    sources = {plain.name: plain, "numpy-2.0.2-wasm32.whl": (archive, "bundle/pyodide/numpy-2.0.2-wasm32.whl")}
+    return entries, sources
+
+
+def test_verified_files_go_in(tmp_path):
+    entries, sources = _fake_lock(tmp_path)
+    done = lite.copy_lock_files(entries, sources, tmp_path / "site")
+    assert sorted(p.name for p in done) == ["numpy-2.0.2-wasm32.whl", "six-1.0-py3-none-any.whl"]
+    assert (tmp_path / "site" / "numpy-2.0.2-wasm32.whl").read_bytes() == b"numpy wheel"
+
+
+@pytest.mark.parametrize("where", ["plain", "zip"])
+def test_a_tampered_file_stops_the_build_and_stays_out(tmp_path, where):
+    entries, sources = _fake_lock(tmp_path)
+    if where == "plain":
+        sources["six-1.0-py3-none-any.whl"].write_bytes(b"six wheel, tampered")
+        bad, got = "six-1.0-py3-none-any.whl", _sha(b"six wheel, tampered")
+    else:
+        import zipfile
+
+        with zipfile.ZipFile(tmp_path / "bundle.whl", "w") as z:
+            z.writestr("bundle/pyodide/numpy-2.0.2-wasm32.whl", b"numpy wheel, tampered")
+        bad, got = "numpy-2.0.2-wasm32.whl", _sha(b"numpy wheel, tampered")
+    expected = next(e["sha256"] for e in entries.values() if e["file_name"] == bad)
+    with pytest.raises(lite.IntegrityError) as err:
+        lite.copy_lock_files(entries, sources, tmp_path / "site")
+    msg = str(err.value)
+    assert bad in msg and f"expected {expected}" in msg and f"got {got}" in msg, msg
+    assert not (tmp_path / "site" / bad).exists(), "a file that failed its check was left in the site"
+
+
+def test_a_missing_file_stops_the_build(tmp_path):
+    entries, sources = _fake_lock(tmp_path)
+    del sources["six-1.0-py3-none-any.whl"]
+    with pytest.raises(lite.IntegrityError, match=r"six-1\.0-py3-none-any\.whl.*missing"):
+        lite.copy_lock_files(entries, sources, tmp_path / "site")
+    (tmp_path / "gone.whl").unlink(missing_ok=True)
+    with pytest.raises(lite.IntegrityError, match=r"gone\.whl.*missing"):
+        lite.verify_file(tmp_path / "gone.whl", _sha(b""))
+
+
+def test_the_site_lock_keeps_what_is_shipped_and_refuses_a_missing_dependency():
+    official = {
+        "info": {"version": "0.27.7"},
+        "packages": {
+            "numpy": {"name": "numpy", "version": "2.0.2", "depends": []},
+            "matplotlib": {"name": "matplotlib", "version": "3.8.4", "depends": ["numpy", "Pillow"]},
+            "pillow": {"name": "pillow", "version": "10.2.0", "depends": []},
+            "scipy": {"name": "scipy", "version": "1.14.1", "depends": ["numpy"]},
+        },
+    }
+    lock = lite.site_lock(official, ["matplotlib"], {"kinlib": {"name": "kinlib", "depends": ["matplotlib"]}})
+    assert sorted(lock["packages"]) == ["kinlib", "matplotlib", "numpy", "pillow"]
+    with pytest.raises(lite.IntegrityError, match="ipywidgets"):
+        lite.site_lock(official, ["numpy"], {"kinlib": {"name": "kinlib", "depends": ["numpy", "ipywidgets"]}})
+
+
+# ---------------------------------------------------------------------------------------------------
+# links and serving
+
+
+def test_lite_link_form():
+    assert lite.lite_link(WORKBOOK) == "lite/notebooks/index.html?path=workbooks/05_singularities_planar.ipynb"
+    assert lite.lite_link("solutions/a b.ipynb") == "lite/notebooks/index.html?path=solutions/a%20b.ipynb"
+    for bad in ("/etc/x.ipynb", "../x.ipynb", "workbooks/x.py", "a\\b.ipynb", "a//b.ipynb", ""):
+        with pytest.raises(ValueError, match="relpath"):
+            lite.lite_link(bad)
+    with pytest.raises(TypeError, match="relpath"):
+        lite.lite_link(Path(WORKBOOK))
+
+
+def test_serve_loopback_mime_types_no_cache(tmp_path):
+    for name in ("a.wasm", "b.mjs", "c.json", "d.js", "e.ipynb"):
+        (tmp_path / name).write_text("{}")
+    server = lite.serve(tmp_path, 0, block=False)
+    try:
+        host, port = server.server_address[:2]
+        assert host == "127.0.0.1"
+        want = {
+            "a.wasm": "application/wasm",
+            "b.mjs": "text/javascript",
+            "c.json": "application/json",
+            "d.js": "text/javascript",
+            "e.ipynb": "application/json",
+        }
+        for name, mime in want.items():
+            r = urllib.request.urlopen(f"http://127.0.0.1:{port}/{name}")
+            assert r.headers["Content-Type"].split(";")[0] == mime, name
+            assert r.headers["Cache-Control"] == "no-store"
+    finally:
+        server.shutdown()
+        server.server_close()
+    with pytest.raises(FileNotFoundError, match="folder"):
+        lite.serve(tmp_path / "nope", 0, block=False)
+
+
+# ---------------------------------------------------------------------------------------------------
+# the pinned table against the official lock (when the downloads are cached)
+
+
+def test_pinned_table_is_well_formed_and_agrees_with_environment_txt():
+    """One row per file, a full sha256 each; the PyPI wheels of the kernel are the versions the project's own
+    environment pins (environment.txt), so the browser runs what the tests run, numpy/matplotlib aside."""
+    assert [p.role for p in lite.SOURCES].count("core") == 1 and lite.PYODIDE_NPM.registry == "npm"
+    for p in lite.SOURCES:
+        assert re.fullmatch(r"[0-9a-f]{64}", p.sha256), p
+        assert p.registry in ("npm", "pypi"), p
+    env = {}
+    for line in (ROOT / "environment.txt").read_text().splitlines():
+        m = re.match(r"^([A-Za-z0-9_.-]+)==(\S+)", line)
+        if m:
+            env[re.sub(r"[-_.]+", "-", m[1]).lower()] = m[2]
+    for p in (*lite.PYPI_WHEELS, lite.WIDGETS_EXTENSION):
+        name = re.sub(r"[-_.]+", "-", p.name).lower()
+        assert env.get(name) == p.version, f"{p.name} {p.version} in lite.py, {env.get(name)} in environment.txt"
+
+
+def _official_lock() -> dict:
+    pkg = lite.cache_dir() / "npm" / f"pyodide-{lite.PYODIDE_VERSION}" / "package" / "pyodide-lock.json"
+    if not pkg.is_file():
+        pytest.skip(f"no cached Pyodide npm package in {pkg.parents[1]} (make handouts downloads it once)")
+    lite.verify_file(pkg, lite.CORE_FILES["pyodide-lock.json"], "pinned")
+    return json.loads(pkg.read_text())
+
+
+def test_pinned_table_matches_the_official_lock():
+    lock = _official_lock()
+    assert lock["info"]["version"] == lite.PYODIDE_VERSION == lite.SUPPORTED["pyodide"]
+    assert lock["info"]["python"] == lite.SUPPORTED["python"]
+    packages = lock["packages"]
+    for name in ("numpy", "matplotlib"):  # the wasm builds kinlib runs on in the browser
+        assert packages[name]["version"] == lite.SUPPORTED[name], name
+    # every pinned PyPI wheel: the version kinlib supports there
+    pins = {p.name: p for p in lite.PYPI_WHEELS}
+    for name in ("sympy", "mpmath", "ipywidgets"):
+        assert pins[name].version == lite.SUPPORTED[name], name
+    assert pins["mpmath"].version == packages["mpmath"]["version"], "mpmath: the version Pyodide ships"
+    # sympy: the same pin as environment.txt (the lock's own sympy is older)
+    env = (ROOT / "environment.txt").read_text()
+    assert re.search(rf"^sympy=={re.escape(pins['sympy'].version)}$", env, re.M), (
+        "sympy pin differs from environment.txt"
+    )
+    for name, (_imports, depends) in lite.EXTRA_LOCK.items():
+        for d in depends:
+            assert d in packages or d in lite.EXTRA_LOCK, f"{name} depends on {d}: neither shipped nor in the lock"
+    # every wheel file of the shipped packages is in the wheel archive and matches (checked without a build)
+    archive = lite.cache_dir() / "pypi" / lite.WHEEL_ARCHIVE.filename
+    if not archive.is_file():
+        pytest.skip(f"no cached {archive.name}")
+    lock_cut = lite.site_lock(lock, lite.PYODIDE_PACKAGES, {})
+    members = lite._archive_members(archive)
+    missing = [v["file_name"] for v in lock_cut["packages"].values() if v["file_name"] not in members]
+    assert not missing, f"not in {archive.name}: {missing}"
+
+
+# ---------------------------------------------------------------------------------------------------
+# the site in the browser
+
+_READY = """() => {
+  const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;
+  const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;
+  return !!k && k.status === 'idle' && !!w.content && w.content.widgets.length > 0;
+}"""
+_FIRST_PICTURE = """() => Array.from(document.querySelectorAll('.jp-OutputArea-output img')).some(
+  i => i.complete && i.naturalWidth >= 100)"""
+
+
+def expose_app(site: Path) -> None:
+    """Let the test reach ``window.jupyterapp`` (JupyterLite's ``exposeAppInBrowser``) in a site built for it."""
+    cfg = site / "lite" / "jupyter-lite.json"
+    data = json.loads(cfg.read_text())
+    data["jupyter-config-data"]["exposeAppInBrowser"] = "true"
+    cfg.write_text(json.dumps(data, indent=2))
+
+
+class Blocker:
+    """Aborts and counts every request that is not to ``base`` (the loopback server) or a page-made URL."""
+
+    def __init__(self, context, base: str):
+        self.base, self.blocked = base, []
+
+        def route(r):
+            url = r.request.url
+            if url.startswith((self.base, "data:", "blob:")):
+                r.continue_()
+            else:
+                self.blocked.append(url)
+                r.abort()
+
+        context.route("**/*", route)
+
+
+def open_workbook(browser, base: str, relpath: str = WORKBOOK, timeout: float = 180):
+    """A fresh context and page on the site's notebook ``relpath``, its kernel idle. Returns (context, page,
+    blocker, seconds from navigation start to the kernel idle in the page's clock)."""
+    context = browser.new_context(viewport={"width": 1400, "height": 1000})
+    blocker = Blocker(context, base)
+    page = context.new_page()
+    page.goto(base + lite.lite_link(relpath), wait_until="domcontentloaded")
+    page.wait_for_function(_READY, timeout=timeout * 1000, polling=200)
+    return context, page, blocker, page.evaluate("() => performance.now()") / 1000
+
+
+def time_to_first_result(handouts: Path, browser=None) -> float:
+    """Seconds from opening workbook 05 of the site in ``handouts`` (``build/handouts``, with ``lite/``) to its
+    first picture, running all cells as soon as the kernel is ready (page clock; ``make bench`` reports it).
+    The site is served from a hard-linked copy whose ``jupyter-lite.json`` exposes the app to the driver."""
+    import os
+    import tempfile
+
+    import labdriver
+
+    with tempfile.TemporaryDirectory(prefix="kinlib-ttfr-") as tmp:
+        site = Path(tmp) / "handouts"
+
+        def link(src, dst):  # hard links where the file system allows, else copies
+            try:
+                os.link(src, dst)
+            except OSError:
+                shutil.copy2(src, dst)
+
+        shutil.copytree(Path(handouts), site, copy_function=link)
+        cfg = site / "lite" / "jupyter-lite.json"
+        text = cfg.read_text()
+        cfg.unlink()  # a new file: never write through the hard link into the real site
+        cfg.write_text(text)
+        expose_app(site)
+        server = lite.serve(site, 0, block=False)
+        base = f"http://127.0.0.1:{server.server_address[1]}/"
+        try:
+            if browser is None:
+                with labdriver.chromium() as b:
+                    return _first_result(b, base)
+            return _first_result(browser, base)
+        finally:
+            server.shutdown()
+            server.server_close()
+
+
+def _first_result(browser, base: str) -> float:
+    context, page, _blocker, _ready = open_workbook(browser, base)
+    try:
+        page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
+        page.wait_for_function(_FIRST_PICTURE, timeout=180000, polling=100)
+        return page.evaluate("() => performance.now()") / 1000
+    finally:
+        context.close()
+
+
+_SCROLL_TO_EXPLORER = """async () => {
+  const w = window.jupyterapp.shell.currentWidget;
+  const i = w.content.widgets.findIndex(c => c.model.type === 'code'
+    && c.model.sharedModel.getSource().includes('widgets.explorer(')
+    && c.model.outputs.toJSON().some(o => o.data && o.data['application/vnd.jupyter.widget-view+json']));
+  if (i < 0) return i;
+  await w.content.scrollToItem(i, 'start');  // the notebook app draws only the cells in view ("full" windowing)
+  w.content.widgets[i].node.setAttribute('data-kinlib-explorer', String(i));
+  return i;
+}"""
+
+
+def explorer(page, timeout: float = 120):
+    """The output area of the notebook's first explorer, scrolled into view and rendered."""
+    i = page.evaluate(_SCROLL_TO_EXPLORER)
+    assert i >= 0, "the notebook shows no explorer (no `widgets.explorer(` cell with a widget output)"
+    area = page.locator(f"[data-kinlib-explorer='{i}'] .jp-OutputArea").first
+    area.locator(".jupyter-widgets").first.wait_for(state="visible", timeout=timeout * 1000)
+    assert labdriver_explorer_text() in area.text_content(), "the explorer's widget did not render"
+    return area
+
+
+_NEW_PICTURE = """([img, before]) => img.src !== before && img.complete && img.naturalWidth > 0"""
+
+
+def drag(page, area, handle, dx: float = 25, timeout: float = 120) -> float:
+    """Drag the slider ``handle`` by ``dx`` px with the mouse (as a pointer user does; the arrow keys are tested
+    too); wait until the explorer's picture in ``area`` is a new one. Returns the milliseconds from
+    the mouse release to the new picture, in the page's clock."""
+    img = area.locator("img").first
+    before = img.get_attribute("src")
+    box = handle.bounding_box()
+    x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
+    page.mouse.move(x, y)
+    page.mouse.down()
+    page.mouse.move(x + dx, y, steps=5)
+    t0 = page.evaluate("() => performance.now()")
+    page.mouse.up()
+    page.wait_for_function(_NEW_PICTURE, arg=[img.element_handle(), before], timeout=timeout * 1000, polling=50)
+    return page.evaluate("() => performance.now()") - t0
+
+
+def labdriver_explorer_text() -> str:
+    import labdriver
+
+    return labdriver.EXPLORER_TEXT
+
+
+@pytest.fixture(scope="module")
+def handouts_site(tmp_path_factory):
+    """Handouts of notebook 05 with the site, built as ``make handouts`` builds them (a download the first
+    time, into the cache; offline after), with the app reachable from the test."""
+    from kinlib.course import handouts
+    from kinlib.course.pages import build_assets
+
+    out = tmp_path_factory.mktemp("lite") / "handouts"
+    t0 = time.perf_counter()
+    nb = NOTEBOOKS / "05_singularities_planar.ipynb"
+    urls = build_assets(out / "assets", VENDOR)
+    handouts.build_one(nb, out, urls, 300, False, log=lambda s: None)  # the workbook, as handouts.build makes it
+    solutions = sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+    lite.build_lite(out, solutions, log=print)  # what handouts.build then calls
+    print(f"\nhandouts 05 + lite site built in {time.perf_counter() - t0:.1f} s")
+    expose_app(out)
+    return out
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+def test_workbook_05_runs_offline_in_jupyterlite(handouts_site):
+    import labdriver
+
+    site = handouts_site
+    size = sum(p.stat().st_size for p in (site / "lite").rglob("*") if p.is_file())
+    print(f"site: {size / 1e6:.0f} MB")
+    server = lite.serve(site, 0, block=False)
+    base = f"http://127.0.0.1:{server.server_address[1]}/"
+    try:
+        with labdriver.chromium() as browser:
+            context, page, blocker, ready = open_workbook(browser, base)
+            errors = []
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            try:
+                # 1. every cell runs (nothing raises), with nothing fetched from outside the site
+                seconds = labdriver.run_all(page, timeout=300)
+                first = page.evaluate("() => performance.now()") / 1000
+                print(f"kernel ready {ready:.1f} s after page load; run-all {seconds:.1f} s (done at {first:.1f} s)")
+
+                # 2. a student fills one answer (5.1, det J) and its self-check says so
+                cell = labdriver.output_of(page, "detJ = ...")
+                assert cell is not None, "workbook 05 has no `detJ = ...` stub"
+                page.evaluate(
+                    """() => {
+                      const w = window.jupyterapp.shell.currentWidget;
+                      const i = w.content.widgets.findIndex(c => c.model.sharedModel.getSource().includes('detJ = ...'));
+                      w.content.widgets[i].model.sharedModel.setSource(
+                        'th1, th2, th3 = robot.thetas\\n(L,) = robot.params\\n'
+                        + 'detJ = sp.sqrt(2) * L**2 * sp.sin(th2 + sp.pi / 4)\\n');
+                      w.content.activeCellIndex = i;
+                      const j = w.content.widgets.findIndex(c => c.model.sharedModel.getSource().includes('check("5.1"'));
+                      w.content.widgets.forEach((c, k) => { if (k === i || k === j) w.content.select(c); });
+                      return window.jupyterapp.commands.execute('notebook:run-cell');
+                    }"""
+                )
+                check = labdriver.output_of(page, 'check("5.1"')
+                page.wait_for_function(
+                    "(root) => /detJ:[^\\n]*correct/.test(root.innerText) && !/detJ:[^\\n]*not answered/.test(root.innerText)",
+                    arg=check.element_handle(),
+                    timeout=60000,
+                    polling=200,
+                )
+                text = check.inner_text()
+                line = next(s for s in text.splitlines() if "detJ" in s)
+                assert "not right" not in line and "correct" in line, text
+                labdriver.scroll_to(check)
+                SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+                check.screenshot(path=str(SCREENSHOTS / "lite-05-selfcheck.png"))
+
+                # 3. an explorer: drag θ1 and the picture changes
+                ex = explorer(page)
+                labdriver.wait_picture(ex, timeout=120, what="the explorer in JupyterLite")
+                before = ex.locator("img").first.get_attribute("src")
+                _slider, handle, readout = labdriver.slider(ex, "θ1")
+                value = readout.inner_text()
+                ms = drag(page, ex, handle)
+                assert readout.inner_text() != value, "the slider did not move"
+                assert ex.locator("img").first.get_attribute("src") != before, "the picture did not change"
+                print(f"slider move → new picture {ms:.0f} ms")
+                # and from the keyboard, as in JupyterLab (the site drops the ←/→ heading bindings that would
+                # take the keys first: lite.SETTINGS_OVERRIDES)
+                img = ex.locator("img").first
+                for key in ("ArrowRight", "ArrowLeft"):
+                    value, before = readout.inner_text(), img.get_attribute("src")
+                    handle.focus()
+                    handle.press(key)
+                    page.wait_for_function(_NEW_PICTURE, arg=[img.element_handle(), before], timeout=120000)
+                    assert readout.inner_text() != value, f"{key} on the focused slider did not move it"
+                ex.screenshot(path=str(SCREENSHOTS / "lite-05-explorer.png"))
+                assert not errors, f"page errors: {errors[:3]}"
+            finally:
+                context.close()
+            assert not blocker.blocked, f"the site asked for {len(blocker.blocked)} outside URLs: {blocker.blocked[:5]}"
+            t = time_to_first_result(site, browser)
+            print(f"time to first result (page load → first picture, run-all at once): {t:.1f} s")
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+@pytest.mark.parametrize("stem", sorted(p.stem for p in NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")))
+def test_solution_notebook_runs_in_the_browser(handouts_site, stem):
+    """Every solution notebook runs top to bottom in the site, its check cells included: kinlib works on the
+    browser's numpy and matplotlib (lite.SUPPORTED: numpy 2.0.2, matplotlib 3.8.4), nothing fetched outside."""
+    import labdriver
+
+    server = lite.serve(handouts_site, 0, block=False)
+    base = f"http://127.0.0.1:{server.server_address[1]}/"
+    try:
+        with labdriver.chromium() as browser:
+            context, page, blocker, ready = open_workbook(browser, base, f"solutions/{stem}.ipynb")
+            try:
+                seconds = labdriver.run_all(page, timeout=400)
+                print(f"\n{stem} (solutions) in JupyterLite: kernel ready {ready:.1f} s, run-all {seconds:.1f} s")
+            finally:
+                context.close()
+            assert not blocker.blocked, f"asked for outside URLs: {blocker.blocked[:5]}"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+def _cached() -> bool:
+    c = lite.cache_dir()
+    npm = c / "npm" / lite.PYODIDE_NPM.filename
+    return npm.is_file() and all((c / "pypi" / p.filename).is_file() for p in lite.SOURCES if p.registry == "pypi")
+
+
+@pytest.fixture(scope="module")
+def built_site(tmp_path_factory):
+    """A site holding solution notebook 05 only, built offline from the cache (skipped when nothing is cached)."""
+    if not _cached():
+        pytest.skip(f"the pinned downloads are not cached in {lite.cache_dir()} (make handouts fetches them once)")
+    out = tmp_path_factory.mktemp("site") / "handouts"
+    lite.build_lite(out, [NOTEBOOKS / "05_singularities_planar.ipynb"], log=lambda s: None)
+    return out / "lite"
+
+
+@pytest.mark.slow
+def test_the_built_site_holds_only_verified_pinned_files(built_site):
+    site = built_site
+    pyo = site / "static" / "pyodide"
+    lock = json.loads((pyo / "pyodide-lock.json").read_text())
+    # what kinlib is said to run on is what the site's lock ships
+    assert lock["info"]["version"] == lite.SUPPORTED["pyodide"] and lock["info"]["python"] == lite.SUPPORTED["python"]
+    for name in ("numpy", "matplotlib", "sympy", "mpmath", "ipywidgets"):
+        assert lock["packages"][name]["version"] == lite.SUPPORTED[name], name
+    # every package file is there, with the sha256 its lock entry names; nothing else but the pinned core
+    shipped = {e["file_name"]: e["sha256"] for e in lock["packages"].values()}
+    for fn, sha in shipped.items():
+        lite.verify_file(pyo / fn, sha)
+    for f in pyo.iterdir():
+        assert f.name in shipped or f.name in lite.CORE_FILES, f"unpinned file in the site: {f.name}"
+    # the notebooks open on the Pyodide kernel
+    nb = json.loads((site / "files" / "solutions" / "05_singularities_planar.ipynb").read_text())
+    assert nb["metadata"]["kernelspec"]["name"] == "python"
+
+
+@pytest.mark.slow
+def test_no_developer_settings_in_the_site(built_site):
+    """The site's settings are its own (its overrides are exactly lite.SETTINGS_OVERRIDES: nothing from
+    sys.prefix, home or notebooks/.lab-settings), its extensions are the kernel's and the widgets', and its URLs
+    are relative (no outside fetch)."""
+    site = built_site
+    cfg = json.loads((site / "jupyter-lite.json").read_text())["jupyter-config-data"]
+    assert cfg.get("settingsOverrides") == lite.SETTINGS_OVERRIDES, "settings overrides other than the site's own"
+    for f in site.rglob("overrides.json"):
+        assert json.loads(f.read_text()) == lite.SETTINGS_OVERRIDES, f"foreign settings overrides in {f}"
+    names = sorted(e["name"] for e in cfg["federated_extensions"])
+    assert names == ["@jupyter-widgets/jupyterlab-manager", "@jupyterlite/pyodide-kernel-extension"], names
+    settings = cfg["litePluginSettings"]["@jupyterlite/pyodide-kernel-extension:kernel"]
+    assert settings["pyodideUrl"].startswith("./") and settings["disablePyPIFallback"] is True
+    assert all(u.startswith("./") for u in settings.get("pipliteUrls", []))
+    text = "\n".join(p.read_text(errors="replace") for p in site.rglob("*.json") if p.stat().st_size < 2_000_000)
+    assert str(ROOT) not in text and str(Path.home()) + "/" not in text, "a local path leaked into the site"
