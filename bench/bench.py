@@ -828,6 +828,20 @@ print(json.dumps({"n": s["n"], "seconds": s["seconds"], "reference_seconds": s["
 T_GRADE_200 = 8 * 60.0  # 200 workbooks, 2 cores, sandbox on
 
 
+def _browser_driver():
+    """(tests/labdriver.py, None) when playwright and Debian's chromium are there, else (None, why not)."""
+    sys.path.insert(0, str(ROOT / "tests"))
+    try:
+        import playwright  # noqa: F401
+
+        import labdriver
+    except ImportError as exc:
+        return None, str(exc)
+    if not Path(labdriver.CHROMIUM).exists():
+        return None, f"{labdriver.CHROMIUM} is missing: `make chromium`"
+    return labdriver, None
+
+
 def browser_section(args, targets: Targets) -> list[str]:
     """JupyterLab in Debian's chromium, started as `make lab` does (tests/labdriver.py): per notebook, Run All
     Cells (command → the kernel's last reply), then 20 key presses on each explorer's θ1 slider, each timed
@@ -842,17 +856,10 @@ def browser_section(args, targets: Targets) -> list[str]:
     ]
     if args.quick:
         return lines + ["skipped (--quick)"]
-    sys.path.insert(0, str(ROOT / "tests"))
-    try:
-        import playwright  # noqa: F401
-
-        import labdriver
-    except ImportError as exc:
+    labdriver, missing = _browser_driver()
+    if missing:
         targets.upper("run-all in JupyterLab", None, T_LAB_RUN_ALL)
-        return lines + [f"{NA} ({exc})"]
-    if not Path(labdriver.CHROMIUM).exists():
-        targets.upper("run-all in JupyterLab", None, T_LAB_RUN_ALL)
-        return lines + [f"{NA} ({labdriver.CHROMIUM} is missing: `make chromium`)"]
+        return lines + [f"{NA} ({missing})"]
     stems = [p.stem for p in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))]
     run_rows, slider_rows = [], []
     with tempfile.TemporaryDirectory() as tmp, labdriver.jupyterlab(Path(tmp)) as url, labdriver.chromium() as b:
@@ -906,18 +913,16 @@ def lite_section(args, targets: Targets) -> list[str]:
     ]
     if args.quick:
         return lines + ["skipped (--quick)"]
-    sys.path.insert(0, str(ROOT / "tests"))
+    labdriver, missing = _browser_driver()
     try:
-        import labdriver
         import test_lite
         from kinlib.course import handouts, lite
         from kinlib.course.pages import build_assets
     except ImportError as exc:
+        missing = missing or str(exc)
+    if missing:
         targets.upper("JupyterLite: time to first result", None, T_LITE_FIRST)
-        return lines + [f"{NA} ({exc})"]
-    if not Path(labdriver.CHROMIUM).exists():
-        targets.upper("JupyterLite: time to first result", None, T_LITE_FIRST)
-        return lines + [f"{NA} ({labdriver.CHROMIUM} is missing: `make chromium`)"]
+        return lines + [f"{NA} ({missing})"]
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "handouts"
         t0 = time.perf_counter()

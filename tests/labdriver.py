@@ -127,6 +127,22 @@ def jupyterlab(work: Path, notebooks: Path = NOTEBOOKS, *, trust: bool = True, t
         log.close()
 
 
+def handouts_are_fresh(out: Path, stems, *, pdf: bool = False) -> bool:
+    """``out`` (build/handouts) was written after the last change to any notebook or kinlib module and has the
+    problems and solutions page of every notebook in ``stems`` (with ``pdf``, their PDFs too): `make handouts`
+    just ran, so a test can look at what it made instead of building again."""
+    index = Path(out) / "index.html"
+    if not index.exists():
+        return False
+    sources = list(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")) + list((ROOT / "kinlib").rglob("*.py"))
+    if max(p.stat().st_mtime for p in sources) >= index.stat().st_mtime:
+        return False
+    kinds = ("problems", "solutions")
+    return all((Path(out) / k / f"{s}.html").exists() for s in stems for k in kinds) and (
+        not pdf or all((Path(out) / "pdf" / k / f"{s}.pdf").exists() for s in stems for k in kinds)
+    )
+
+
 @contextmanager
 def chromium():
     """Debian's chromium through playwright (never a downloaded browser build)."""

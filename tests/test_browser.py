@@ -56,7 +56,7 @@ def _page_id(p):
 # fixtures
 
 
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")  # closed with the module: a later module may start playwright (one per thread)
 def browser():
     if not Path(CHROMIUM).exists():
         pytest.fail(f"{CHROMIUM} is missing: `make chromium` (or apt-get install chromium) installs Debian's")
@@ -87,7 +87,7 @@ def sites(tmp_path_factory):
         out["handouts"] = Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
     elif REAL:
         built = ROOT / "build" / "handouts"
-        if _fresh(built):  # `make handouts` just ran: test what it made
+        if labdriver.handouts_are_fresh(built, REAL):  # `make handouts` just ran: test what it made
             out["handouts"] = built
         else:
             try:
@@ -96,17 +96,6 @@ def sites(tmp_path_factory):
             except handouts.NotebookFailed as e:
                 out["handouts"] = e
     return out
-
-
-def _fresh(built: Path) -> bool:
-    """build/handouts is newer than every notebook and kinlib module, and has every notebook's pages."""
-    index = built / "index.html"
-    if not index.exists():
-        return False
-    sources = list(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")) + list((ROOT / "kinlib").rglob("*.py"))
-    if max(p.stat().st_mtime for p in sources) >= index.stat().st_mtime:
-        return False
-    return all((built / k / f"{s}.html").exists() for s in REAL for k in ("problems", "solutions"))
 
 
 def _site(sites, name):

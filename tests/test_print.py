@@ -29,6 +29,7 @@ from pathlib import Path
 
 import pytest
 
+import labdriver
 from kinlib.course import handouts, pages, printing
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -64,23 +65,12 @@ def built(tmp_path_factory) -> Path:
     if os.environ.get("KINLIB_HANDOUTS_DIR"):
         return Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
     out = ROOT / "build" / "handouts"
-    if not _fresh(out):
+    if not labdriver.handouts_are_fresh(out, REAL, pdf=True):
         handouts.build(NOTEBOOKS, out, vendor=VENDOR, jobs=2, verify=False, log=lambda s: None)
     return out
 
 
-def _fresh(out: Path) -> bool:
-    """build/handouts is newer than every notebook and kinlib module and has every page and PDF."""
-    index = out / "index.html"
-    if not index.exists():
-        return False
-    sources = list(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")) + list((ROOT / "kinlib").rglob("*.py"))
-    if max(p.stat().st_mtime for p in sources) >= index.stat().st_mtime:
-        return False
-    return all((out / k / f"{s}.html").exists() and (out / "pdf" / k / f"{s}.pdf").exists() for k, s in PAGES)
-
-
-@pytest.fixture(scope="session")
+@pytest.fixture(scope="module")  # closed with the module: a later module may start playwright (one per thread)
 def browser():
     from playwright.sync_api import sync_playwright
 
