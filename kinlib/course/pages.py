@@ -14,6 +14,7 @@ import shutil
 import time
 from pathlib import Path
 
+from .lite import lite_link
 from .npm import npm_pack
 
 __all__ = [
@@ -208,12 +209,6 @@ def _code_colours(body: str, background: str = "#f5f5f5", target: float = 4.6) -
     )
 
 
-def _lite_link(relpath: str) -> str:
-    from .lite import lite_link  # kinlib.course.lite imports this module: import it when used
-
-    return lite_link(relpath)
-
-
 def print_header(stem: str, title: str, problems: bool) -> str:
     """The header of each printed page of a handout: course, section number, title and which handout.
 
@@ -288,7 +283,7 @@ def _print_and_links(body: str, nb, dest: Path, *, title: str, problems: bool, l
         bar_links.append((f"../pdf/{kind}/{stem}.pdf", f"PDF of this page ({kind})"))
     if "lite" in links:
         bar_links.append(
-            ("../" + _lite_link(notebook), f"Open {which} in the browser (JupyterLite, nothing to install)")
+            ("../" + lite_link(notebook), f"Open {which} in the browser (JupyterLite, nothing to install)")
         )
     if problems:
         bar_links.append((f"../workbooks/{stem}.ipynb", "Download the workbook (.ipynb)"))
@@ -376,14 +371,14 @@ def write_index(out: Path, entries: list, links=LINKS) -> None:
             + f"<li>{a(f'solutions/{stem}.html', f'Solutions {num} (web page)')}"
             + (f"{sep}{a(f'pdf/solutions/{stem}.pdf', f'Solutions {num} (PDF)')}" if pdf else "")
             + (
-                f"{sep}{a(_lite_link(f'solutions/{stem}.ipynb'), f'Solutions {num}: open the notebook in the browser')}"
+                f"{sep}{a(lite_link(f'solutions/{stem}.ipynb'), f'Solutions {num}: open the notebook in the browser')}"
                 if lite
                 else ""
             )
             + "</li>\n"
             + f"<li>{a(f'workbooks/{stem}.ipynb', f'Workbook {num} (download .ipynb)', ' download')}"
             + (
-                f"{sep}{a(_lite_link(f'workbooks/{stem}.ipynb'), f'Workbook {num}: open in the browser')}"
+                f"{sep}{a(lite_link(f'workbooks/{stem}.ipynb'), f'Workbook {num}: open in the browser')}"
                 if lite
                 else ""
             )
