@@ -36,6 +36,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import json
+import shutil
 import subprocess
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -44,21 +45,25 @@ from pathlib import Path
 import nbformat
 
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
-from .pages import HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_index
+from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
 from .schema import (
     ANSWER_TAGS,
     CHECK,
+    HINT,
+    PREDICT_ANSWER,
     SELFCHECK,
     SELFCHECK_MODULES,
     SOLUTION,
     Group,
     answer_groups,
+    answer_kind,
     cell_answers,
     cell_meta,
     cell_part,
     cell_tags,
     notebook_sections,
     notebook_title,
+    set_source_hidden,
 )
 from .selfcheck import FINGERPRINT_MARK, emit_fingerprints
 
@@ -304,6 +309,35 @@ def _student_setup(cell, used) -> None:
         cell.source = trim_setup(cell.source, used)
 
 
+def graded_prediction(cell) -> str:
+    """The part a ``predict-answer`` cell gives the answer of (its ``metadata.kinlib.part``), or "".
+
+    Such an answer is shown in the solutions only; the problems and the workbook keep the folded cell with a
+    pointer to the part's self-check instead (:func:`_student_reading_aid`).
+
+    >>> graded_prediction({"metadata": {"tags": ["predict-answer"], "kinlib": {"part": "4.1"}}})
+    '4.1'
+    >>> graded_prediction({"metadata": {"tags": ["predict-answer"]}})
+    ''
+    """
+    return cell_part(cell_meta(cell)) if PREDICT_ANSWER in cell_tags(cell) else ""
+
+
+def _student_reading_aid(cell) -> None:
+    """In the problems and the workbook: hints and predict-answers folded; a graded prediction's answer
+    replaced by a pointer to the self-check of its part."""
+    tags = set(cell_tags(cell))
+    part = graded_prediction(cell)
+    if part:
+        cell.source = (
+            f"**Check your prediction** with the self-check of part {part} below (it says whether your answer "
+            "is right without showing it); the reasoning is in the solutions."
+        )
+        cell.pop("attachments", None)
+    if tags & {HINT, PREDICT_ANSWER}:
+        set_source_hidden(cell)
+
+
 def make_problems(executed) -> tuple:
     """The problem version of an executed notebook, and a list of notes on what was dropped.
 
@@ -352,6 +386,7 @@ def make_problems(executed) -> tuple:
     for i, c in enumerate(nb.cells):
         if dropped_cell(i, c):
             continue  # answers, worked-solution steps, what is computed from answers and its caption
+        _student_reading_aid(c)
         if c.cell_type == "code":
             _student_setup(c, used)  # the student's setup: not the imports that give the method away
             kept = [o for o in c.outputs if not _leaks(o, texts, images)]
@@ -373,6 +408,26 @@ def make_problems(executed) -> tuple:
 # ---------------------------------------------------------------------------------------------------
 
 
+# How to write the answer forms a student may not have met (shown under the stubs of those answers);
+# tests/test_notebook_structure.py checks that each example is accepted by the self-check's comparers.
+ANSWER_FORM_EXAMPLES = {
+    "set": (
+        "How to write a set of angles (SymPy sets; n is an integer symbol):",
+        "  a few values:       sp.FiniteSet(-sp.pi / 2, sp.pi / 2)",
+        "  a periodic family:  n = sp.Symbol('n', integer=True)",
+        "                      sp.ImageSet(sp.Lambda(n, sp.pi / 4 + n * sp.pi), sp.Integers)",
+        "  several families:   sp.Union(sp.ImageSet(...), sp.ImageSet(...));  none at all: sp.EmptySet",
+    ),
+    "choice": (
+        "How to write a choice: a joint number, 1-based (e.g. 2); if joints tie, a tuple of all of them (e.g. (1, 2)).",
+    ),
+    "subspace": (
+        "How to write a subspace: a Matrix whose columns span it, e.g. sp.Matrix([[1, 0], [0, 1], [0, 0]]) for the",
+        "x-y plane (any basis of the same span is right).",
+    ),
+}
+
+
 def _stub(cell, describe: dict) -> str:
     meta = cell_meta(cell)
     part = cell_part(meta)
@@ -386,6 +441,9 @@ def _stub(cell, describe: dict) -> str:
     for name in answers:
         what = ", ".join(x for x in (words.get(name), describe.get(name)) if x)
         lines.append(f"{name} = ...  # TODO: {what or 'your answer'} (part {part})")
+    examples = [answer_kind(meta, name) for name in answers]
+    for kind in dict.fromkeys(examples):
+        lines += [f"#   {line}" for line in ANSWER_FORM_EXAMPLES.get(kind, ())]
     return "\n".join(lines) + "\n"
 
 
@@ -458,6 +516,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
         elif i in narrative:
             pass
         else:
+            _student_reading_aid(cell)
             if i in needs:
                 cell.source = f"%%needs {' '.join(needs[i])}\n" + cell.source
             else:
@@ -521,7 +580,12 @@ def run_workbook(path: Path, timeout: int = 120):
 # The job
 
 
-def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log=print, links=LINKS) -> dict:
+AUDIENCES = ("all", "students")  # all: problems, solutions, workbooks; students: no solution in any form
+
+
+def build_one(
+    path: Path, out: Path, urls: dict, timeout: int, verify: bool, log=print, links=LINKS, audience: str = "all"
+) -> dict:
     """Execute one notebook and write its three handouts; return its index entry.
 
     It runs the notebook (and, with ``verify``, the workbook) in a Jupyter kernel (seconds;
@@ -539,9 +603,15 @@ def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log
     executed, groups, fps = execute_notebook(path, timeout)
     t_exec = time.perf_counter() - t0
     title = notebook_title(executed, stem.replace("_", " "))
-    export_html(
-        executed, out / "solutions" / f"{stem}.html", urls, title=f"{title} (solutions)", problems=False, links=links
-    )
+    if audience == "all":
+        export_html(
+            executed,
+            out / "solutions" / f"{stem}.html",
+            urls,
+            title=f"{title} (solutions)",
+            problems=False,
+            links=links,
+        )
     problems, notes = make_problems(executed)
     export_html(
         problems, out / "problems" / f"{stem}.html", urls, title=f"{title} (problems)", problems=True, links=links
@@ -585,12 +655,18 @@ def build(
     only: list | None = None,
     site: bool = True,
     pdfs: bool = True,
+    audience: str = "all",
     log=print,
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
     ``index.html``, ``problems/`` and ``solutions/`` (HTML), ``workbooks/`` (.ipynb), and unless switched off
     ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.lite.build_lite`) and ``pdf/`` (``pdfs``:
     every page printed by Chromium, :func:`kinlib.course.printing.print_pdfs`); the pages link only what is built.
+    ``reference/cheatsheet.html`` (and its PDF) is the one-page cheat sheet (``notebooks/cheatsheet.md``).
+
+    ``audience="students"`` leaves out every solution: no ``solutions/`` pages or PDFs, no solution notebooks
+    in the in-browser site, no link to them in the index (what a course publishes to its students; a
+    ``solutions/`` folder left in ``out`` by an earlier build is removed first).
 
     A folder without ``NN_*.ipynb`` notebooks is refused before anything is written:
 
@@ -609,6 +685,8 @@ def build(
     ['02_planar_robot_jacobian']
     """
     t0 = time.perf_counter()
+    if audience not in AUDIENCES:
+        raise ValueError(f"audience: expected one of {', '.join(AUDIENCES)}, got {audience!r}")
     notebooks, out = Path(notebooks), Path(out)
     links = tuple(k for k, on in (("pdf", pdfs), ("lite", site)) if on)
     paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
@@ -617,7 +695,10 @@ def build(
     if not paths:
         raise FileNotFoundError(f"no notebooks named NN_*.ipynb in {notebooks}")
     vendor = Path(vendor) if vendor else out.parent / "vendor"
-    log(f"kinlib handouts: {len(paths)} notebook(s) from {notebooks} -> {out}")
+    log(f"kinlib handouts: {len(paths)} notebook(s) from {notebooks} -> {out} (for {audience})")
+    if audience == "students":  # nothing of an earlier full build may stay behind
+        for stale in (out / "solutions", out / "pdf" / "solutions"):
+            shutil.rmtree(stale, ignore_errors=True)
     urls = build_assets(out / "assets", vendor)
     log(
         f"  assets: MathJax (jupyter-server-mathjax), require.js {REQUIREJS[1]}, "
@@ -627,10 +708,10 @@ def build(
     if jobs <= 1:
         for k, p in enumerate(paths, 1):
             log(f"[{k}/{len(paths)}] {p.name} ...")
-            entries[p] = build_one(p, out, urls, timeout, verify, log, links)
+            entries[p] = build_one(p, out, urls, timeout, verify, log, links, audience)
     else:
         with ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = {p: pool.submit(build_one, p, out, urls, timeout, verify, log, links) for p in paths}
+            futures = {p: pool.submit(build_one, p, out, urls, timeout, verify, log, links, audience) for p in paths}
             log(f"  running {len(paths)} notebooks, {jobs} at a time")
             try:
                 for p, f in futures.items():
@@ -639,16 +720,20 @@ def build(
                 for f in futures.values():
                     f.cancel()
                 raise
-    write_index(out, [entries[p] for p in paths], links)
+    sheet = notebooks / CHEATSHEET
+    if sheet.exists():
+        write_cheatsheet(sheet, out / "reference" / "cheatsheet.html", urls, links=links)
+    write_index(out, [entries[p] for p in paths], links, audience=audience, cheatsheet=sheet.exists())
     if site:
         from .lite import build_lite  # the notebooks in the browser (JupyterLite, offline): out/lite/
 
-        build_lite(out, paths, log=log)
+        build_lite(out, paths if audience == "all" else [], log=log)
     if pdfs:
         from .printing import print_pdfs  # the PDFs of the pages (chromium, offline): out/pdf/
 
         print_pdfs(out, log=log)
     log(
-        f"kinlib handouts: wrote {out / 'index.html'} and {3 * len(paths)} handouts in {time.perf_counter() - t0:.1f} s"
+        f"kinlib handouts: wrote {out / 'index.html'} and {(3 if audience == 'all' else 2) * len(paths)} handouts "
+        f"in {time.perf_counter() - t0:.1f} s"
     )
     return [entries[p] for p in paths]
