@@ -128,6 +128,8 @@ def test_workbook_keeps_the_help_and_no_solution(path):
     leaked = sorted(line for line in _answer_lines(nb) if line in text)
     assert not leaked, leaked[:5]
     assert not _with(wb, schema.CHECK)
+    for c in _with(wb, schema.SELFCHECK) + _with(wb, "workbook-setup"):  # machinery: folded, still run
+        assert schema.is_source_hidden(c)
 
 
 def _examples(lines) -> list:

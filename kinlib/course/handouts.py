@@ -330,8 +330,8 @@ def _student_reading_aid(cell) -> None:
     part = graded_prediction(cell)
     if part:
         cell.source = (
-            f"**Check your prediction** with the self-check of part {part} below (it says whether your answer "
-            "is right without showing it); the reasoning is in the solutions."
+            f"**Check your prediction** with the self-check of part {part} in the workbook: it says whether your "
+            "answer is right without showing it. The reasoning is in the solutions."
         )
         cell.pop("attachments", None)
     if tags & {HINT, PREDICT_ANSWER}:
@@ -529,6 +529,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
             f"%load_ext {SELFCHECK_MODULES[0]}\n# (cells marked %%needs run once the answers they use are filled in)"
         )
         setup.metadata["tags"] = ["workbook-setup"]
+        set_source_hidden(setup)  # machinery, not reading: folded (it still runs)
         first_code = next((k for k, c in enumerate(cells) if c.cell_type == "code"), len(cells))
         cells.insert(first_code, setup)
     nb.cells = cells
@@ -541,6 +542,7 @@ def _selfcheck_cell(group: Group, fps: dict, original):
     if original is not None and "kinlib" in original.metadata:
         cell.metadata["kinlib"] = copy.deepcopy(original.metadata["kinlib"])
     cell.metadata["tags"] = [SELFCHECK]
+    set_source_hidden(cell)  # the student reads its verdict, not its fingerprints and imports
     return cell
 
 

@@ -331,12 +331,14 @@ details.kinlib-predict-answer { border-left-color: #2e7d32; } details.kinlib-hin
     if (window.matchMedia && window.matchMedia("print").matches) { openAll(); }
   });
   window.addEventListener("beforeprint", openAll);
-  document.addEventListener("toggle", function (e) {
-    var d = e.target;
-    if (d.open && d.classList && d.classList.contains("kinlib-fold") && window.MathJax && MathJax.Hub) {
-      MathJax.Hub.Queue(["Rerender", MathJax.Hub, d]);
-    }
-  }, true);
+  document.addEventListener("click", function (e) {  /* a reader's click (or Enter) on a summary, not the parser */
+    var s = e.target && e.target.closest ? e.target.closest("details.kinlib-fold > summary") : null;
+    if (!s) { return; }
+    setTimeout(function () {
+      var d = s.parentNode;
+      if (d.open && window.MathJax && MathJax.Hub) { MathJax.Hub.Queue(["Rerender", MathJax.Hub, d]); }
+    }, 0);
+  });
 })();
 </script>
 """
@@ -363,12 +365,15 @@ def fold_cells(body: str, nb, *, problems: bool) -> str:
     >>> "<summary>Show the answer</summary>" in page, page.index("Guess?") < page.index("<details") < page.index("It is")
     (True, True)
     """
-    kinds = {}
+    kinds, titles = {}, {}
     for c in nb.cells:
         tags = set(cell_tags(c))
         for tag in (CHECK, PREDICT_ANSWER, HINT, MISTAKE, PREDICT):
             if tag in tags and c.get("id"):
                 kinds[c["id"]] = tag
+                bold = re.match(r"\s*\*\*(.+?)\*\*", c.get("source", "")) if c.get("cell_type") == "markdown" else None
+                if tag == HINT and bold:  # "Hint: Step 1: the screw axes", from the cell's bold lead
+                    titles[c["id"]] = "Hint: " + html.escape(bold.group(1).strip().rstrip(".:"))
                 break
     if not kinds:
         return body
@@ -387,7 +392,8 @@ def fold_cells(body: str, nb, *, problems: bool) -> str:
         if kind in _SUMMARIES:
             opened = " open" if kind == HINT and not problems else ""
             out.append(
-                f'<details class="kinlib-fold kinlib-{kind}"{opened}><summary>{_SUMMARIES[kind]}</summary>\n'
+                f'<details class="kinlib-fold kinlib-{kind}"{opened}>'
+                f"<summary>{titles.get(html.unescape(cid), _SUMMARIES[kind])}</summary>\n"
                 f"{cell}\n</details>\n"
             )
         else:
