@@ -469,6 +469,21 @@ def write_cheatsheet(src: Path, dest: Path, urls: dict, *, links=LINKS) -> None:
     nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell(text, id="cheatsheet")])
     urls = {"require_js_url": "../assets/require.js", **urls}
     export_html(nb, dest, urls, title=title, problems=False, links=tuple(k for k in links if k == "pdf"))
+    page = dest.read_text(encoding="utf-8")
+    dest.write_text(page.replace("</head>", _CHEATSHEET_PRINT + "</head>", 1), encoding="utf-8")
+
+
+# The cheat sheet prints on one A4 page: smaller type and tighter headings than a handout.
+_CHEATSHEET_PRINT = """<style>/* kinlib: the cheat sheet on one printed page */
+@media print {
+  .jp-RenderedHTMLCommon { font-size: 10.5px !important; line-height: 1.32 !important; }
+  .jp-RenderedHTMLCommon h1 { font-size: 17px !important; margin: 0 0 4px !important; }
+  .jp-RenderedHTMLCommon h2 { font-size: 13.5px !important; margin: 8px 0 3px !important; }
+  .jp-RenderedHTMLCommon p, .jp-RenderedHTMLCommon ul { margin-top: 2px !important; margin-bottom: 3px !important; }
+  .jp-RenderedHTMLCommon li { margin: 1px 0 !important; }
+}
+</style>
+"""
 
 
 def write_index(out: Path, entries: list, links=LINKS, *, audience: str = "all", cheatsheet: bool = False) -> None:
