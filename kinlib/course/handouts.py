@@ -23,6 +23,13 @@ For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with n
   filled in, and say "fix the answer above first" if they fail on a wrong one (``%%needs``,
   :mod:`kinlib.course.needs`); outputs cleared. Unless ``--no-verify``, each
   workbook is then run top to bottom (the stubs must not crash it);
+- the reading aids (``notebooks/README.md``) stay in the problems and the workbooks: objectives, summary,
+  ``predict`` questions with their folded ``predict-answer`` (one that gives a graded answer away becomes a
+  pointer to the part's self-check), folded ``hint`` steps, ``mistake`` callouts, ``given`` text; the pages fold
+  checks, answers and hints in ``<details>`` (:func:`kinlib.course.pages.fold_cells`); under a stub of an
+  answer form a student may not know (a set, a choice, a subspace) the workbook shows how to write it;
+- ``reference/cheatsheet.html``: the cheat sheet ``notebooks/cheatsheet.md``;
+- with ``--audience students`` no solution page, PDF or notebook at all (the folder to publish to students);
 - ``index.html`` linking everything, and ``assets/``: MathJax 2 (copied from the installed
   ``jupyter-server-mathjax``), require.js and the ``@jupyter-widgets/html-manager`` embed bundle
   (``npm pack`` from the npm registry into ``build/vendor`` once, then reused), so every page
