@@ -23,8 +23,9 @@ import nbformat
 import pytest
 import sympy as sp
 
-from kinlib.course import handouts, schema
-from kinlib.course.selfcheck import fingerprint
+from kinlib.course import schema
+from kinlib.course.publish import aids, handouts
+from kinlib.course.workbook.selfcheck import fingerprint
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
@@ -119,7 +120,7 @@ def test_workbook_keeps_the_help_and_no_solution(path):
         assert kept is not None, f"{c.get('id')} ({', '.join(sorted(aid))}) left out of the workbook"
         if tags & {schema.HINT, schema.PREDICT_ANSWER}:
             assert schema.is_source_hidden(kept), f"{c.get('id')}: not folded in the workbook"
-        if handouts.graded_prediction(c):
+        if aids.graded_prediction(c):
             assert "self-check of part" in kept.source and kept.source != c.source
         elif schema.PREDICT_ANSWER in tags or schema.HINT in tags:
             assert kept.source == c.source
@@ -163,16 +164,16 @@ def test_answer_form_examples_are_accepted():
     """What the stubs show is what the self-check compares as meant: a periodic family is the same set of
     angles as its members in one turn, a tie is a tuple in any order, a subspace any basis of the span."""
     env = {"sp": sp, "n": sp.Symbol("n", integer=True)}
-    sets = [eval(e, env) for e in _examples(handouts.ANSWER_FORM_EXAMPLES["set"])]  # noqa: S307 (our own text)
+    sets = [eval(e, env) for e in _examples(aids.ANSWER_FORM_EXAMPLES["set"])]  # noqa: S307 (our own text)
     assert any(isinstance(s, sp.ImageSet) for s in sets) and any(isinstance(s, sp.FiniteSet) for s in sets)
     family = next(s for s in sets if isinstance(s, sp.ImageSet))
     assert fingerprint(family, "set") == fingerprint(sp.FiniteSet(sp.pi / 4, -3 * sp.pi / 4), "set")
     finite = next(s for s in sets if isinstance(s, sp.FiniteSet))
     assert fingerprint(finite, "set") == fingerprint(sp.FiniteSet(3 * sp.pi / 2, sp.pi / 2), "set")
-    choice = " ".join(handouts.ANSWER_FORM_EXAMPLES["choice"])
+    choice = " ".join(aids.ANSWER_FORM_EXAMPLES["choice"])
     assert "(1, 2)" in choice and fingerprint((1, 2), "choice") == fingerprint((2, 1), "choice")
     assert fingerprint(2, "choice") != fingerprint((1, 2), "choice")
-    (basis,) = [eval(e, env) for e in _examples(handouts.ANSWER_FORM_EXAMPLES["subspace"])]  # noqa: S307
+    (basis,) = [eval(e, env) for e in _examples(aids.ANSWER_FORM_EXAMPLES["subspace"])]  # noqa: S307
     other = sp.Matrix([[1, 1], [1, -1], [0, 0]])
     assert fingerprint(basis, "subspace") == fingerprint(other, "subspace")
 
@@ -181,7 +182,7 @@ def test_stubs_show_the_examples():
     cell = nbformat.v4.new_code_cell(
         "x = 1", metadata={"tags": ["solution"], "kinlib": {"part": "5.1", "answers": ["x"], "kinds": {"x": "set"}}}
     )
-    stub = handouts._stub(cell, {})
+    stub = aids.stub(cell, {})
     assert "sp.ImageSet(sp.Lambda(n, sp.pi / 4 + n * sp.pi), sp.Integers)" in stub
     assert "x = ...  # TODO" in stub and "x = 1" not in stub
 
@@ -192,7 +193,7 @@ def test_stubs_show_the_examples():
 
 @pytest.fixture(scope="module")
 def students(tmp_path_factory, monkeypatch_module):
-    from kinlib.course import lite
+    from kinlib.course.publish import lite
 
     out = tmp_path_factory.mktemp("students") / "handouts"
     (out / "solutions").mkdir(parents=True)

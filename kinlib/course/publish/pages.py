@@ -14,9 +14,9 @@ import shutil
 import time
 from pathlib import Path
 
+from ..schema import CHECK, HINT, MISTAKE, PREDICT, PREDICT_ANSWER, cell_tags
 from .lite import lite_link
 from .npm import npm_pack
-from .schema import CHECK, HINT, MISTAKE, PREDICT, PREDICT_ANSWER, cell_tags
 
 __all__ = [
     "build_assets",
@@ -157,7 +157,7 @@ def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool, links
 
 
 # ---------------------------------------------------------------------------------------------------
-# What export_html adds to nbconvert's page: the print stylesheet and header (kinlib.course.printing), a bar
+# What export_html adds to nbconvert's page: the print stylesheet and header (kinlib.course.publish.printing), a bar
 # of links (index, PDF, workbook, "open in the browser"), and a text alternative for every figure.
 
 COURSE = "Problem Set 4"  # the course name in the PDF page headers

@@ -3,30 +3,30 @@ executed notebooks.
 
     kinlib handouts notebooks --out build/handouts [--jobs 2] [--timeout 120] [--no-verify] [--only 05]
 
-(the command line is :mod:`kinlib.course.cli`; the pages and assets are :mod:`kinlib.course.pages`).
+(the command line is :mod:`kinlib.course.cli`; the pages and assets are :mod:`kinlib.course.publish.pages`).
 
 For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with nbconvert) it writes
 
 - ``solutions/NN_*.html``: the whole notebook with its outputs;
 - ``problems/NN_*.html``: questions, narrative, the student's set-up and figures; left out: ``solution`` and
   ``check`` cells, the set-up's imports and helper functions that only they use (they would give the
-  method away: :func:`kinlib.course.analysis.trim_setup`), the untagged markdown inside a worked solution (between a ``question`` and the last
+  method away: :func:`kinlib.course.publish.analysis.trim_setup`), the untagged markdown inside a worked solution (between a ``question`` and the last
   ``solution``/``check`` cell answering it), cells that read answer variables (and their markdown
   caption just above), any output that repeats an answer cell's output; no prompt numbers; the saved
   widget state pruned to the widgets still shown;
 - ``workbooks/NN_*.ipynb``: the student notebook: each ``solution`` code cell becomes a stub
   (``Js = ...  # TODO: ...``, keeping its ``kinlib`` metadata), each solution markdown cell a prompt,
-  each ``check`` cell a self-check (:mod:`kinlib.course.selfcheck`) that compares a fingerprint of the
+  each ``check`` cell a self-check (:mod:`kinlib.course.workbook.selfcheck`) that compares a fingerprint of the
   student's answer with the reference's made here (a part without a check cell gets one after its
   last solution cell); worked-solution markdown left out as above; the set-up imports only what the
   student starts with (as in the problems); cells that use answer variables run only once those are
   filled in, and say "fix the answer above first" if they fail on a wrong one (``%%needs``,
-  :mod:`kinlib.course.needs`); outputs cleared. Unless ``--no-verify``, each
+  :mod:`kinlib.course.workbook.needs`); outputs cleared. Unless ``--no-verify``, each
   workbook is then run top to bottom (the stubs must not crash it);
 - the reading aids (``notebooks/README.md``) stay in the problems and the workbooks: objectives, summary,
   ``predict`` questions with their folded ``predict-answer`` (one that gives a graded answer away becomes a
   pointer to the part's self-check), folded ``hint`` steps, ``mistake`` callouts, ``given`` text; the pages fold
-  checks, answers and hints in ``<details>`` (:func:`kinlib.course.pages.fold_cells`); under a stub of an
+  checks, answers and hints in ``<details>`` (:func:`kinlib.course.publish.pages.fold_cells`); under a stub of an
   answer form a student may not know (a set, a choice, a subspace) the workbook shows how to write it;
 - ``reference/cheatsheet.html``: the cheat sheet ``notebooks/cheatsheet.md``;
 - with ``--audience students`` no solution page, PDF or notebook at all (the folder to publish to students);
@@ -51,19 +51,14 @@ from pathlib import Path
 
 import nbformat
 
-from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
-from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
-from .schema import (
+from ..schema import (
     ANSWER_TAGS,
     CHECK,
-    HINT,
-    PREDICT_ANSWER,
     SELFCHECK,
     SELFCHECK_MODULES,
     SOLUTION,
     Group,
     answer_groups,
-    answer_kind,
     cell_answers,
     cell_meta,
     cell_part,
@@ -72,7 +67,10 @@ from .schema import (
     notebook_title,
     set_source_hidden,
 )
-from .selfcheck import FINGERPRINT_MARK, emit_fingerprints
+from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
+from .aids import stub, student_reading_aid
+from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
+from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
 
 __all__ = [
     "build",
@@ -316,35 +314,6 @@ def _student_setup(cell, used) -> None:
         cell.source = trim_setup(cell.source, used)
 
 
-def graded_prediction(cell) -> str:
-    """The part a ``predict-answer`` cell gives the answer of (its ``metadata.kinlib.part``), or "".
-
-    Such an answer is shown in the solutions only; the problems and the workbook keep the folded cell with a
-    pointer to the part's self-check instead (:func:`_student_reading_aid`).
-
-    >>> graded_prediction({"metadata": {"tags": ["predict-answer"], "kinlib": {"part": "4.1"}}})
-    '4.1'
-    >>> graded_prediction({"metadata": {"tags": ["predict-answer"]}})
-    ''
-    """
-    return cell_part(cell_meta(cell)) if PREDICT_ANSWER in cell_tags(cell) else ""
-
-
-def _student_reading_aid(cell) -> None:
-    """In the problems and the workbook: hints and predict-answers folded; a graded prediction's answer
-    replaced by a pointer to the self-check of its part."""
-    tags = set(cell_tags(cell))
-    part = graded_prediction(cell)
-    if part:
-        cell.source = (
-            f"**Check your prediction** with the self-check of part {part} in the workbook: it says whether your "
-            "answer is right without showing it. The reasoning is in the solutions."
-        )
-        cell.pop("attachments", None)
-    if tags & {HINT, PREDICT_ANSWER}:
-        set_source_hidden(cell)
-
-
 def make_problems(executed) -> tuple:
     """The problem version of an executed notebook, and a list of notes on what was dropped.
 
@@ -393,7 +362,7 @@ def make_problems(executed) -> tuple:
     for i, c in enumerate(nb.cells):
         if dropped_cell(i, c):
             continue  # answers, worked-solution steps, what is computed from answers and its caption
-        _student_reading_aid(c)
+        student_reading_aid(c)
         if c.cell_type == "code":
             _student_setup(c, used)  # the student's setup: not the imports that give the method away
             kept = [o for o in c.outputs if not _leaks(o, texts, images)]
@@ -413,45 +382,6 @@ def make_problems(executed) -> tuple:
 
 
 # ---------------------------------------------------------------------------------------------------
-
-
-# How to write the answer forms a student may not have met (shown under the stubs of those answers);
-# tests/test_notebook_structure.py checks that each example is accepted by the self-check's comparers.
-ANSWER_FORM_EXAMPLES = {
-    "set": (
-        "How to write a set of angles (SymPy sets; n is an integer symbol):",
-        "  a few values:       sp.FiniteSet(-sp.pi / 2, sp.pi / 2)",
-        "  a periodic family:  n = sp.Symbol('n', integer=True)",
-        "                      sp.ImageSet(sp.Lambda(n, sp.pi / 4 + n * sp.pi), sp.Integers)",
-        "  several families:   sp.Union(sp.ImageSet(...), sp.ImageSet(...));  none at all: sp.EmptySet",
-    ),
-    "choice": (
-        "How to write a choice: a joint number, 1-based (e.g. 2); if joints tie, a tuple of all of them (e.g. (1, 2)).",
-    ),
-    "subspace": (
-        "How to write a subspace: a Matrix whose columns span it, e.g. sp.Matrix([[1, 0], [0, 1], [0, 0]]) for the",
-        "x-y plane (any basis of the same span is right).",
-    ),
-}
-
-
-def _stub(cell, describe: dict) -> str:
-    meta = cell_meta(cell)
-    part = cell_part(meta)
-    answers = cell_answers(meta)
-    words = meta.get("describe") if isinstance(meta.get("describe"), dict) else {}
-    lines = [
-        f"# Part {part}: your answer. Replace each ... below; the self-check further down says whether it is right."
-        if answers
-        else f"# Part {part}: your work here."
-    ]
-    for name in answers:
-        what = ", ".join(x for x in (words.get(name), describe.get(name)) if x)
-        lines.append(f"{name} = ...  # TODO: {what or 'your answer'} (part {part})")
-    examples = [answer_kind(meta, name) for name in answers]
-    for kind in dict.fromkeys(examples):
-        lines += [f"#   {line}" for line in ANSWER_FORM_EXAMPLES.get(kind, ())]
-    return "\n".join(lines) + "\n"
 
 
 def _selfcheck_source(answers: list, fps: dict) -> str:
@@ -474,7 +404,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
 
     >>> from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
     >>> from kinlib.course.schema import answer_groups
-    >>> from kinlib.course.selfcheck import fingerprint
+    >>> from kinlib.course.workbook.selfcheck import fingerprint
     >>> nb = new_notebook(cells=[
     ...     new_markdown_cell("**1.1 (2 points).** What is 6 * 7?", metadata={"tags": ["question"]}),
     ...     new_code_cell("x = 6 * 7", metadata={"tags": ["solution"], "kinlib": {"part": "1.1", "answers": ["x"]}}),
@@ -511,7 +441,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
         if SOLUTION in tags:
             if cell.cell_type == "code":
                 d = {name: describe.get((i, name), "") for name in cell_answers(meta)}
-                cell.source = _stub(cell, d)
+                cell.source = stub(cell, d)
             else:
                 cell.source = f"**Your answer (part {part}):** *write it here.*"
                 cell.pop("attachments", None)
@@ -523,7 +453,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
         elif i in narrative:
             pass
         else:
-            _student_reading_aid(cell)
+            student_reading_aid(cell)
             if i in needs:
                 cell.source = f"%%needs {' '.join(needs[i])}\n" + cell.source
             else:
@@ -669,8 +599,8 @@ def build(
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
     ``index.html``, ``problems/`` and ``solutions/`` (HTML), ``workbooks/`` (.ipynb), and unless switched off
-    ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.lite.build_lite`) and ``pdf/`` (``pdfs``:
-    every page printed by Chromium, :func:`kinlib.course.printing.print_pdfs`); the pages link only what is built.
+    ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.publish.lite.build_lite`) and ``pdf/`` (``pdfs``:
+    every page printed by Chromium, :func:`kinlib.course.publish.printing.print_pdfs`); the pages link only what is built.
     ``reference/cheatsheet.html`` (and its PDF) is the one-page cheat sheet (``notebooks/cheatsheet.md``).
 
     ``audience="students"`` leaves out every solution: no ``solutions/`` pages or PDFs, no solution notebooks
