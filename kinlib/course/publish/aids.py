@@ -46,7 +46,7 @@ def student_reading_aid(cell) -> None:
     tags = set(cell_tags(cell))
     part = graded_prediction(cell)
     if part:
-        cell.source = (
+        cell["source"] = (
             f"**Check your prediction** with the self-check of part {part} in the workbook: it says whether your "
             "answer is right without showing it. The reasoning is in the solutions."
         )
