@@ -12,7 +12,7 @@ import sympy as sp
 from ._backend import as_matrix, as_scalar, as_vector, check_real_finite, describe, exact_number, is_symbolic
 from .display import is_identically_zero
 from .exactfield import decide_zero
-from .rigid import check_se3, check_unit_vector, cross, log3, skew, unskew
+from .rigid import check_se3, check_unit_vector, cross, log3, rodrigues_coefficients, skew, unskew
 
 __all__ = [
     "screw_revolute",
@@ -176,9 +176,9 @@ def exp6_unchecked(S, theta, kind: str, symbolic: bool):
         return T
     W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
     W2 = W @ W
-    s, c = np.sin(theta), np.cos(theta)
-    T[:3, :3] += s * W + (1.0 - c) * W2
-    T[:3, 3] = (theta * v) + (1.0 - c) * (W @ v) + (theta - s) * (W2 @ v)
+    s, one_c, t_s = rodrigues_coefficients(float(theta))
+    T[:3, :3] += s * W + one_c * W2
+    T[:3, 3] = (theta * v) + one_c * (W @ v) + t_s * (W2 @ v)
     return T
 
 
