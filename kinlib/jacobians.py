@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_vector, describe, is_symbolic
+from ._backend import as_matrix, as_vector, describe, is_symbolic, nested_shape
 from .poe import checked_screw_list, fk_space
 from .rigid import check_se3, check_so3, cross, rodrigues_coefficients, skew
 from .screws import exp6_unchecked
@@ -349,7 +349,9 @@ def linear_first(J):
     Matrix([[L1*sin(theta1), -L1*cos(theta1), 0, 0, 0, 1]])
     """
     symbolic = is_symbolic(J)
-    if isinstance(J, sp.MatrixBase) or (np.ndim(J) == 2):
+    if isinstance(J, (str, bytes)) or J is None:
+        raise TypeError(f"J must be a twist (6 entries) or a 6×n Jacobian, got {describe(J)}")
+    if len(nested_shape(J, "J")) == 2:  # a ragged list is refused here, naming J
         X = as_matrix(J, "J", (6, None), symbolic)
     else:
         X = as_vector(J, "J", 6, symbolic)

@@ -21,7 +21,15 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ._backend import as_vector, describe, exact_jacobian, is_symbolic, numeric_jacobian, numeric_vectors
+from ._backend import (
+    as_vector,
+    describe,
+    exact_jacobian,
+    is_symbolic,
+    nested_shape,
+    numeric_jacobian,
+    numeric_vectors,
+)
 from .exact import exact_det
 from .exactfield import decide_zero
 from .singularities import trig_simplify
@@ -487,8 +495,9 @@ def strongest_joints(row: Any, tol: float = 1e-9):
     elif isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
         raise TypeError(f"row must be the n entries of one row of J, got {describe(row)}")
     else:
+        nested_shape(row, "row")  # a ragged list is named as such
         arr = np.asarray(row, dtype=object)
-        if arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
+        if arr.ndim == 0 or arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
             raise ValueError(f"row must be the n entries of one row of J, got {describe(row)}")
         vals = list(arr.reshape(-1))
     if not vals:

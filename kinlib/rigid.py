@@ -88,7 +88,12 @@ def unskew(W):
     >>> unskew(skew([4.0, 5.0, 6.0])).tolist()
     [4.0, 5.0, 6.0]
     """
-    W = as_matrix(W, "W", (3, 3))
+    return skew_vector(W, "W")
+
+
+def skew_vector(W, name: str):
+    """:func:`unskew` with the argument's name for the messages (``unbracket`` passes "the upper-left 3×3 of X")."""
+    W = as_matrix(W, name, (3, 3))
     symbolic = isinstance(W, sp.MatrixBase)
     bad = (
         (not all(decide_zero(W[i, j] + W[j, i]) for i in range(3) for j in range(i, 3)))
@@ -96,7 +101,8 @@ def unskew(W):
         else not np.allclose(W, -W.T, atol=_TOL)
     )
     if bad:
-        raise ValueError(f"W must be skew-symmetric (W = -Wᵀ), got {W.tolist()}")
+        rel = f"{name} = -{name}ᵀ" if name.isidentifier() else "equal to minus its transpose"
+        raise ValueError(f"{name} must be skew-symmetric ({rel}), got {W.tolist()}")
     v = [W[2, 1], W[0, 2], W[1, 0]]
     return sp.Matrix(v) if symbolic else np.array(v, dtype=float)
 
