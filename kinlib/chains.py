@@ -374,7 +374,9 @@ class SerialChain:
         the temporaries of what was recorded: straight-line code equal to the exact product of
         exponentials to rounding, in 0.1–0.4 s for a dense 7-joint arm whatever the size of the
         chain's exact numbers (no exact SymPy arithmetic on the whole chain; the batched code is
-        generated on the first batched call)."""
+        generated on the first batched call). A chain with ``placements`` (from URDF) also records fk, J_s
+        and the geometric J as constant placements times rotations about the joints' own axes
+        (:func:`_local_rows`) and compiles whichever recording has fewer operations."""
         if what not in self._num:
             if self.params:
                 raise ValueError(
