@@ -17,7 +17,10 @@ those of :mod:`kinlib.course.answers`, the normaliser the instructor checker use
 - ``"set"``: a SymPy Set (or Python set/list of values, a number, a dict {symbol: Set} or a list of
   those dicts), compared through its points in [-2π, 2π] taken modulo 2π (angles), intervals by their
   end points;
-- ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector.
+- ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector;
+- ``"property:<p>"`` (declared by ``properties`` in the metadata, :func:`kinlib.course.schema.grading_kind`): an
+  open-ended answer (5.5: the student's own redesigned robot) judged by the property asked, exactly as the
+  grader judges it (:func:`kinlib.course.properties.judge`); its spec ``property|<p>|-`` holds no value.
 
 A wrong answer is tried against the known mistakes of :mod:`kinlib.course.mistakes` (transposed, wrong
 sign, [v; ω] order, columns swapped, degrees, wrong shape, ...; the instructor checker uses the same):
@@ -424,6 +427,8 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     >>> fingerprint((2, 1), "choice") == fingerprint([1, 2, 2], "choice")
     True
     """
+    if str(kind).startswith("property:"):
+        return _property_spec(value, kind.partition(":")[2])
     if kind not in _CANON:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     if answers.is_unanswered(value):
@@ -432,12 +437,37 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     return f"{form}|{shape}|{_hash(form, canon, salt)}"
 
 
+def _property_spec(value, prop: str) -> str:
+    """The spec of an answer judged by a property of the student's own design (``kind`` "property:<p>",
+    :mod:`kinlib.course.properties`): ``"property|<p>|-"``; it holds no value, and the reference answer must
+    have the property itself (else ValueError: a problem in the solution notebook).
+
+    >>> from kinlib.robots import planar_rpp
+    >>> _property_spec(planar_rpp(), "nonsingular")
+    'property|nonsingular|-'
+    """
+    if answers.is_unanswered(value):
+        raise Unanswered("the value is missing or ...")
+    ok, msg = _judge_property(value, prop, "the reference answer")
+    if not ok:
+        raise ValueError(f"the solution's own answer fails its property {prop!r}: {msg}")
+    return f"property|{prop}|-"
+
+
+def _judge_property(value, prop: str, name: str) -> tuple[bool, str]:
+    from .properties import judge  # the grader's own judge (kinlib.singularities proofs)
+
+    return judge(prop, answers.property_answer(value), name)
+
+
 def describe_answer(value, kind: str = "default") -> str:
     """A short description of the form of an answer (for the workbook's stub), e.g. 'a 6×3 Matrix'.
 
     >>> describe_answer(sp.zeros(6, 3)), describe_answer(3, "choice"), describe_answer({sp.Symbol("t"): {0}}, "set")
     ('a 6×3 Matrix', 'a joint number or a tuple of joint numbers (1-based)', 'a dict {symbol: SymPy Set}')
     """
+    if str(kind).startswith("property:"):
+        return "your robot (a kinlib SerialChain) or its task Jacobian J (a Matrix)"
     if kind == "choice":
         return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"
     if kind == "set":
@@ -499,6 +529,9 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
         return "unanswered", "not answered yet"
     if form == "none":
         return "error", "this answer has no automatic self-check: compare it with the worked solution"
+    if form == "property":  # judged by the property asked, on the student's own design (kinlib.course.properties)
+        ok, message = _judge_property(value, shape, "your answer")
+        return ("correct", f"correct: {message}") if ok else ("incorrect", f"not right yet: {message}")
     kind = _FORM_KIND.get(form)
     if kind is None:
         raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
@@ -639,6 +672,8 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
             what = (
                 _shape_words(shape)
                 if form in ("matrix", "scalar")
+                else "your robot, a SerialChain, or its task Jacobian J"
+                if form == "property"
                 else ("see the question" if form == "none" else "True or False" if form == "bool" else f"a {form}")
             )
             message = f"not answered yet: replace the ... in `{name} = ...` above with your answer ({what})"
