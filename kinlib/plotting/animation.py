@@ -197,7 +197,8 @@ def animate_singularity(
     :func:`kinlib.taskspace.default_task_rows`) along the path with a moving marker. ``.values`` holds the
     manipulability per step. Play it in a static page with ``anim.to_jshtml()`` (``IPython.display.HTML``),
     or make it a cell's value (:class:`SingularityAnimation`: the player showing frame 0 at once, and a static
-    image/png of frame 0 for a notebook opened without running it).
+    image/png of frame 0 for a notebook opened without running it). Its figure is closed in pyplot (no second,
+    static copy below the cell); the player still draws it.
 
     >>> from kinlib.robots import planar_offset_3r
     >>> anim = animate_singularity(planar_offset_3r(1), np.zeros((3, 3)))
@@ -277,4 +278,5 @@ def animate_singularity(
     anim.frame_function, anim.n_frames = frame, P.shape[0]
     anim.movers = [*arm.artists, *ells.artists, mark, txt]
     anim.summary = f"animation of {chain.name} along a path of {P.shape[0]} configurations (frame 0 shown)"
+    plt.close(fig)  # shown by its player only: an inline backend would print a second, static copy of frame 0
     return anim
