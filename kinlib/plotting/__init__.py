@@ -37,6 +37,7 @@ Functions (each returns an object to update or inspect):
   ``plot_manipulability_map(chain, joints=(1, 2), q_fixed=None, *, rows=None, singular=True)`` → :class:`MapPlot`;
 * ``plot_singularity_cost(chain, joint, q_singular, V, *, offsets=None, damping=0.05)`` → :class:`CostPlot`
   (what a singularity costs: ‖J⁻¹V‖ beside damped least squares and its velocity error, log scales);
+* ``legend_beside(ax, where="right")``: a legend outside the axes (never over the drawing);
 * ``sweep(chain, joint, values, q_fixed=None)`` and ``animate_singularity(chain, path)`` → a FuncAnimation
   (``.to_jshtml()`` plays in a static page and shows frame 0 at once; as a cell's value it also carries a
   static image/png of frame 0).
@@ -86,7 +87,7 @@ from .plots import (
     plot_manipulability_map,
     sweep,
 )
-from .view import new_axes, pi_ticks
+from .view import legend_beside, new_axes, pi_ticks
 
 __all__ = [
     "is_planar",
@@ -117,6 +118,7 @@ __all__ = [
     "sweep",
     "animate_singularity",
     "new_axes",
+    "legend_beside",
     "pi_ticks",
     "ROW_NAMES",
     "ROW_LABELS",

@@ -435,8 +435,6 @@ def plot_manipulability_map(
             sing.append(
                 ax.plot(xs, ys, color="red", lw=2, label=lab if lab else ("singular set" if k == 0 else None))[0]
             )
-    if sing:
-        ax.legend(loc="upper right", fontsize=8)
     ax.set_xlim(xlo, xhi)
     ax.set_ylim(ylo, yhi)
     ax.set_xlabel(theta_tex(i + 1))
@@ -444,7 +442,9 @@ def plot_manipulability_map(
     for k, (lo, hi), axis in ((i, (xlo, xhi), ax.xaxis), (j, (ylo, yhi), ax.yaxis)):
         if chain.joint_types[k] == "R" and hi - lo >= math.pi / 2:
             pi_ticks(axis, lo, hi, 2)
-    ax.set_title(f"{chain.name}: {label} of rows ({rows_label(r, tex=True)})")
+    # the singular set is named in the title, not in a legend box that would sit on the map's curves
+    note = "\nred: the singular set" if sing else ""
+    ax.set_title(f"{chain.name}: {label} of rows ({rows_label(r, tex=True)}){note}")
     return MapPlot(ax, im, x, y, vals, (i + 1, j + 1), sing)
 
 
