@@ -1,8 +1,8 @@
 """Notebook 07 (exercises beyond the problem set) is graded and self-checked like the others (issue 21, item 7).
 
-For every answer of 7.1–7.5 the workbook self-check (:mod:`kinlib.course.selfcheck`: a fingerprint of the
-reference, the student's value checked against it) and the grader (:func:`kinlib.course.probe.describe` then
-:func:`kinlib.course.compare.compare`, both sides through a JSON round trip as across the kernel boundary) are
+For every answer of 7.1–7.5 the workbook self-check (:mod:`kinlib.course.workbook.selfcheck`: a fingerprint of the
+reference, the student's value checked against it) and the grader (:func:`kinlib.course.grader.in_kernel.probe.describe` then
+:func:`kinlib.course.answers.compare.compare`, both sides through a JSON round trip as across the kernel boundary) are
 fed the right answer, other valid forms of it, and wrong answers (the mistakes a student makes).
 
 The references are written here by hand, independently of kinlib and of the notebook's code: the 2R Jacobian
@@ -19,10 +19,11 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
-from kinlib.course import compare as C
-from kinlib.course import probe, schema
-from kinlib.course.selfcheck import fingerprint
-from kinlib.course.selfcheck import verdict as sc_verdict
+from kinlib.course import schema
+from kinlib.course.answers import compare as C
+from kinlib.course.grader.in_kernel import probe
+from kinlib.course.workbook.selfcheck import fingerprint
+from kinlib.course.workbook.selfcheck import verdict as sc_verdict
 
 ROOT = Path(__file__).resolve().parents[1]
 NB = ROOT / "notebooks" / "07_going_further.ipynb"

@@ -1,7 +1,7 @@
 """The answer normaliser: what form a student's (or the reference's) answer value has, in SymPy terms.
 
-One implementation for both the workbook self-checks (:mod:`kinlib.course.selfcheck`) and the
-instructor checker (:mod:`kinlib.course.probe`, which runs it inside each student kernel), so an answer
+One implementation for both the workbook self-checks (:mod:`kinlib.course.workbook.selfcheck`) and the
+instructor checker (:mod:`kinlib.course.grader.in_kernel.probe`, which runs it inside each student kernel), so an answer
 form one of them accepts, the other accepts too:
 
 * **matrices and expressions** (:func:`to_sympy`): SymPy matrices; NumPy arrays (0-d: a number, 1-D:
@@ -272,7 +272,7 @@ _TREE_MAX_NODES = 4000
 def expr_tree(obj, max_nodes=_TREE_MAX_NODES):
     """A SymPy expression or matrix as a JSON tree of plain lists: a ``property`` answer (or a constant exact
     subspace) is decided exactly in the grader, which rebuilds it from a whitelist of numbers, symbols, π,
-    +, ×, powers and sin/cos/tan (:func:`kinlib.course.properties.from_tree`). Raises ValueError for
+    +, ×, powers and sin/cos/tan (:func:`kinlib.course.answers.properties.from_tree`). Raises ValueError for
     anything else or more than ``max_nodes`` nodes.
 
     >>> import sympy as sp
@@ -336,7 +336,7 @@ def robot_screws(value):
 
 def property_answer(value) -> dict:
     """An answer judged by a property of the student's own design (problem 5.5: "your redesign has no singular
-    configuration") as plain JSON data for the judge (:mod:`kinlib.course.properties`): ``{"tag": "robot",
+    configuration") as plain JSON data for the judge (:mod:`kinlib.course.answers.properties`): ``{"tag": "robot",
     "tree": …}`` for a robot (its screw axes, :func:`robot_screws`), ``{"tag": "matrix"|"scalar", "tree": …}``
     for a matrix (its task Jacobian) or an expression, with the exact :func:`expr_tree`; ``tree_error`` says
     why there is none; other tags as :func:`to_sympy`.

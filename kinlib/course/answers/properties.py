@@ -2,18 +2,18 @@
 
 A ``property`` answer (kind "property:<name>" in the grader; declared by ``properties`` in the solution cell's
 metadata, see :func:`kinlib.course.schema.grading_kind`) crosses the kernel boundary as a JSON expression tree
-(:func:`kinlib.course.probe.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
+(:func:`kinlib.course.grader.in_kernel.probe.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
 with bounded size, so a hostile tree cannot run code or exhaust the grader. :data:`PROPERTIES` maps each
 property to its decision, ``(ok, message)``; the message talks about the student's own answer only.
 
-:func:`exact_ranks` compares constant exact subspaces exactly (:func:`kinlib.course.compare.compare_subspace`).
+:func:`exact_ranks` compares constant exact subspaces exactly (:func:`kinlib.course.answers.compare.compare_subspace`).
 
 * ``nonsingular`` (problem 5.5): the student's redesigned robot (a ``SerialChain``: the judge computes its J from
   its screw axes) or its task Jacobian J has det(J Jᵀ) ≠ 0 for every joint value, proved exactly by
   :func:`kinlib.singularities.singular_configurations` (trigonometric normal forms, :mod:`kinlib.trigsign`
   proofs of non-vanishing). A bare value of det(J Jᵀ) belongs to no robot and is refused.
 
-The same judges serve the workbook self-check (:func:`kinlib.course.selfcheck.verdict`, spec
+The same judges serve the workbook self-check (:func:`kinlib.course.workbook.selfcheck.verdict`, spec
 ``property|nonsingular|-``) and the grader (:func:`kinlib.course.compare.compare_property`).
 """
 
@@ -265,7 +265,7 @@ def _judge_task_jacobian(J, syms: dict, name: str, what: str) -> tuple[bool, str
 
 def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
     """The student's own redesign has no singular configuration: det(J Jᵀ) ≠ 0 for every joint value, decided
-    exactly for **their robot**. The answer (:func:`kinlib.course.answers.property_answer`) is the robot (tag
+    exactly for **their robot**. The answer (:func:`kinlib.course.answers.normalise.property_answer`) is the robot (tag
     "robot": its space screw axes, 6×n; the judge computes J_s from them, :func:`kinlib.jacobians.jacobian_space`,
     and takes its task rows ω_z, v_x, v_y; the robot must be planar) or its task Jacobian J (a 3×n matrix). A
     number or expression alone (a claimed det(J Jᵀ), e.g. 1) is refused: it belongs to no robot. Proofs by
@@ -301,7 +301,7 @@ PROPERTIES = {"nonsingular": nonsingular}
 
 def judge(prop: str, stu: dict, name: str) -> tuple[bool, str]:
     """``(ok, message)``: the property ``prop`` of :data:`PROPERTIES` judged on the answer description ``stu``
-    (:func:`kinlib.course.answers.property_answer`); never raises.
+    (:func:`kinlib.course.answers.normalise.property_answer`); never raises.
 
     >>> judge("nonsingular", {"tag": "ellipsis"}, "redesign")
     (False, 'redesign is not answered yet')
