@@ -530,9 +530,7 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
         return "unanswered", "not answered yet"
     if form == "none":
         return "error", "this answer has no automatic self-check: compare it with the worked solution"
-    if (
-        form == "property"
-    ):  # judged by the property asked, on the student's own design (kinlib.course.answers.properties)
+    if form == "property":  # judged by the property asked, on the student's own design (answers.properties)
         ok, message = _judge_property(value, shape, "your answer")
         return ("correct", f"correct: {message}") if ok else ("incorrect", f"not right yet: {message}")
     kind = _FORM_KIND.get(form)
