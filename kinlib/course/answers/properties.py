@@ -21,7 +21,17 @@ from __future__ import annotations
 
 import math
 
-__all__ = ["from_tree", "exact_ranks", "nonsingular", "judge", "PROPERTIES", "MAX_TERMS_ESTIMATE", "MAX_ROBOT_JOINTS"]
+__all__ = [
+    "from_tree",
+    "exact_ranks",
+    "nonsingular",
+    "judge",
+    "PROPERTIES",
+    "MAX_TERMS_ESTIMATE",
+    "MAX_ROBOT_JOINTS",
+    "judge_value",
+    "property_spec",
+]
 
 MAX_TERMS_ESTIMATE = 50_000  # a bound on the terms of det(J Jᵀ) expanded (see _terms_estimate)
 
@@ -319,3 +329,41 @@ def judge(prop: str, stu: dict, name: str) -> tuple[bool, str]:
         return PROPERTIES[prop](stu, name)
     except (ValueError, TypeError, RecursionError) as exc:
         return False, f"{name} could not be read exactly ({str(exc)[:120]})"
+
+
+def judge_value(prop: str, value, name: str) -> tuple[bool, str]:
+    """:func:`judge` on a value itself (the workbook self-check's side, in the student's kernel), described by
+    :func:`kinlib.course.answers.normalise.property_answer` exactly as the grader's kernel describes it.
+
+    >>> judge_value("nonsingular", 1, "redesign")[0]
+    False
+    """
+    from .normalise import property_answer
+
+    return judge(prop, property_answer(value), name)
+
+
+def property_spec(value, prop: str) -> str:
+    """The self-check spec of an answer judged by a property (kind "property:<p>"): ``"property|<p>|-"``; it holds
+    nothing of the reference answer, which must have the property itself (else ValueError: a problem in the
+    solution notebook).
+
+    >>> from kinlib.robots import planar_rpp
+    >>> property_spec(planar_rpp(), "nonsingular")
+    'property|nonsingular|-'
+    """
+    ok, msg = judge_value(prop, value, "the reference answer")
+    if not ok:
+        raise ValueError(f"the solution's own answer fails its property {prop!r}: {msg}")
+    return f"property|{prop}|-"
+
+
+def property_verdict(prop: str, value) -> tuple[str, str]:
+    """The workbook self-check's ``(status, message)`` for a property answer: correct or incorrect, by
+    :func:`judge_value` (the grader's judgement); the message talks about the student's own design only.
+
+    >>> property_verdict("nonsingular", 2)[0]
+    'incorrect'
+    """
+    ok, message = judge_value(prop, value, "your answer")
+    return ("correct", f"correct: {message}") if ok else ("incorrect", f"not right yet: {message}")

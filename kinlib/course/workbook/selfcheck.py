@@ -18,9 +18,7 @@ those of :mod:`kinlib.course.answers.normalise`, the normaliser the instructor c
   those dicts), compared through its points in [-2π, 2π] taken modulo 2π (angles), intervals by their
   end points;
 - ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector;
-- ``"property:<p>"`` (declared by ``properties`` in the metadata, :func:`kinlib.course.schema.grading_kind`): an
-  open-ended answer (5.5: the student's own redesigned robot) judged by the property asked, exactly as the
-  grader judges it (:func:`kinlib.course.answers.properties.judge`); its spec ``property|<p>|-`` holds no value.
+- ``"property:<p>"``: the student's own design (5.5) judged as the grader does (:mod:`..answers.properties`).
 
 A wrong answer is tried against the known mistakes of :mod:`kinlib.course.answers.mistakes` (transposed, wrong
 sign, [v; ω] order, columns swapped, degrees, wrong shape, ...; the instructor checker uses the same):
@@ -44,6 +42,7 @@ import sympy as sp
 
 from ..answers import mistakes
 from ..answers import normalise as answers
+from ..answers.properties import property_spec, property_verdict
 from ..schema import KINDS
 from .needs import answer_status, last_results, needs
 
@@ -428,37 +427,14 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     >>> fingerprint((2, 1), "choice") == fingerprint([1, 2, 2], "choice")
     True
     """
+    if answers.is_unanswered(value):
+        raise Unanswered("the value is missing or ...")
     if str(kind).startswith("property:"):
-        return _property_spec(value, kind.partition(":")[2])
+        return property_spec(value, kind.partition(":")[2])
     if kind not in _CANON:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    if answers.is_unanswered(value):
-        raise Unanswered("the value is missing or ...")
     form, shape, canon = _CANON[kind](value)
     return f"{form}|{shape}|{_hash(form, canon, salt)}"
-
-
-def _property_spec(value, prop: str) -> str:
-    """The spec of an answer judged by a property of the student's own design (``kind`` "property:<p>",
-    :mod:`kinlib.course.answers.properties`): ``"property|<p>|-"``; it holds no value, and the reference answer must
-    have the property itself (else ValueError: a problem in the solution notebook).
-
-    >>> from kinlib.robots import planar_rpp
-    >>> _property_spec(planar_rpp(), "nonsingular")
-    'property|nonsingular|-'
-    """
-    if answers.is_unanswered(value):
-        raise Unanswered("the value is missing or ...")
-    ok, msg = _judge_property(value, prop, "the reference answer")
-    if not ok:
-        raise ValueError(f"the solution's own answer fails its property {prop!r}: {msg}")
-    return f"property|{prop}|-"
-
-
-def _judge_property(value, prop: str, name: str) -> tuple[bool, str]:
-    from ..answers.properties import judge  # the grader's own judge (kinlib.singularities proofs)
-
-    return judge(prop, answers.property_answer(value), name)
 
 
 def describe_answer(value, kind: str = "default") -> str:
@@ -503,14 +479,7 @@ def _parse_spec(spec: str):
     return form, shape, digest
 
 
-_FORM_KIND = {
-    "matrix": "default",
-    "scalar": "default",
-    "bool": "default",
-    "choice": "choice",
-    "set": "set",
-    "subspace": "subspace",
-}
+_FORM_KIND = dict.fromkeys(("matrix", "scalar", "bool"), "default") | {f: f for f in ("choice", "set", "subspace")}
 
 
 def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
@@ -531,8 +500,7 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     if form == "none":
         return "error", "this answer has no automatic self-check: compare it with the worked solution"
     if form == "property":  # judged by the property asked, on the student's own design (answers.properties)
-        ok, message = _judge_property(value, shape, "your answer")
-        return ("correct", f"correct: {message}") if ok else ("incorrect", f"not right yet: {message}")
+        return property_verdict(shape, value)
     kind = _FORM_KIND.get(form)
     if kind is None:
         raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
