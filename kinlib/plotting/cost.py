@@ -36,7 +36,13 @@ __all__ = ["CostPlot", "plot_singularity_cost"]
 class CostPlot:
     """Result of :func:`plot_singularity_cost`. ``offsets`` δ (distance of the joint from its singular value),
     ``rates_exact`` ‖J⁻¹V‖, ``rates_dls`` ‖θ̇_λ‖, ``error_dls`` ‖J θ̇_λ − V‖ (one per offset), ``bound`` the DLS
-    bound ‖V‖/(2λ), ``damping`` λ, ``fig`` and ``axes`` (rates, error)."""
+    bound ‖V‖/(2λ), ``damping`` λ, ``fig`` and ``axes`` (rates, error).
+
+    >>> from kinlib.robots import planar_offset_3r
+    >>> c = plot_singularity_cost(planar_offset_3r(1), 2, [0.0, -np.pi / 4, 0.0], [0, 0, 0.1], offsets=[1e-3, 1e-1])
+    >>> type(c).__name__, c.damping, bool(c.rates_exact[0] > 10 * c.rates_exact[1])
+    ('CostPlot', 0.05, True)
+    """
 
     offsets: np.ndarray
     rates_exact: np.ndarray
