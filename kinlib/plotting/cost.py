@@ -39,7 +39,7 @@ class CostPlot:
     bound ‖V‖/(2λ), ``damping`` λ, ``fig`` and ``axes`` (rates, error).
 
     >>> from kinlib.robots import planar_offset_3r
-    >>> c = plot_singularity_cost(planar_offset_3r(1), 2, [0.0, -np.pi / 4, 0.0], [0, 0, 0.1], offsets=[1e-3, 1e-1])
+    >>> c = plot_singularity_cost(planar_offset_3r(1), 2, [0.0, -np.pi / 4, 0.0], [0, 0.1, 0], offsets=[1e-3, 1e-1])
     >>> type(c).__name__, c.damping, bool(c.rates_exact[0] > 10 * c.rates_exact[1])
     ('CostPlot', 0.05, True)
     """
