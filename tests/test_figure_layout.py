@@ -166,3 +166,29 @@ def test_no_legend_covers_the_drawing_in_any_notebook_figure(path):
         problems += [f"{path.name} cell {cid}: {f}" for f in legend_overlaps(fig)]
     assert count >= 1, f"{path.name} drew no static figure"
     assert not problems, "\n".join(problems)
+
+
+# --- 5.3's directions: any basis gives the same arrows, and "can" never lies on "cannot" ---------------------------
+
+
+@pytest.mark.parametrize(
+    "basis",
+    [
+        [[1, 0], [0, 1], [0, -1]],  # the printed (48), up to scale
+        [[0, 1], [1, 0], [-1, 0]],  # its columns swapped: drew no arrow before
+        [[2, 1], [3, 0], [-3, 0]],  # mixed columns, other lengths
+        [[1, 1, 0], [0, 1, 1], [0, -1, -1]],  # three spanning columns
+    ],
+)
+def test_5_3_arrows_from_any_basis_and_never_on_top_of_each_other(basis):
+    from kinlib.plotting import draw_directions, held_span
+
+    fig, ax = plt.subplots()
+    can = draw_directions(ax, (0, 0), np.array(basis, float), hold=(0,), components=(1, 2), both_ways=True)
+    assert len(draw_directions(ax, (0, 0), np.array([[0.0], [1.0], [1.0]]), components=(1, 2))) == 1
+    arrows = [a for a in can if isinstance(a, FancyArrowPatch)]
+    assert len(arrows) == 1  # one translation is possible with the orientation held: the −45° line
+    u, w = held_span(np.array(basis, float), (0,))[1:, 0], np.array([1.0, 1.0]) / np.sqrt(2)
+    assert np.isclose(abs(u @ np.array([1, -1]) / np.sqrt(2)), 1.0)
+    assert abs(u @ w) < 1e-12  # perpendicular: they cannot sit on top of each other
+    plt.close(fig)
