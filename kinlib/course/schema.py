@@ -196,8 +196,8 @@ PROPERTIES = ("nonsingular",)
 def grading_kind(meta: dict, name: str) -> str:
     """How the grader compares answer ``name``: "property:<p>" when the cell's ``kinlib`` metadata declares
     ``properties`` {name: p} (an open-ended answer graded by the property asked, e.g. "nonsingular":
-    det(J Jᵀ) ≠ 0 for every θ, never by one design's value), else :func:`answer_kind`. The self-check and
-    the handouts keep :func:`answer_kind` (they know the printed solution's value only).
+    det(J Jᵀ) ≠ 0 for every θ of the student's own robot, never by one design's value), else :func:`answer_kind`.
+    The self-check judges a property answer by the same judge (:mod:`kinlib.course.answers.properties`).
 
     >>> grading_kind({"properties": {"d": "nonsingular"}}, "d"), grading_kind({"kinds": {"S": "set"}}, "S")
     ('property:nonsingular', 'set')
@@ -324,7 +324,7 @@ def answer_groups(nb) -> list[Group]:
             meta = cell_meta(cell)
             for name in cell_answers(meta):
                 pending.answers = [a for a in pending.answers if a[1] != name]
-                pending.answers.append((cell_part(meta), name, answer_kind(meta, name), i))
+                pending.answers.append((cell_part(meta), name, grading_kind(meta, name), i))
             pending.last_solution = i
         if CHECK in tags:
             close(check=i)
