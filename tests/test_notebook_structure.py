@@ -31,17 +31,7 @@ ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 VENDOR = ROOT / "build" / "vendor"
-PENDING = ("05_", "06_")  # l21-b adds their reading aids in parallel; the lead removes this at merge
-
-
-def _param(path):
-    marks = []
-    if path.name.startswith(PENDING):
-        marks.append(pytest.mark.xfail(reason="l21-b adds them", strict=False))
-    return pytest.param(path, id=path.stem, marks=marks)
-
-
-PARAMS = [_param(p) for p in NOTEBOOKS]
+PARAMS = [pytest.param(p, id=p.stem) for p in NOTEBOOKS]
 
 
 def _tags(cell) -> set:
