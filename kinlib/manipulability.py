@@ -38,6 +38,9 @@ __all__ = [
     "singular_values",
     "strongest_joints",
     "manipulability_values",
+    "NEAR_SINGULAR_RATIO",
+    "dimensionless_scales",
+    "near_singular",
     "MEASURES",
     "measure_label",
 ]
@@ -513,3 +516,50 @@ def measure_label(measure: Any, m: int, n: int) -> str:
     if isinstance(measure, str):
         return MEASURES.get(measure, measure)
     return getattr(measure, "__name__", "measure")
+
+
+#: the one "near a singular configuration" threshold: σ_min/σ_max of the dimensionless task Jacobian below it
+NEAR_SINGULAR_RATIO = 0.05
+
+
+def dimensionless_scales(rows: Any, joint_types: str, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """(row scales, column scales) that make the task rows of a geometric Jacobian J = [ω_s; ṗ] unit-free:
+    ṗ rows (m/s per unit rate) divided by the characteristic ``length`` ℓ, prismatic columns (m/s per m/s)
+    multiplied by ℓ, everything else 1. Then every entry of diag(rows) J_r diag(cols) is a pure number, and
+    changing the length unit (ℓ and J's lengths together) leaves it unchanged.
+
+    >>> dimensionless_scales(("wz", "vx", "vy"), "RPR", 2.0)
+    (array([1. , 0.5, 0.5]), array([1., 2., 1.]))
+    """
+    idx = task_row_indices(rows)
+    if not isinstance(joint_types, str) or not joint_types or set(joint_types) - {"R", "P"}:
+        raise ValueError(f"joint_types must be a string of 'R' and 'P', got {describe(joint_types)}")
+    ell = float(length) if isinstance(length, (int, float, np.floating)) and not isinstance(length, bool) else None
+    if ell is None or not np.isfinite(ell) or ell <= 0:
+        raise ValueError(f"length must be a positive number (the arm's characteristic length), got {describe(length)}")
+    r = np.array([1.0 if k < 3 else 1.0 / ell for k in idx])
+    c = np.array([ell if t == "P" else 1.0 for t in joint_types])
+    return r, c
+
+
+def near_singular(J_rows: Any, rows: Any, joint_types: str, length: float, ratio: float = NEAR_SINGULAR_RATIO):
+    """The one unit-aware "near a singular configuration" rule: (near, r) with r = σ_min/σ_max of the
+    dimensionless task Jacobian diag(a) J_r diag(b) (:func:`dimensionless_scales`: ṗ rows over the
+    characteristic length ℓ, prismatic columns times ℓ) and near = r < ``ratio`` (:data:`NEAR_SINGULAR_RATIO`).
+    ``J_rows``: the task rows ``rows`` of the geometric Jacobian (m×n floats). Exact singularity is decided
+    elsewhere (:func:`kinlib.singularities.singular_configurations`); this rule only says "close to one".
+    The browser explorers evaluate the same formula with the same scales and threshold (:mod:`kinlib.widgets`).
+
+    >>> import numpy as np
+    >>> near_singular(np.array([[1.0, 1.0], [0.0, 0.05]]), ("vx", "vy"), "RR", 1.0)[0]
+    True
+    >>> near_singular(np.eye(2), ("vx", "vy"), "RR", 1.0)
+    (False, 1.0)
+    """
+    J = numeric_jacobian(J_rows, "J_rows")
+    a, b = dimensionless_scales(rows, joint_types, length)
+    if J.shape != (a.size, b.size):
+        raise ValueError(f"J_rows must be {a.size}×{b.size} (the rows × the joints), got {describe(J_rows)}")
+    s = np.linalg.svd(a[:, None] * J * b[None, :], compute_uv=False)
+    r = float(s[-1] / s[0]) if s.size and s[0] > 0 else 0.0
+    return r < float(ratio), r

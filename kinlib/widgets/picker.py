@@ -53,9 +53,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from ._backend import describe
-from .manipulability import manipulability_values, singular_values, strongest_joints
-from .plotting import (
+from .._backend import describe
+from ..manipulability import manipulability_values, singular_values, strongest_joints
+from ..plotting import (
     JOINT_COLORS,
     default_ranges,
     draw_chain,
@@ -63,10 +63,10 @@ from .plotting import (
     draw_velocity,
     draw_velocity_ellipses,
 )
-from .plotting.common import as_configuration, checked_numeric, theta_tex
-from .plotting.primitives import add_line, set_line
-from .taskspace import ROW_LABELS, ROW_TEX, default_task_rows, is_planar, rows_label, task_row_indices, task_rows
-from .widgets_render import Blitter, data_url, display_bundle, new_figure, render_png
+from ..plotting.common import as_configuration, checked_numeric, theta_tex
+from ..plotting.primitives import add_line, set_line
+from ..taskspace import ROW_LABELS, ROW_TEX, default_task_rows, is_planar, rows_label, task_row_indices, task_rows
+from .render import Blitter, data_url, display_bundle, new_figure, render_png
 
 __all__ = [
     "explorer",
