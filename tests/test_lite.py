@@ -212,7 +212,8 @@ _READY = """() => {
   return !!k && k.status === 'idle' && !!w.content && w.content.widgets.length > 0;
 }"""
 _FIRST_PICTURE = """() => Array.from(document.querySelectorAll('.jp-OutputArea-output img')).some(
-  i => i.complete && i.naturalWidth >= 100)"""
+  i => i.complete && i.naturalWidth >= 100)
+  || document.querySelectorAll('.jp-OutputArea-output .kinlib-explorer .kinlib-links').length > 0"""
 
 
 def expose_app(site: Path) -> None:
@@ -301,7 +302,8 @@ _SCROLL_TO_EXPLORER = """async () => {
   const w = window.jupyterapp.shell.currentWidget;
   const i = w.content.widgets.findIndex(c => c.model.type === 'code'
     && c.model.sharedModel.getSource().includes('widgets.explorer(')
-    && c.model.outputs.toJSON().some(o => o.data && o.data['application/vnd.jupyter.widget-view+json']));
+    && c.model.outputs.toJSON().some(o => o.data && (o.data['application/vnd.jupyter.widget-view+json']
+        || String(o.data['application/javascript'] || '').includes('kinlibExplorer'))));
   if (i < 0) return i;
   await w.content.scrollToItem(i, 'start');  // the notebook app draws only the cells in view ("full" windowing)
   w.content.widgets[i].node.setAttribute('data-kinlib-explorer', String(i));
@@ -314,20 +316,26 @@ def explorer(page, timeout: float = 120):
     i = page.evaluate(_SCROLL_TO_EXPLORER)
     assert i >= 0, "the notebook shows no explorer (no `widgets.explorer(` cell with a widget output)"
     area = page.locator(f"[data-kinlib-explorer='{i}'] .jp-OutputArea").first
-    area.locator(".jupyter-widgets").first.wait_for(state="visible", timeout=timeout * 1000)
+    area.locator(".jupyter-widgets, .kinlib-explorer").first.wait_for(state="visible", timeout=timeout * 1000)
     assert labdriver_explorer_text() in area.text_content(), "the explorer's widget did not render"
     return area
 
 
-_NEW_PICTURE = """([img, before]) => img.src !== before && img.complete && img.naturalWidth > 0"""
+# the explorer's picture, as a string that changes when the picture does: the drawn arm of a kinlib explorer
+# (its SVG path), or an image's source once loaded
+_PICTURE_NOW = """(root) => { const l = root.querySelector('.kinlib-scene .kinlib-links');
+  if (l) return l.getAttribute('d');
+  const i = root.querySelector('img'); return i && i.complete && i.naturalWidth > 0 ? i.src : null; }"""
+_NEW_PICTURE = """([root, before]) => { const l = root.querySelector('.kinlib-scene .kinlib-links');
+  if (l) return l.getAttribute('d') !== before;
+  const i = root.querySelector('img'); return !!i && i.src !== before && i.complete && i.naturalWidth > 0; }"""
 
 
 def drag(page, area, handle, dx: float = 25, timeout: float = 120) -> float:
     """Drag the slider ``handle`` by ``dx`` px with the mouse (as a pointer user does; the arrow keys are tested
     too); wait until the explorer's picture in ``area`` is a new one. Returns the milliseconds from
     the mouse release to the new picture, in the page's clock."""
-    img = area.locator("img").first
-    before = img.get_attribute("src")
+    before = area.evaluate(_PICTURE_NOW)
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.mouse.move(x, y)
@@ -335,7 +343,7 @@ def drag(page, area, handle, dx: float = 25, timeout: float = 120) -> float:
     page.mouse.move(x + dx, y, steps=5)
     t0 = page.evaluate("() => performance.now()")
     page.mouse.up()
-    page.wait_for_function(_NEW_PICTURE, arg=[img.element_handle(), before], timeout=timeout * 1000, polling=50)
+    page.wait_for_function(_NEW_PICTURE, arg=[area.element_handle(), before], timeout=timeout * 1000, polling=50)
     return page.evaluate("() => performance.now()") - t0
 
 
@@ -418,21 +426,20 @@ def test_workbook_05_runs_offline_in_jupyterlite(handouts_site):
                 # 3. an explorer: drag θ1 and the picture changes
                 ex = explorer(page)
                 labdriver.wait_picture(ex, timeout=120, what="the explorer in JupyterLite")
-                before = ex.locator("img").first.get_attribute("src")
+                before = ex.evaluate(_PICTURE_NOW)
                 _slider, handle, readout = labdriver.slider(ex, "θ1")
                 value = readout.inner_text()
                 ms = drag(page, ex, handle)
                 assert readout.inner_text() != value, "the slider did not move"
-                assert ex.locator("img").first.get_attribute("src") != before, "the picture did not change"
+                assert ex.evaluate(_PICTURE_NOW) != before, "the picture did not change"
                 print(f"slider move → new picture {ms:.0f} ms")
                 # and from the keyboard, as in JupyterLab (the site drops the ←/→ heading bindings that would
                 # take the keys first: lite.SETTINGS_OVERRIDES)
-                img = ex.locator("img").first
                 for key in ("ArrowRight", "ArrowLeft"):
-                    value, before = readout.inner_text(), img.get_attribute("src")
+                    value, before = readout.inner_text(), ex.evaluate(_PICTURE_NOW)
                     handle.focus()
                     handle.press(key)
-                    page.wait_for_function(_NEW_PICTURE, arg=[img.element_handle(), before], timeout=120000)
+                    page.wait_for_function(_NEW_PICTURE, arg=[ex.element_handle(), before], timeout=120000)
                     assert readout.inner_text() != value, f"{key} on the focused slider did not move it"
                 ex.screenshot(path=str(SCREENSHOTS / "lite-05-explorer.png"))
                 assert not errors, f"page errors: {errors[:3]}"
