@@ -252,10 +252,12 @@ def open_workbook(browser, base: str, relpath: str = WORKBOOK, timeout: float = 
     return context, page, blocker, page.evaluate("() => performance.now()") / 1000
 
 
-def time_to_first_result(handouts: Path, browser=None) -> float:
+def time_to_first_result(handouts: Path, browser=None, moves: int = 0):
     """Seconds from opening workbook 05 of the site in ``handouts`` (``build/handouts``, with ``lite/``) to its
     first picture, running all cells as soon as the kernel is ready (page clock; ``make bench`` reports it).
-    The site is served from a hard-linked copy whose ``jupyter-lite.json`` exposes the app to the driver."""
+    The site is served from a hard-linked copy whose ``jupyter-lite.json`` exposes the app to the driver.
+    With ``moves``: the pair (seconds, [ms]) where [ms] are ``moves`` key presses on θ1 of the first explorer,
+    each timed from the keydown to the frame that shows the redrawn picture (labdriver.move_slider)."""
     import os
     import tempfile
 
@@ -281,19 +283,30 @@ def time_to_first_result(handouts: Path, browser=None) -> float:
         try:
             if browser is None:
                 with labdriver.chromium() as b:
-                    return _first_result(b, base)
-            return _first_result(browser, base)
+                    return _first_result(b, base, moves)
+            return _first_result(browser, base, moves)
         finally:
             server.shutdown()
             server.server_close()
 
 
-def _first_result(browser, base: str) -> float:
+def _first_result(browser, base: str, moves: int = 0):
+    import labdriver
+
     context, page, _blocker, _ready = open_workbook(browser, base)
     try:
         page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
         page.wait_for_function(_FIRST_PICTURE, timeout=180000, polling=100)
-        return page.evaluate("() => performance.now()") / 1000
+        first = page.evaluate("() => performance.now()") / 1000
+        if not moves:
+            return first
+        labdriver.run_all(page, timeout=300)  # every cell done: the explorers are drawn
+        area = explorer(page)
+        labdriver.wait_picture(area, timeout=120)
+        _slider, handle, _readout = labdriver.slider(area, "θ1")
+        handle.focus()
+        keys = ("ArrowRight", "ArrowLeft")
+        return first, [labdriver.move_slider(area, handle, keys[k % 2]) for k in range(moves)]
     finally:
         context.close()
 
