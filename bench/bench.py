@@ -836,8 +836,8 @@ def static_section(args, targets: Targets) -> list[str]:
     if missing:
         targets.upper("slider (static page)", None, T_SLIDER)
         return lines + [f"{NA} ({missing})"]
-    from kinlib.course import handouts
-    from kinlib.course.pages import build_assets
+    from kinlib.course.publish import handouts
+    from kinlib.course.publish.pages import build_assets
 
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -146,7 +146,7 @@ return res;
 
 
 def test_jupyterlite_runs_workbook_05_in_webkit(webkit, handouts_site, tmp_path):  # noqa: F811
-    from kinlib.course import lite
+    from kinlib.course.publish import lite
 
     server = lite.serve(handouts_site, 0, block=False)
     base = f"http://127.0.0.1:{server.server_address[1]}/"
