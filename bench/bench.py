@@ -849,7 +849,7 @@ def static_section(args, targets: Targets) -> list[str]:
             page = b.new_page(viewport={"width": 1400, "height": 1000})
             page.route("**/*", lambda r: r.continue_() if r.request.url.startswith("file:") else r.abort())
             page.goto((out / "solutions" / f"{nb.stem}.html").as_uri())
-            page.wait_for_selector(".kinlib-explorer .kinlib-links")
+            page.wait_for_selector(".kinlib-explorer .kinlib-arm")
             areas = page.locator(".jp-OutputArea-output").filter(has=page.locator(".kinlib-explorer"))
             for i in range(areas.count()):
                 ms = _slider_times(labdriver, areas.nth(i), args.moves)

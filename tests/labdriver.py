@@ -312,7 +312,7 @@ _PICTURE = """(root) => Array.from(root.querySelectorAll('img')).some(
   i => i.complete && i.naturalWidth >= 100 && i.naturalHeight >= 100
        && i.getBoundingClientRect().width >= 100 && i.getBoundingClientRect().height >= 100)
   || Array.from(root.querySelectorAll('svg.kinlib-picture')).some(
-  s => !!s.querySelector('.kinlib-links') && s.getBoundingClientRect().width >= 100
+  s => !!s.querySelector('.kinlib-arm') && s.getBoundingClientRect().width >= 100
        && s.getBoundingClientRect().height >= 100)"""
 
 

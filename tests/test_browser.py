@@ -164,7 +164,7 @@ def test_handout_page_renders_offline(sites, browser, spec):
             n_explorers = html.count("window.kinlibExplorer(host, S)")
             if n_explorers:
                 page.wait_for_function(
-                    "(n) => document.querySelectorAll('.kinlib-explorer svg.kinlib-picture .kinlib-links').length >= n",
+                    "(n) => document.querySelectorAll('.kinlib-explorer svg.kinlib-picture .kinlib-arm').length >= n",
                     arg=n_explorers,
                     timeout=15000,
                 )
@@ -246,9 +246,7 @@ def _explorer_on_static_page(sites, browser, stem, index=-1):
     root = _site(sites, "handouts")
     path = root / "solutions" / f"{stem}.html"
     page, watch = _open(browser, path)
-    page.wait_for_function(
-        "() => document.querySelectorAll('.kinlib-explorer .kinlib-links').length > 0", timeout=15000
-    )
+    page.wait_for_function("() => document.querySelectorAll('.kinlib-explorer .kinlib-arm').length > 0", timeout=15000)
     ex = page.locator(".kinlib-explorer").nth(index) if index >= 0 else page.locator(".kinlib-explorer").last
     ex.scroll_into_view_if_needed()
     return page, watch, ex
@@ -286,6 +284,14 @@ def test_static_page_05_explorer_goes_singular_without_a_kernel(sites, browser):
         text = live.inner_text()
         assert "Singular configuration" in text and "cannot move along" in text, text
         ex.screenshot(path=str(SCREENSHOTS / "static-05-explorer-singular.png"))
+        # printed (the PDF handouts): the drawing and the values stay, the sliders give way
+        page.emulate_media(media="print")
+        shown = ex.evaluate(
+            "root => ['.kinlib-picture', '.kinlib-arm', '.kinlib-readout', '.kinlib-status', '.kinlib-track']"
+            ".map(s => getComputedStyle(root.querySelector(s)).display !== 'none')"
+        )
+        assert shown == [True, True, True, True, False], shown
+        page.emulate_media(media="screen")
         times.sort()
         print(
             f"\nstatic page: key → new picture min {times[0]:.1f} / median {times[len(times) // 2]:.1f} / max {times[-1]:.1f} ms"
@@ -325,7 +331,7 @@ def test_static_page_3d_explorer_turns_and_moves(sites, browser):
     try:
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)
         ex.screenshot(path=str(SCREENSHOTS / "static-06-explorer-before.png"))
-        links = ex.locator(".kinlib-links")
+        links = ex.locator(".kinlib-arm")
         before = links.get_attribute("d")
         world = ex.locator(".kinlib-tool").get_attribute("data-x")
         ex.locator("svg.kinlib-picture").focus()

@@ -213,7 +213,7 @@ _READY = """() => {
 }"""
 _FIRST_PICTURE = """() => Array.from(document.querySelectorAll('.jp-OutputArea-output img')).some(
   i => i.complete && i.naturalWidth >= 100)
-  || document.querySelectorAll('.jp-OutputArea-output .kinlib-explorer .kinlib-links').length > 0"""
+  || document.querySelectorAll('.jp-OutputArea-output .kinlib-explorer .kinlib-arm').length > 0"""
 
 
 def expose_app(site: Path) -> None:
@@ -336,10 +336,10 @@ def explorer(page, timeout: float = 120):
 
 # the explorer's picture, as a string that changes when the picture does: the drawn arm of a kinlib explorer
 # (its SVG path), or an image's source once loaded
-_PICTURE_NOW = """(root) => { const l = root.querySelector('.kinlib-scene .kinlib-links');
+_PICTURE_NOW = """(root) => { const l = root.querySelector('.kinlib-scene .kinlib-arm');
   if (l) return l.getAttribute('d');
   const i = root.querySelector('img'); return i && i.complete && i.naturalWidth > 0 ? i.src : null; }"""
-_NEW_PICTURE = """([root, before]) => { const l = root.querySelector('.kinlib-scene .kinlib-links');
+_NEW_PICTURE = """([root, before]) => { const l = root.querySelector('.kinlib-scene .kinlib-arm');
   if (l) return l.getAttribute('d') !== before;
   const i = root.querySelector('img'); return !!i && i.src !== before && i.complete && i.naturalWidth > 0; }"""
 

@@ -68,16 +68,16 @@ def webkit():
 
 _STATIC = """
 const sleep = ms => new Promise(r => setTimeout(r, ms));
-for (let i = 0; i < 100 && !document.querySelector('.kinlib-explorer .kinlib-links'); i++) await sleep(100);
+for (let i = 0; i < 100 && !document.querySelector('.kinlib-explorer .kinlib-arm'); i++) await sleep(100);
 const all = document.querySelectorAll('.kinlib-explorer');
 if (!all.length) return {drawn: false};
 const ex = all[all.length - 1], X = ex.kinlib, S = X.S;
 const inp = ex.querySelector("input.kinlib-slider[data-joint='2']");
-const before = ex.querySelector('.kinlib-links').getAttribute('d');
+const before = ex.querySelector('.kinlib-arm').getAttribute('d');
 const k = Math.round((-Math.PI / 4 - S.ranges[1][0]) / (S.ranges[1][1] - S.ranges[1][0]) * S.ticks[1]);
 inp.value = String(k);
 inp.dispatchEvent(new Event('input', {bubbles: true}));
-return {drawn: true, moved: ex.querySelector('.kinlib-links').getAttribute('d') !== before, q2: X.q[1],
+return {drawn: true, moved: ex.querySelector('.kinlib-arm').getAttribute('d') !== before, q2: X.q[1],
         state: ex.querySelector('.kinlib-status').getAttribute('data-state'),
         det: ex.querySelector('.kinlib-det').textContent, held: ex.querySelector('.kinlib-held').textContent,
         blocked: ex.querySelectorAll('.kinlib-blocked').length, live: ex.querySelector('.kinlib-live').textContent,
@@ -132,14 +132,14 @@ const i = w.content.widgets.findIndex(c => c.model.type === 'code'
 res.explorer_cell = i;
 if (i < 0) { res.stage = 'no explorer output'; return res; }
 await w.content.scrollToItem(i, 'start');
-for (let k = 0; k < 100 && !w.content.widgets[i].node.querySelector('.kinlib-explorer .kinlib-links'); k++) await sleep(100);
+for (let k = 0; k < 100 && !w.content.widgets[i].node.querySelector('.kinlib-explorer .kinlib-arm'); k++) await sleep(100);
 const ex = w.content.widgets[i].node.querySelector('.kinlib-explorer');
 if (!ex) { res.stage = 'explorer not drawn'; return res; }
 const inp = ex.querySelector("input.kinlib-slider[data-joint='1']");
-const before = ex.querySelector('.kinlib-links').getAttribute('d');
+const before = ex.querySelector('.kinlib-arm').getAttribute('d');
 inp.value = String(+inp.value + 10);
 inp.dispatchEvent(new Event('input', {bubbles: true}));
-res.moved = ex.querySelector('.kinlib-links').getAttribute('d') !== before;
+res.moved = ex.querySelector('.kinlib-arm').getAttribute('d') !== before;
 res.stage = 'done';
 return res;
 """

@@ -210,7 +210,7 @@
     while (g.firstChild) g.removeChild(g.firstChild);
     var P = function (p) { return project(S, view, p); };
     if (!S.planar) { // the floor grid and the axes of {s}
-      var R = S.view.r, c = S.view.c, gl = svg("g", {stroke: C.grid, "stroke-width": 1}, g);
+      var R = S.view.r / Math.SQRT2, c = S.view.c, gl = svg("g", {stroke: C.grid, "stroke-width": 1}, g); // corners inside the view
       for (var i = -4; i <= 4; i++) {
         var u = c[0] + R * i / 4, v = c[1] + R * i / 4;
         svg("path", {d: pathOf([P([u, c[1] - R, 0]), P([u, c[1] + R, 0])])}, gl);
@@ -240,7 +240,7 @@
     }
     // the arm: links, joints (their axes), tool
     var scr = st.pts.map(P);
-    svg("path", {d: pathOf(scr), fill: "none", stroke: C.arm, "stroke-width": 4, "stroke-linejoin": "round", class: "kinlib-links"}, g);
+    svg("path", {d: pathOf(scr), fill: "none", stroke: C.arm, "stroke-width": 4, "stroke-linejoin": "round", class: "kinlib-arm"}, g);
     svg("rect", {x: scr[0][0] - 7, y: scr[0][1] - 3, width: 14, height: 10, fill: "#555", class: "kinlib-base"}, g);
     for (var j = 0; j < S.n; j++) {
       var pj = st.pts[j + 1], sj = scr[j + 1], ax = st.axes[j];
@@ -263,7 +263,13 @@
     tm.setAttribute("data-x", tool[0]); tm.setAttribute("data-y", tool[1]); tm.setAttribute("data-z", tool[2]);
     if (S.showVelocity) { // ṗ = J θ̇ from the tool, scaled
       var tip = []; for (k = 0; k < 3; k++) tip.push(tool[k] + ext * (k < d ? st.v[k] : 0));
-      var tp = P(tip), dx = tp[0] - ts[0], dy = tp[1] - ts[1], len = Math.hypot(dx, dy);
+      var tp = P(tip), dx = tp[0] - ts[0], dy = tp[1] - ts[1];
+      var f = 1; // a long arrow stops at the edge of the drawing (its direction kept; ṗ is in the readout)
+      [[dx, ts[0]], [dy, ts[1]]].forEach(function (a) {
+        if (a[0] > 0) f = Math.min(f, (S.size - 4 - a[1]) / a[0]); else if (a[0] < 0) f = Math.min(f, (4 - a[1]) / a[0]);
+      });
+      f = Math.max(f, 0); dx *= f; dy *= f; tp = [ts[0] + dx, ts[1] + dy];
+      var len = Math.hypot(dx, dy);
       if (len > 1) {
         svg("path", {d: pathOf([ts, tp]), stroke: C.vel, "stroke-width": 3, class: "kinlib-velocity"}, g);
         var ux = dx / len, uy = dy / len, hw = Math.min(7, len / 2);
@@ -345,7 +351,7 @@
     ".kinlib-explorer .kinlib-legend svg{vertical-align:middle;margin-right:6px}" +
     ".kinlib-explorer button{font:inherit;margin:2px;padding:2px 8px}.kinlib-explorer button:focus{outline:2px solid #0b4fa8}" +
     ".kinlib-sr{position:absolute;width:1px;height:1px;overflow:hidden;clip:rect(0 0 0 0);white-space:nowrap}" +
-    "@media print{.kinlib-explorer .kinlib-track,.kinlib-explorer .kinlib-orbit{display:none}}";
+    "@media print{.kinlib-explorer .kinlib-track,.kinlib-explorer .kinlib-orbit,.kinlib-explorer .kinlib-sr{display:none}}";
 
   function legendItem(ul, text, attrs, fill) {
     var li = el("li", {}, ul), s = svg("svg", {width: 30, height: 12, "aria-hidden": "true"}, li);

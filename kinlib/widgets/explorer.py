@@ -34,7 +34,7 @@ Accessible: native range inputs (arrow keys, Home/End, Page Up/Down) with ``aria
 degrees and a description of the singular marks; orbit buttons and arrow keys on the focused 3-D drawing;
 a ``role=status`` (``aria-live``) sentence after every move (state, singular values, the blocked direction);
 colours that differ in lightness and line style. HTML hooks for tests: ``.kinlib-status[data-state]``,
-``.kinlib-det``, ``.kinlib-held``, ``.kinlib-live``, ``.kinlib-mark[data-value]``, ``.kinlib-joint`` and
+``.kinlib-det``, ``.kinlib-held``, ``.kinlib-live``, ``.kinlib-mark[data-value]``, ``.kinlib-arm`` (the links' path), ``.kinlib-joint`` and
 ``.kinlib-tool`` (their world coordinates in ``data-x/y/z``); the explorer's root element carries
 ``.kinlib`` (the state, ``set(q)``).
 
@@ -247,7 +247,7 @@ class Explorer:
         J = self.chain.jacobian_geometric(Q)[:, list(self.ellipse_rows), :]
         smax = float(np.max(np.linalg.svd(J, compute_uv=False)[:, 0])) * vscale
         pts = np.concatenate([sk.transpose(1, 0, 2).reshape(3, -1), np.zeros((3, 1))], axis=1)
-        lo, hi = pts.min(axis=1) - 0.3 * smax, pts.max(axis=1) + 0.3 * smax
+        lo, hi = pts.min(axis=1) - smax, pts.max(axis=1) + smax  # room for the largest ellipse at any point
         if self.planar:
             c = 0.5 * (lo + hi)
             half = 0.5 * float(max(hi[0] - lo[0], hi[1] - lo[1])) * 1.08 + 1e-9
@@ -258,7 +258,7 @@ class Explorer:
             return {"x0": c[0] - half, "x1": c[0] + half, "y0": c[1] - half, "y1": c[1] + half, "tick": tick}
         c = 0.5 * (lo + hi)
         c[2] = max(c[2], 0.0)
-        r = float(np.max(np.linalg.norm(pts - c[:, None], axis=0))) + 0.3 * smax
+        r = float(np.max(np.linalg.norm(pts - c[:, None], axis=0))) + smax
         return {"c": c.tolist(), "r": r, "az": 0.6, "el": 0.45}
 
     @property
