@@ -88,8 +88,12 @@ notebooks: $(STAMP)
 	$(VENV)/bin/kinlib execute $(NB)
 
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
+# make handouts AUDIENCE=students -> build/handouts-students/: the same without any solution (page, PDF or
+# notebook), the folder to publish to students; build/handouts/ is the instructors' (it has the solutions).
+AUDIENCE ?= all
+HANDOUTS_OUT := $(if $(filter students,$(AUDIENCE)),build/handouts-students,build/handouts)
 handouts: $(STAMP) chromium
-	$(VENV)/bin/kinlib handouts notebooks --out build/handouts
+	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE)
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
 # http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.
