@@ -7,7 +7,7 @@ STAMP  := $(VENV)/.installed
 NOTEBOOKS := $(sort $(wildcard notebooks/[0-9][0-9]_*.ipynb))
 PYTEST_ARGS ?=
 
-.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium poppler bubblewrap clean
+.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium webkit poppler bubblewrap clean
 
 all: test
 
@@ -39,6 +39,14 @@ chromium:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; }
 
+# The second browser engine of the browser tests: Debian's WebKitGTK, driven from Debian's python3 (GObject
+# introspection) under Xvfb (tests/webkit_run.py, tests/test_second_engine.py).
+webkit:
+	@{ command -v xvfb-run >/dev/null 2>&1 && /usr/bin/python3 -c "import gi; gi.require_version('WebKit2', '4.1')" 2>/dev/null; } || { \
+	  echo "installing Debian's WebKitGTK, python3-gi and xvfb for the second-engine tests"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq gir1.2-webkit2-4.1 python3-gi xvfb >/dev/null; }
+
 # Debian's poppler-utils (pdftotext, pdfinfo, pdftoppm): tests/test_print.py reads the handout PDFs with them.
 poppler:
 	@command -v pdftotext >/dev/null 2>&1 || { \
@@ -55,7 +63,7 @@ bubblewrap:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq bubblewrap >/dev/null; }
 
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
-test: $(STAMP) lint chromium poppler bubblewrap
+test: $(STAMP) lint chromium webkit poppler bubblewrap
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
 	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider $(PYTEST_ARGS)
 

@@ -396,6 +396,20 @@ class SerialChain:
             self._num[what] = tp.compile(rows, self.thetas, f"{self.name}.{what}")
         return self._num[what]
 
+    def numeric_code(self, what: str) -> CompiledMatrix:
+        """The generated numeric code behind the float path of ``fk`` (``"fk"``), ``jacobian_space`` (``"js"``),
+        ``jacobian_body`` (``"jb"``), ``jacobian_geometric`` (``"jg"``) and ``skeleton`` (``"skeleton"``): a
+        :class:`~kinlib.codegen.CompiledMatrix` (its ``source``; ``javascript(name)`` prints the same cse'd
+        expressions as JavaScript, for :mod:`kinlib.widgets`). Numeric chains only.
+
+        >>> from kinlib.robots import planar_2r
+        >>> planar_2r(1, 1).numeric_code("skeleton").shape
+        (3, 4)
+        """
+        if what not in ("fk", "js", "jb", "jg", "skeleton"):
+            raise ValueError(f"what must be one of 'fk', 'js', 'jb', 'jg', 'skeleton', got {what!r}")
+        return self._compiled(what)
+
     # --- kinematics ------------------------------------------------------------------------------
     def fk(self, q=None):
         """T(θ) = e^{[S1]θ1} ⋯ e^{[Sn]θn} M (4×4; (N, 4, 4) for a batch).

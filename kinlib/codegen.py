@@ -25,7 +25,9 @@ chain's exact numbers (building the exact SymPy expression of a dense 7-joint ar
 Simplified expressions would be slower: simplification destroys the shared subexpressions. The printer only rearranges what it prints (rationals as
 float literals, ``c - a*b`` rather than ``-a*b + c``, ``(x*x)`` rather than ``x**2``), so the
 numbers agree with the expression to rounding.
-``CompiledMatrix.source`` holds the generated code.
+``CompiledMatrix.source`` holds the generated code; :meth:`CompiledMatrix.javascript` prints the same
+temporaries and entries as a JavaScript function (SymPy's JavaScript printer), for the explorers that compute
+in the browser (:mod:`kinlib.widgets`).
 """
 
 from __future__ import annotations
@@ -37,12 +39,13 @@ from collections.abc import Sequence
 
 import numpy as np
 import sympy as sp
+from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.precedence import precedence
 from sympy.printing.pycode import PythonCodePrinter
 
 from ._backend import describe
 
-__all__ = ["CompiledMatrix"]
+__all__ = ["CompiledMatrix", "javascript_function"]
 
 _MATH = {name: getattr(math, name) for name in ("sin", "cos", "tan", "sqrt", "exp", "log", "atan2", "pi", "e")}
 _NUMPY = {
@@ -103,6 +106,56 @@ class _Printer(PythonCodePrinter):
         for sign, t in items[1:]:
             out += f" {sign} {t}"
         return out
+
+
+class _JSPrinter(JavascriptCodePrinter):
+    """JavaScript printer for generated numeric code: rationals as float literals (the same correctly rounded
+    double as in the Python code), small integer powers as products."""
+
+    def _print_Rational(self, expr):
+        return repr(float(expr))
+
+    def _print_Half(self, expr):
+        return "0.5"
+
+    def _print_Float(self, expr):
+        return repr(float(expr))
+
+    def _print_Pow(self, expr):
+        b, e = expr.args
+        if e.is_Integer and 2 <= int(e) <= 4:
+            base = self.parenthesize(b, precedence(expr), strict=False)
+            return "(" + "*".join([base] * int(e)) + ")"
+        if e.is_Integer and int(e) == -1:
+            return "(1/" + self.parenthesize(b, precedence(expr), strict=False) + ")"
+        return super()._print_Pow(expr)
+
+
+_JS_NAME = re.compile(r"^[A-Za-z_$][A-Za-z0-9_$]*$")
+
+
+def javascript_function(repl, reduced, n: int, name: str) -> str:
+    """``function name(q) {…}``: JavaScript for cse pieces (``repl`` a list of (temporary, expression),
+    ``reduced`` the entries, both in the joint symbols ``_q0 … _q{n−1}``) returning the entries as an Array.
+
+    >>> x0, q0 = sp.symbols("_x0 _q0")
+    >>> print(javascript_function([(x0, sp.sin(q0))], [x0, x0**2 / 2], 1, "f"))
+    function f(q) {
+      const _q0 = q[0];
+      const _x0 = Math.sin(_q0);
+      return [_x0, (0.5)*(_x0*_x0)];
+    }
+    """
+    if not isinstance(name, str) or not _JS_NAME.match(name):
+        raise ValueError(f"name must be a JavaScript identifier, got {describe(name)}")
+    pr = _JSPrinter()
+    lines = [f"function {name}(q) {{"]
+    if n:
+        lines.append("  const " + ", ".join(f"_q{i} = q[{i}]" for i in range(n)) + ";")
+    lines += [f"  const {s} = {pr.doprint(e)};" for s, e in repl]
+    items = [repr(v) if (v := _constant(e)) is not None else pr.doprint(e) for e in reduced]
+    lines += ["  return [" + ", ".join(items) + "];", "}"]
+    return "\n".join(lines)
 
 
 def _constant(e: sp.Expr):
@@ -591,6 +644,20 @@ class CompiledMatrix:
         exec(compile(source, f"<kinlib {self.name} batch>", "exec"), ns_batch)
         self._batch_fn = ns_batch["_batch"]
         self._batch_source = source
+
+    def javascript(self, name: str = "matrix") -> str:
+        """The same straight-line code as a JavaScript ``function name(q)`` returning the rows·cols entries
+        (row-major) as an Array: the temporaries and entries this matrix was compiled from, printed by SymPy's
+        JavaScript printer (see :func:`javascript_function`).
+
+        >>> x = sp.Symbol("x", real=True)
+        >>> print(CompiledMatrix(sp.Matrix([[sp.cos(x), 1]]), [x]).javascript("f"))
+        function f(q) {
+          const _q0 = q[0];
+          return [Math.cos(_q0), 1.0];
+        }
+        """
+        return javascript_function(self._repl, self._reduced, self.n, name)
 
     @property
     def source(self) -> str:

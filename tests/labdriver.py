@@ -261,7 +261,8 @@ _MARK_WIDGET_CELLS = """() => {
   const found = [];
   w.content.widgets.forEach((c, i) => {
     if (c.model.type !== 'code') return;
-    if (c.model.outputs.toJSON().some(o => o.data && o.data['application/vnd.jupyter.widget-view+json'])) {
+    if (c.model.outputs.toJSON().some(o => o.data && (o.data['application/vnd.jupyter.widget-view+json']
+        || String(o.data['application/javascript'] || '').includes('kinlibExplorer')))) {
       c.node.setAttribute('data-kinlib-cell', String(i));
       found.push(i);
     }
@@ -271,7 +272,8 @@ _MARK_WIDGET_CELLS = """() => {
 
 
 def widget_cells(page):
-    """The output areas of the code cells whose output is a Jupyter widget, in notebook order."""
+    """The output areas of the code cells whose output is a Jupyter widget or a kinlib explorer (its
+    ``application/javascript``), in notebook order."""
     return [page.locator(f"[data-kinlib-cell='{i}'] .jp-OutputArea").first for i in page.evaluate(_MARK_WIDGET_CELLS)]
 
 
@@ -295,7 +297,7 @@ def explorers(page, timeout: float = 60):
     found = []
     for area in widget_cells(page):
         scroll_to(area, timeout)
-        area.locator(".jupyter-widgets").first.wait_for(state="attached", timeout=timeout * 1000)
+        area.locator(".jupyter-widgets, .kinlib-explorer").first.wait_for(state="attached", timeout=timeout * 1000)
         if EXPLORER_TEXT in area.text_content():
             found.append(area)
     return found
@@ -308,7 +310,10 @@ def animations(page):
 
 _PICTURE = """(root) => Array.from(root.querySelectorAll('img')).some(
   i => i.complete && i.naturalWidth >= 100 && i.naturalHeight >= 100
-       && i.getBoundingClientRect().width >= 100 && i.getBoundingClientRect().height >= 100)"""
+       && i.getBoundingClientRect().width >= 100 && i.getBoundingClientRect().height >= 100)
+  || Array.from(root.querySelectorAll('svg.kinlib-picture')).some(
+  s => !!s.querySelector('.kinlib-arm') && s.getBoundingClientRect().width >= 100
+       && s.getBoundingClientRect().height >= 100)"""
 
 
 def scroll_to(locator, timeout: float = 60) -> None:
@@ -334,7 +339,13 @@ def wait_picture(locator, timeout: float = 60, what: str = "the output") -> None
 
 
 def slider(explorer, label: str = "θ1"):
-    """The joint slider of ``explorer`` whose description starts with ``label`` (θ1, θ2, ...)."""
+    """(slider, the element that takes the keys, its readout) of the joint slider ``label`` (θ1, θ2, ...) of
+    ``explorer``: a kinlib explorer's range input, or an ipywidgets slider's handle."""
+    if explorer.locator(".kinlib-explorer").count():
+        j = int(label.lstrip("θ"))
+        s = explorer.locator(f"input.kinlib-slider[data-joint='{j}']").first
+        value = explorer.locator(f"label:has(+ .kinlib-track input.kinlib-slider[data-joint='{j}']) .kinlib-value")
+        return s, s, value.first
     s = explorer.locator(".widget-slider, .widget-hslider").filter(has_text=label).first
     return s, s.locator(".noUi-handle").first, s.locator(".widget-readout").first
 
@@ -361,10 +372,27 @@ _ARM_CHANGE = """(root, events) => {
 }"""
 
 
+_SCENE_CHANGE = """(root, events) => {
+  const scene = root.querySelector('.kinlib-scene');
+  const change = {t0: null, ms: null};
+  window.__kinlibChange = change;
+  for (const ev of events)
+    root.addEventListener(ev, () => { if (change.t0 === null) change.t0 = performance.now(); }, {capture: true});
+  const obs = new MutationObserver(() => {
+    if (change.t0 === null || change.ms !== null) return;
+    obs.disconnect();
+    requestAnimationFrame(() => { change.ms = performance.now() - change.t0; });  // the frame that shows it
+  });
+  obs.observe(scene, {childList: true});
+}"""
+
+
 def _timed_change(area, action, events, timeout: float) -> float:
-    """Run ``action``; wait until the largest picture in ``area`` has a new source that has loaded. Returns the
-    milliseconds from the first of ``events`` (captured in the page) to the image's load event."""
-    area.evaluate(_ARM_CHANGE, list(events))
+    """Run ``action``; wait until the picture in ``area`` is new: a kinlib explorer's redrawn SVG scene (to the
+    next animation frame, the one that paints it), or the largest image's new source, loaded. Returns the
+    milliseconds from the first of ``events`` (captured in the page) to then."""
+    script = _SCENE_CHANGE if area.locator(".kinlib-scene").count() else _ARM_CHANGE
+    area.evaluate(script, list(events))
     action()
     area.page.wait_for_function("() => window.__kinlibChange.ms !== null", timeout=timeout * 1000, polling="raf")
     return float(area.page.evaluate("() => window.__kinlibChange.ms"))

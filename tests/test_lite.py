@@ -212,7 +212,8 @@ _READY = """() => {
   return !!k && k.status === 'idle' && !!w.content && w.content.widgets.length > 0;
 }"""
 _FIRST_PICTURE = """() => Array.from(document.querySelectorAll('.jp-OutputArea-output img')).some(
-  i => i.complete && i.naturalWidth >= 100)"""
+  i => i.complete && i.naturalWidth >= 100)
+  || document.querySelectorAll('.jp-OutputArea-output .kinlib-explorer .kinlib-arm').length > 0"""
 
 
 def expose_app(site: Path) -> None:
@@ -251,10 +252,12 @@ def open_workbook(browser, base: str, relpath: str = WORKBOOK, timeout: float = 
     return context, page, blocker, page.evaluate("() => performance.now()") / 1000
 
 
-def time_to_first_result(handouts: Path, browser=None) -> float:
+def time_to_first_result(handouts: Path, browser=None, moves: int = 0):
     """Seconds from opening workbook 05 of the site in ``handouts`` (``build/handouts``, with ``lite/``) to its
     first picture, running all cells as soon as the kernel is ready (page clock; ``make bench`` reports it).
-    The site is served from a hard-linked copy whose ``jupyter-lite.json`` exposes the app to the driver."""
+    The site is served from a hard-linked copy whose ``jupyter-lite.json`` exposes the app to the driver.
+    With ``moves``: the pair (seconds, [ms]) where [ms] are ``moves`` key presses on θ1 of the first explorer,
+    each timed from the keydown to the frame that shows the redrawn picture (labdriver.move_slider)."""
     import os
     import tempfile
 
@@ -280,19 +283,30 @@ def time_to_first_result(handouts: Path, browser=None) -> float:
         try:
             if browser is None:
                 with labdriver.chromium() as b:
-                    return _first_result(b, base)
-            return _first_result(browser, base)
+                    return _first_result(b, base, moves)
+            return _first_result(browser, base, moves)
         finally:
             server.shutdown()
             server.server_close()
 
 
-def _first_result(browser, base: str) -> float:
+def _first_result(browser, base: str, moves: int = 0):
+    import labdriver
+
     context, page, _blocker, _ready = open_workbook(browser, base)
     try:
         page.evaluate("() => window.jupyterapp.commands.execute('notebook:run-all-cells')")
         page.wait_for_function(_FIRST_PICTURE, timeout=180000, polling=100)
-        return page.evaluate("() => performance.now()") / 1000
+        first = page.evaluate("() => performance.now()") / 1000
+        if not moves:
+            return first
+        labdriver.run_all(page, timeout=300)  # every cell done: the explorers are drawn
+        area = explorer(page)
+        labdriver.wait_picture(area, timeout=120)
+        _slider, handle, _readout = labdriver.slider(area, "θ1")
+        handle.focus()
+        keys = ("ArrowRight", "ArrowLeft")
+        return first, [labdriver.move_slider(area, handle, keys[k % 2]) for k in range(moves)]
     finally:
         context.close()
 
@@ -301,7 +315,8 @@ _SCROLL_TO_EXPLORER = """async () => {
   const w = window.jupyterapp.shell.currentWidget;
   const i = w.content.widgets.findIndex(c => c.model.type === 'code'
     && c.model.sharedModel.getSource().includes('widgets.explorer(')
-    && c.model.outputs.toJSON().some(o => o.data && o.data['application/vnd.jupyter.widget-view+json']));
+    && c.model.outputs.toJSON().some(o => o.data && (o.data['application/vnd.jupyter.widget-view+json']
+        || String(o.data['application/javascript'] || '').includes('kinlibExplorer'))));
   if (i < 0) return i;
   await w.content.scrollToItem(i, 'start');  // the notebook app draws only the cells in view ("full" windowing)
   w.content.widgets[i].node.setAttribute('data-kinlib-explorer', String(i));
@@ -314,20 +329,26 @@ def explorer(page, timeout: float = 120):
     i = page.evaluate(_SCROLL_TO_EXPLORER)
     assert i >= 0, "the notebook shows no explorer (no `widgets.explorer(` cell with a widget output)"
     area = page.locator(f"[data-kinlib-explorer='{i}'] .jp-OutputArea").first
-    area.locator(".jupyter-widgets").first.wait_for(state="visible", timeout=timeout * 1000)
+    area.locator(".jupyter-widgets, .kinlib-explorer").first.wait_for(state="visible", timeout=timeout * 1000)
     assert labdriver_explorer_text() in area.text_content(), "the explorer's widget did not render"
     return area
 
 
-_NEW_PICTURE = """([img, before]) => img.src !== before && img.complete && img.naturalWidth > 0"""
+# the explorer's picture, as a string that changes when the picture does: the drawn arm of a kinlib explorer
+# (its SVG path), or an image's source once loaded
+_PICTURE_NOW = """(root) => { const l = root.querySelector('.kinlib-scene .kinlib-arm');
+  if (l) return l.getAttribute('d');
+  const i = root.querySelector('img'); return i && i.complete && i.naturalWidth > 0 ? i.src : null; }"""
+_NEW_PICTURE = """([root, before]) => { const l = root.querySelector('.kinlib-scene .kinlib-arm');
+  if (l) return l.getAttribute('d') !== before;
+  const i = root.querySelector('img'); return !!i && i.src !== before && i.complete && i.naturalWidth > 0; }"""
 
 
 def drag(page, area, handle, dx: float = 25, timeout: float = 120) -> float:
     """Drag the slider ``handle`` by ``dx`` px with the mouse (as a pointer user does; the arrow keys are tested
     too); wait until the explorer's picture in ``area`` is a new one. Returns the milliseconds from
     the mouse release to the new picture, in the page's clock."""
-    img = area.locator("img").first
-    before = img.get_attribute("src")
+    before = area.evaluate(_PICTURE_NOW)
     box = handle.bounding_box()
     x, y = box["x"] + box["width"] / 2, box["y"] + box["height"] / 2
     page.mouse.move(x, y)
@@ -335,7 +356,7 @@ def drag(page, area, handle, dx: float = 25, timeout: float = 120) -> float:
     page.mouse.move(x + dx, y, steps=5)
     t0 = page.evaluate("() => performance.now()")
     page.mouse.up()
-    page.wait_for_function(_NEW_PICTURE, arg=[img.element_handle(), before], timeout=timeout * 1000, polling=50)
+    page.wait_for_function(_NEW_PICTURE, arg=[area.element_handle(), before], timeout=timeout * 1000, polling=50)
     return page.evaluate("() => performance.now()") - t0
 
 
@@ -418,21 +439,20 @@ def test_workbook_05_runs_offline_in_jupyterlite(handouts_site):
                 # 3. an explorer: drag θ1 and the picture changes
                 ex = explorer(page)
                 labdriver.wait_picture(ex, timeout=120, what="the explorer in JupyterLite")
-                before = ex.locator("img").first.get_attribute("src")
+                before = ex.evaluate(_PICTURE_NOW)
                 _slider, handle, readout = labdriver.slider(ex, "θ1")
                 value = readout.inner_text()
                 ms = drag(page, ex, handle)
                 assert readout.inner_text() != value, "the slider did not move"
-                assert ex.locator("img").first.get_attribute("src") != before, "the picture did not change"
+                assert ex.evaluate(_PICTURE_NOW) != before, "the picture did not change"
                 print(f"slider move → new picture {ms:.0f} ms")
                 # and from the keyboard, as in JupyterLab (the site drops the ←/→ heading bindings that would
                 # take the keys first: lite.SETTINGS_OVERRIDES)
-                img = ex.locator("img").first
                 for key in ("ArrowRight", "ArrowLeft"):
-                    value, before = readout.inner_text(), img.get_attribute("src")
+                    value, before = readout.inner_text(), ex.evaluate(_PICTURE_NOW)
                     handle.focus()
                     handle.press(key)
-                    page.wait_for_function(_NEW_PICTURE, arg=[img.element_handle(), before], timeout=120000)
+                    page.wait_for_function(_NEW_PICTURE, arg=[ex.element_handle(), before], timeout=120000)
                     assert readout.inner_text() != value, f"{key} on the focused slider did not move it"
                 ex.screenshot(path=str(SCREENSHOTS / "lite-05-explorer.png"))
                 assert not errors, f"page errors: {errors[:3]}"

@@ -1,7 +1,13 @@
-"""kinlib.widgets: the explorer and the configuration picker react to their controls and say the right
-thing about singular configurations (known independently: problem 5.1's θ2 = −π/4, the UR5 at home)."""
+"""kinlib.widgets: the explorer computed in the browser (kinlib/widgets/explorer.js with the functions kinlib
+generates) draws the arm where the forward kinematics puts it and says the right thing about singular
+configurations — checked against independent computation (modern_robotics, NumPy SVD, the closed-form
+singular set), numerically with Node (when installed) and drawn in Chromium (``browser`` mark); the
+configuration picker (problem 4.1) reacts to its buttons."""
 
+import json
 import math
+import shutil
+import subprocess
 
 import matplotlib
 
@@ -11,10 +17,31 @@ import matplotlib.pyplot as plt  # noqa: E402
 import modern_robotics as mr  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+import sympy as sp  # noqa: E402
 
-from kinlib import robots, widgets, widgets_render  # noqa: E402
+from kinlib import robots, widgets  # noqa: E402
+from kinlib.manipulability import NEAR_SINGULAR, peak_manipulability, singularity_state  # noqa: E402
+from kinlib.taskspace import task_rows  # noqa: E402
 
 PNG = b"\x89PNG"
+NODE = shutil.which("node")
+
+#: every robot of kinlib.robots, with numbers for its lengths, and its explorer's keywords (as the notebooks)
+ROBOTS = {
+    "cart_pole": (lambda: robots.cart_pole(1, sp.Rational(1, 2)), {"rows": ("vx", "vy")}),
+    "planar_2r": (lambda: robots.planar_2r(1, sp.Rational(3, 4)), {}),
+    "planar_3r": (lambda: robots.planar_3r(1, 1, 1), {}),
+    "planar_offset_3r": (lambda: robots.planar_offset_3r(1), {}),
+    "planar_rpp": (lambda: robots.planar_rpp(1), {}),
+    "spatial_rppr": (lambda: robots.spatial_rppr(1, sp.Rational(3, 5)), {"rows": "all"}),
+    "ur5": (lambda: robots.ur5(), {}),
+}
+
+
+def test_every_robot_is_covered():
+    made = {n for n in dir(robots) if callable(getattr(robots, n)) and not n.startswith("_")}
+    makers = {n for n in made if n not in ("SerialChain", "describe", "exact_number", "from_urdf_joints", "length")}
+    assert makers <= set(ROBOTS), makers - set(ROBOTS)
 
 
 @pytest.fixture(scope="module")
@@ -26,131 +53,281 @@ def tool_position(chain, q):
     return mr.FKinSpace(np.array(chain.M, float), np.array(chain.screws, float), np.asarray(q, float))[:3, 3]
 
 
-def pdot_fd(chain, q, qdot, h=1e-6):
-    """ṗ by central differences of the modern_robotics forward kinematics."""
-    q, qdot = np.asarray(q, float), np.asarray(qdot, float)
-    return (tool_position(chain, q + h * qdot) - tool_position(chain, q - h * qdot)) / (2 * h)
+def _configs(ex, k, seed):
+    rng = np.random.default_rng(seed)
+    lo = np.array([r[0] for r in ex.ranges])
+    hi = np.array([r[1] for r in ex.ranges])
+    return lo + (hi - lo) * rng.random((k, ex.chain.n))
 
 
-@pytest.mark.parametrize(
-    "make",
-    [
-        lambda: robots.cart_pole(1, 1),
-        lambda: robots.planar_offset_3r(1),
-        lambda: robots.spatial_rppr(1, 1),
-        lambda: robots.planar_3r(1, 1, 1),
-        lambda: robots.planar_rpp(1),
-        lambda: robots.ur5(),
-    ],
-)
-def test_explorer_builds_for_every_robot(make):
-    chain = make()
-    ex = widgets.explorer(chain)
-    assert len(ex.sliders) == chain.n and len(ex.rate_sliders) == chain.n
-    assert bytes(ex.picture).startswith(PNG)
-    for i, s in enumerate(ex.sliders):
-        assert s.description.startswith(f"θ{i + 1} (")
-        assert ("rad" in s.description) == (chain.joint_types[i] == "R")
-    q = np.linspace(0.1, 0.4, chain.n)
-    ex.update(q)
-    d = 2 if ex.planar else 3
-    np.testing.assert_allclose(ex.arm.tool_position, tool_position(chain, q), atol=1e-9)
-    assert ex.velocity.velocity.shape == (d,)
-
-
-def test_status_at_a_singular_and_a_regular_configuration(r3):
-    ex = widgets.explorer(r3, q=[0.3, math.pi / 4, 0.2])
-    assert ex.state == "regular"
-    assert "singular" not in ex.status.value.lower()
-    img = bytes(ex.picture)
-    # a slider move (as in the browser) to θ2 = −π/4: problem 5.1's singular configuration
-    ex.sliders[1].value = -math.pi / 4
-    assert ex.state == "singular"
-    assert "SINGULAR configuration" in ex.status.value
-    assert ex.info["rank"] == 2 and abs(ex.info["det"]) < 1e-9
-    assert bytes(ex.picture) != img
-    # close to it, but not at it
-    ex.sliders[1].value = -math.pi / 4 + 0.05
-    assert ex.state == "near" and "near a singular configuration" in ex.status.value
-    # the other family θ2 = 3π/4, reached through update()
-    ex.update([1.0, 3 * math.pi / 4, -2.0])
-    assert ex.state == "singular"
-    ex.update([1.0, 0.0, -2.0])
-    assert ex.state == "regular" and "singular" not in ex.status.value.lower()
-
-
-def test_slider_step_reaches_the_singular_value(r3):
-    ex = widgets.explorer(r3)
-    s = ex.sliders[1]
-    k = round((-math.pi / 4 - s.min) / s.step)
-    s.value = s.min + k * s.step  # what a slider at an integer number of steps reports
-    assert ex.state == "singular"
-
-
-def test_explorer_readout_matches_the_kinematics(r3):
-    q, qdot = [0.2, -0.7, 0.5], [0.5, -1.0, 0.25]
-    ex = widgets.explorer(r3, q=q, qdot=qdot)
-    pdot = pdot_fd(r3, q, qdot)
-    np.testing.assert_allclose(ex.velocity.velocity, pdot[:2], atol=1e-6)
-    J = mr.JacobianSpace(np.array(r3.screws, float), np.array(q))[[2, 3, 4]]
-    assert ex.info["det"] == pytest.approx(np.linalg.det(J), abs=1e-9)
-    assert ex.info["manipulability"] == pytest.approx(abs(np.linalg.det(J)), abs=1e-9)
-    assert f"<span class='kinlib-det'>{ex.info['det']:+.4g}</span>" in ex.readout.value
-    # the rate sliders drive the arrow
-    arrow = ex.velocity.artist
-    ex.rate_sliders[0].value = 2.0
-    assert ex.velocity.artist is arrow
-    qd = [2.0, -1.0, 0.25]
-    pdot = pdot_fd(r3, q, qd)
-    np.testing.assert_allclose(ex.velocity.velocity, pdot[:2], atol=1e-6)
-
-
-def test_explorer_updates_artists_in_place(r3):
-    ex = widgets.explorer(r3)
-    ids = [id(a) for a in ex.arm.artists + ex.ellipse.artists + ex.velocity.artists]
-    children = len(ex.ax.get_children())
-    for v in (0.3, 0.6, -1.0):
-        ex.sliders[2].value = v
-    assert [id(a) for a in ex.arm.artists + ex.ellipse.artists + ex.velocity.artists] == ids
-    assert len(ex.ax.get_children()) == children
-    np.testing.assert_allclose(ex.q, [0, 0, -1.0])
-    # the cached-background picture equals a full redraw of the same state
-    import io
-
-    from PIL import Image
-
-    fast = np.asarray(Image.open(io.BytesIO(ex.picture)).convert("RGB"), float)  # 8-bit (palette) PNG
-    for a in ex._blit.artists:
-        a.set_animated(False)
-    full = np.asarray(Image.open(io.BytesIO(widgets_render.render_png(ex.fig))).convert("RGB"), float)
-    assert fast.shape == full.shape
-    assert np.mean(np.any(np.abs(fast - full) > 40, axis=-1)) < 0.01  # equal up to the palette's rounding
-
-
-def test_ur5_home_is_singular():
-    ex = widgets.explorer(robots.ur5(), rate_sliders=False)
-    assert ex.rate_sliders == []
-    assert ex.state == "singular"  # θ5 = 0: the wrist singularity of the UR5
-    ex.update([0.1, -0.6, 1.2, 0.3, 0.8, 0.2])
+# --- kernel side: what the explorer sends ---------------------------------------------------------------
+def test_the_05_explorer_knows_the_closed_form_singular_set(r3):
+    """Problem 5.1: det J ∝ sin(θ2 + π/4): the family θ2 = −π/4 + kπ, exactly as singular_configurations says."""
+    ex = widgets.explorer(r3, q=[math.pi / 6, math.pi / 6, -math.pi / 3])
+    assert ex.conditions == [{"families": {"1": {"offset": -math.pi / 4, "period": math.pi}}}] and ex.complete
     assert ex.state != "singular"
+    assert ex.update([0.3, -math.pi / 4, 0.2]).state == "singular"
+    assert ex.update([0.3, 3 * math.pi / 4, 0.2]).state == "singular"
+    assert ex.update([0.3, -math.pi / 4 + 1e-6, 0.2]).state == "near"  # a float off the family: near, not singular
 
 
-def test_explorer_bad_input(r3):
-    with pytest.raises(ValueError, match=r"symbolic.*\bL\b"):  # names the parameter without a number
-        widgets.explorer(robots.planar_offset_3r())
-    with pytest.raises(ValueError, match="q must hold 3"):
-        widgets.explorer(r3, q=[0, 0])
+def test_several_joint_families_need_all_joints():
+    """planar 3R, task (ṗ_x, ṗ_y): singular only when θ2 and θ3 are both multiples of π (stretched and folded)."""
+    ex = widgets.explorer(robots.planar_3r(1, 1, 1), rows=("vx", "vy"), q=[0.2, 0.0, 0.5])
+    assert {tuple(sorted(c["families"])) for c in ex.conditions} == {("1", "2")}
+    assert ex.state != "singular" and ex.update([0.2, 0.0, math.pi]).state == "singular"
+
+
+def test_near_rule_is_the_course_rule(r3):
+    """The explorer's "near" is kinlib.manipulability.singularity_state's: w < NEAR_SINGULAR · w_max, with w_max
+    the arm's largest manipulability over the slider ranges (within the sample: at most, never above it)."""
     ex = widgets.explorer(r3)
-    with pytest.raises(ValueError, match="q must hold 3"):
-        ex.update([0, 0, 0, 0])
-    with pytest.raises(ValueError, match="qdot"):
-        ex.update(qdot=[1])
-    with pytest.raises(ValueError, match="lo < hi"):
+    w_max = peak_manipulability(r3, ex.rows, ex.ranges)
+    assert w_max * (1 - 1e-3) <= ex.w_max <= np.sqrt(2) + 1e-12  # √2 L² exactly for this arm (L = 1)
+    for q in [*_configs(ex, 20, 1), [0.3, -np.pi / 4 + 0.05, 0.2]]:
+        ex.update(q)
+        J = task_rows(r3.jacobian_geometric(q), ex.rows)
+        expected = singularity_state(J, ex.w_max)
+        if ex.state != "singular":
+            assert ex.state == expected
+        assert (ex.state == "near") == (np.prod(np.linalg.svd(J, compute_uv=False)) < NEAR_SINGULAR * ex.w_max)
+
+
+def test_near_rule_is_unit_aware():
+    """Lengths in mm instead of m: the same w / w_max (the rule has no unit)."""
+    q = [0.3, 0.9, -0.4]
+    r_m, r_mm = robots.planar_offset_3r(1), robots.planar_offset_3r(1000)
+    a = widgets.explorer(r_m, q=q).info["w_ratio"]
+    b = widgets.explorer(r_mm, q=q).info["w_ratio"]
+    assert abs(a - b) < 1e-12
+
+
+def test_bad_input(r3):
+    with pytest.raises(ValueError, match="L"):
+        widgets.explorer(robots.planar_offset_3r())
+    with pytest.raises(ValueError, match="q"):
+        widgets.explorer(r3, q=[0, 0])
+    with pytest.raises(ValueError, match="ranges"):
         widgets.explorer(r3, ranges={2: (1, -1)})
-    ex = widgets.explorer(robots.planar_offset_3r(), params={"L": 1}, ranges={2: (-1, 1)})
-    assert (ex.sliders[1].min, ex.sliders[1].max) == (-1, 1)
+    with pytest.raises(ValueError, match="size"):
+        widgets.explorer(r3, size=10)
+    with pytest.raises(TypeError, match="unexpected"):
+        widgets.explorer(r3, colour="red")
 
 
+def test_display_bundle_carries_the_front_end_and_a_static_picture(r3):
+    import base64
+
+    b = widgets.explorer(r3)._repr_mimebundle_()
+    assert set(b) == {"application/javascript", "image/png", "text/plain"}
+    assert base64.b64decode(b["image/png"]).startswith(PNG)
+    js = b["application/javascript"]
+    assert "function skel(q)" in js and "function jg(q)" in js and "kinlibExplorer" in js
+    assert "</script" not in js.lower()  # safe inside a page's <script>
+    assert "explorer of planar_offset_3r" in b["text/plain"]
+
+
+def test_output_is_deterministic(r3):
+    assert widgets.explorer(r3).javascript == widgets.explorer(r3).javascript
+
+
+def test_importing_widgets_leaves_pyplot_figures_alone(r3):
+    n = len(plt.get_fignums())
+    widgets.explorer(r3)._repr_mimebundle_()
+    widgets.config_picker(robots.planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]})
+    assert len(plt.get_fignums()) == n
+
+
+# --- the generated JavaScript, run by Node: the same numbers as NumPy ---------------------------------
+_NODE_RUN = """
+global.window = global; global.element = {}; global.performance = {now: () => 0};
+const fs = require('fs');
+const src = fs.readFileSync(process.argv[2], 'utf8');
+const job = JSON.parse(fs.readFileSync(process.argv[3], 'utf8'));
+const results = [];
+global.kinlibExplorer_capture = null;
+window.kinlibExplorer = null;
+eval(src.replace('window.kinlibExplorer(host, S);', 'global.kinlibExplorer_capture = S;'));
+const S = global.kinlibExplorer_capture, M = window.kinlibExplorerMath;
+for (const q of job.qs) {
+  const st = M.compute(S, q, S.qd0);
+  results.push({pts: st.pts, J: st.J, s: st.s, det: st.det, state: st.state, wRatio: st.wRatio, w: st.w,
+                held: st.held ? st.held.s : null, free: st.free.s, marks: q.map((_, j) => M.marksFor(S, q, j))});
+}
+process.stdout.write(JSON.stringify(results));
+"""
+
+
+def _node(ex, qs, tmp_path):
+    (tmp_path / "run.js").write_text(_NODE_RUN)
+    (tmp_path / "ex.js").write_text(ex.javascript)
+    (tmp_path / "job.json").write_text(json.dumps({"qs": [list(map(float, q)) for q in qs]}))
+    out = subprocess.run(
+        [NODE, str(tmp_path / "run.js"), str(tmp_path / "ex.js"), str(tmp_path / "job.json")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert out.returncode == 0, out.stderr
+    return json.loads(out.stdout)
+
+
+@pytest.mark.skipif(NODE is None, reason="node is not installed")
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_generated_javascript_equals_numpy(name, tmp_path):
+    """At random configurations: the skeleton, J, σ's, det, manipulability and the state computed by the
+    browser code equal NumPy's (SVD) and modern_robotics' forward kinematics."""
+    make, kw = ROBOTS[name]
+    chain = make()
+    ex = widgets.explorer(chain, **kw)
+    qs = _configs(ex, 12, 7)
+    for q, got in zip(qs, _node(ex, qs, tmp_path)):
+        pts = np.array(got["pts"]).T
+        np.testing.assert_allclose(pts, chain.skeleton(q), atol=1e-9)
+        np.testing.assert_allclose(pts[:, -1], tool_position(chain, q), atol=1e-9)
+        J = chain.jacobian_geometric(q)
+        np.testing.assert_allclose(np.array(got["J"]).reshape(6, chain.n), J, atol=1e-9)
+        Jr = task_rows(J, ex.rows)
+        s = np.linalg.svd(Jr, compute_uv=False)
+        np.testing.assert_allclose(got["s"], s, atol=1e-7 * max(1.0, s[0]))
+        np.testing.assert_allclose(got["w"], np.prod(s), atol=1e-7 * max(1.0, s[0]) ** len(s))
+        if Jr.shape[0] == Jr.shape[1]:
+            np.testing.assert_allclose(got["det"], np.linalg.det(Jr), atol=1e-8 * max(1.0, s[0]) ** len(s))
+        ex.update(q)
+        assert got["state"] == ex.state
+        assert abs(got["wRatio"] - ex.info["w_ratio"]) < 1e-7
+
+
+@pytest.mark.skipif(NODE is None, reason="node is not installed")
+def test_slider_marks_are_the_closed_form_families(r3, tmp_path):
+    """The 05 robot: θ2's track is marked at −π/4 + kπ in [−π, π] (−π/4 and 3π/4), whatever θ1 and θ3; the
+    other tracks carry no mark (the family does not involve them)."""
+    ex = widgets.explorer(r3)
+    qs = _configs(ex, 5, 3)
+    for got in _node(ex, qs, tmp_path):
+        assert got["marks"][0] == [] and got["marks"][2] == []
+        np.testing.assert_allclose(got["marks"][1], [-math.pi / 4, 3 * math.pi / 4], atol=1e-15)
+
+
+@pytest.mark.skipif(NODE is None, reason="node is not installed")
+def test_expression_conditions_are_marked_where_they_vanish(tmp_path):
+    """The UR5 (closed form asked for): the shoulder condition f(θ2, θ3, θ4) = 0 is marked on θ2's track at
+    roots of f found by bisection; f vanishes there."""
+    ur5 = robots.ur5()
+    ex = widgets.explorer(ur5, singular_budget=60.0)
+    k = next(c for c in ex.conditions if "expr" in c)
+    q = np.array([0.1, 0.4, -0.8, 0.3, 1.1, 0.2])
+    got = _node(ex, [q], tmp_path)[0]
+    assert got["marks"][1], "no mark on θ2's track"
+    f = ex._exprs[k["expr"]]
+    for x in got["marks"][1]:
+        qq = q.copy()
+        qq[1] = x
+        assert abs(f(qq)[0, 0]) < 1e-9 * k["scale"]
+
+
+# --- drawn in Chromium: what is drawn is where fk says ------------------------------------------------
+@pytest.fixture(scope="module")
+def chromium():
+    from pathlib import Path
+
+    if not Path("/usr/bin/chromium").exists():
+        pytest.skip("chromium is not installed")
+    from playwright.sync_api import sync_playwright
+
+    with sync_playwright() as p:
+        b = p.chromium.launch(executable_path="/usr/bin/chromium", args=["--no-sandbox"])
+        yield b
+        b.close()
+
+
+def page_with(browser, exs, tmp_path):
+    body = "".join(
+        f'<div class="out"><script>var element = document.currentScript.parentNode;\n{ex.javascript}</script></div>'
+        for ex in exs
+    )
+    path = tmp_path / "explorers.html"
+    path.write_text(f"<!doctype html><html><head><meta charset='utf-8'></head><body>{body}</body></html>")
+    page = browser.new_page(viewport={"width": 1100, "height": 900})
+    errors = []
+    page.on("pageerror", lambda e: errors.append(str(e)))
+    page.route("**/*", lambda route: route.continue_() if route.request.url.startswith("file:") else route.abort())
+    page.goto(path.as_uri())
+    return page, errors
+
+
+_READ_BACK = """([q]) => {
+  const root = document.querySelector('.kinlib-explorer'), X = root.kinlib;
+  X.set(q);
+  const pick = sel => Array.from(root.querySelectorAll(sel)).map(e => ({
+    x: +e.getAttribute('data-x'), y: +e.getAttribute('data-y'), z: +e.getAttribute('data-z'),
+    cx: e.tagName === 'circle' ? +e.getAttribute('cx') : +e.getAttribute('x') + 6,
+    cy: e.tagName === 'circle' ? +e.getAttribute('cy') : +e.getAttribute('y') + 6}));
+  const tool = root.querySelector('.kinlib-tool');
+  const d = tool.getAttribute('d').match(/[-0-9.]+/g).map(Number);
+  return {joints: pick('.kinlib-joint'), tool: {x: +tool.getAttribute('data-x'), y: +tool.getAttribute('data-y'),
+          z: +tool.getAttribute('data-z'), cx: d[2], cy: d[1]}, state: X.st.state,
+          view: X.S.view, k: X.S.k, px0: X.S.px0, py0: X.S.py0};
+}"""
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("name", sorted(ROBOTS))
+def test_drawn_joints_and_tool_are_at_fk(chromium, name, tmp_path):
+    """Read back from the SVG at random configurations: each joint's and the tool's world coordinates equal
+    the skeleton and modern_robotics' FKinSpace; in 2-D their pixel positions are those points under one
+    scale for x and y (equal axes, no stretching), and the SVG is shown at the size it is drawn."""
+    make, kw = ROBOTS[name]
+    chain = make()
+    ex = widgets.explorer(chain, **kw)
+    page, errors = page_with(chromium, [ex], tmp_path)
+    try:
+        box = page.locator("svg.kinlib-picture").bounding_box()
+        assert abs(box["width"] - ex.spec["size"]) < 1 and abs(box["height"] - ex.spec["size"]) < 1
+        for q in _configs(ex, 6, 11):
+            got = page.evaluate(_READ_BACK, [q.tolist()])
+            sk = chain.skeleton(q)
+            world = np.array([[j["x"], j["y"], j["z"]] for j in got["joints"]]).T
+            np.testing.assert_allclose(world, sk[:, 1:-1], atol=1e-9)
+            t = got["tool"]
+            np.testing.assert_allclose([t["x"], t["y"], t["z"]], tool_position(chain, q), atol=1e-9)
+            if ex.planar:
+                v, k = got["view"], got["k"]
+                for p, w in zip(got["joints"] + [t], list(sk[:, 1:-1].T) + [sk[:, -1]]):
+                    assert abs(p["cx"] - (got["px0"] + (w[0] - v["x0"]) * k)) < 0.01
+                    assert abs(p["cy"] - (got["py0"] - (w[1] - v["y0"]) * k)) < 0.01
+            assert got["state"] == ex.update(q).state
+        assert not errors, errors
+    finally:
+        page.close()
+
+
+@pytest.mark.browser
+def test_keyboard_moves_a_slider_and_the_live_text_says_so(chromium, r3, tmp_path):
+    """θ2 of the 05 robot to −π/4 with the arrow keys only: singular banner, det J 0, a collapsed held
+    ellipse, the blocked direction drawn, and the aria-live text says it in words."""
+    ex = widgets.explorer(r3, q=[math.pi / 6, math.pi / 6, -math.pi / 3])
+    page, errors = page_with(chromium, [ex], tmp_path)
+    try:
+        s = page.locator("input.kinlib-slider[data-joint='2']")
+        s.focus()
+        for _ in range(75):  # π/6 → −π/4: 75 steps of π/180
+            page.keyboard.press("ArrowLeft")
+        root = page.locator(".kinlib-explorer")
+        assert root.locator(".kinlib-status").get_attribute("data-state") == "singular"
+        assert root.locator(".kinlib-det").inner_text() == "0"
+        held = [float(x) for x in root.locator(".kinlib-held").inner_text().split(",")]
+        assert min(held) == 0 and max(held) > 0
+        assert root.locator(".kinlib-blocked").count() == 1
+        live = root.locator(".kinlib-live")
+        assert live.get_attribute("aria-live") == "polite"
+        text = live.inner_text()
+        assert "Singular configuration" in text and "cannot move along" in text and "Singular values" in text
+        assert "θ2 = -0.785 rad (-45.0°)" in s.get_attribute("aria-valuetext")
+        assert not errors, errors
+    finally:
+        page.close()
+
+
+# --- the configuration picker (problem 4.1) -----------------------------------------------------------
 CONFIGS = {
     "θ = (−π/8, π/4, π/8)": [-math.pi / 8, math.pi / 4, math.pi / 8],
     "θ = (3π/4, −π/4, 0)": [3 * math.pi / 4, -math.pi / 4, 0],
@@ -191,197 +368,3 @@ def test_config_picker_bad_input():
     cp = widgets.config_picker(chain, {"a": [0, 0, 0]})
     with pytest.raises(ValueError, match="unknown configuration"):
         cp.select("b")
-
-
-def test_the_image_widget_carries_the_picture_as_a_data_url(r3):
-    """The browser gets a data URL (decoded in the page; a Blob URL costs a round trip through the browser
-    process): it must decode to exactly the rendered picture, for PNG and JPEG explorers and the picker."""
-    import base64
-
-    for ex, mime in ((widgets.explorer(r3), "png"), (widgets.explorer(r3, image_format="jpeg"), "jpeg")):
-        ex.sliders[0].value = 0.4
-        assert ex.image.format == "url"
-        head, _, body = bytes(ex.image.value).partition(b",")
-        assert head == f"data:image/{mime};base64".encode()
-        assert base64.b64decode(body, validate=True) == bytes(ex.picture)
-    cp = widgets.config_picker(r3, {"a": [0, 0, 0], "b": [0.3, 0.2, 0.1]}, rows="vx")
-    cp.select("b")
-    head, _, body = bytes(cp.image.value).partition(b",")
-    assert head == b"data:image/png;base64" and base64.b64decode(body) == bytes(cp.picture)
-    assert bytes(cp.picture).startswith(PNG)
-
-
-def test_jpeg_pictures_and_bad_format(r3):
-    ex = widgets.explorer(r3, image_format="jpeg")
-    assert bytes(ex.picture).startswith(b"\xff\xd8") and ex.picture_format == "jpeg"
-    with pytest.raises(ValueError, match="image_format"):
-        widgets.explorer(r3, image_format="gif")
-
-
-def test_importing_widgets_leaves_pyplot_figures_alone(r3):
-    n = len(plt.get_fignums())
-    widgets.explorer(r3)
-    widgets.config_picker(robots.planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]})
-    assert len(plt.get_fignums()) == n  # no extra static copy under the inline backend
-
-
-# --- the task space of the arm (kinlib.taskspace.default_task_rows) --------------------------------
-def test_2r_explorer_sees_the_stretched_out_singularity():
-    """A student's 2R arm: its task space is (ṗ_x, ṗ_y); at θ2 = 0 (stretched out) they lose rank.
-    (All six rows of J have rank 2 everywhere, so testing them called this configuration regular.)"""
-    chain = robots.planar_2r(1, 1)
-    ex = widgets.explorer(chain, q=[0.4, 0.0])
-    assert ex.rows == (3, 4)
-    assert ex.state == "singular" and "SINGULAR configuration" in ex.status.value
-    assert ex.info["rank"] == 1 and ex.info["full_rank"] == 2
-    # independently: det of the ṗ rows from modern_robotics' forward kinematics is L1 L2 sin θ2
-    assert ex.info["det"] == pytest.approx(math.sin(0.0), abs=1e-12)
-    ex.update([0.4, 1.0])
-    assert ex.state == "regular" and "singular" not in ex.status.value.lower()
-    assert ex.info["det"] == pytest.approx(math.sin(1.0), abs=1e-9)
-    ex.sliders[1].value = 0.0  # a slider move back to the stretched-out arm
-    assert ex.state == "singular"
-    assert "task rows of J: (ṗ_x, ṗ_y)" in ex.readout.value
-
-
-def test_default_rows_follow_the_arm():
-    assert widgets.explorer(robots.planar_offset_3r(1)).rows == (2, 3, 4)  # planar, 3 joints
-    assert widgets.explorer(robots.cart_pole(1, 1)).rows == (3, 4)  # planar, 2 joints
-    assert widgets.explorer(robots.spatial_rppr(1, 1)).rows == (3, 4, 5)  # spatial, 4 joints
-    assert widgets.explorer(robots.ur5(), rate_sliders=False).rows == tuple(range(6))
-    assert widgets.explorer(robots.planar_2r(1, 1), rows="planar").rows == (2, 3, 4)  # asked for: as given
-
-
-def test_classify_is_rank_below_min_m_n():
-    rng = np.random.default_rng(5)
-    for m, n in ((2, 3), (3, 3), (6, 4), (3, 2)):
-        A = rng.normal(size=(m, n))
-        assert widgets.classify(A)["state"] != "singular"
-        U, s, Vt = np.linalg.svd(A, full_matrices=False)
-        s[-1] = 0.0  # one rank less than min(m, n)
-        info = widgets.classify((U * s) @ Vt)
-        assert info["state"] == "singular" and info["rank"] == min(m, n) - 1 == info["full_rank"] - 1
-        assert info["manipulability"] == pytest.approx(0.0, abs=1e-12)
-        assert (info["det"] is None) == (m != n)
-    # a tall J (n < m) of full column rank is regular: w = √det(JᵀJ) > 0
-    info = widgets.classify(np.vstack([np.eye(2), np.zeros((4, 2))]))
-    assert info["state"] == "regular" and info["manipulability"] == pytest.approx(1.0)
-
-
-# --- explorers show what the banner says; pictures on open (issue 13, items 3 and 5) ------------------------
-def _span(html_text, cls):
-    import re
-
-    m = re.search(rf"<span class='{cls}'>([^<]*)</span>", html_text)
-    return None if m is None else m.group(1)
-
-
-def _geometric_J_mr(chain, q):
-    S, M = np.array(chain.screws, float), np.array(chain.M, float)
-    Js = mr.JacobianSpace(S, np.asarray(q, float))
-    p = mr.FKinSpace(M, S, np.asarray(q, float))[:3, 3]
-    return np.vstack([Js[:3], Js[3:] - np.cross(p, Js[:3].T).T])
-
-
-def _held_map(chain, q):
-    """J_ṗ N with N an orthonormal basis of null(J_ωz), by QR (independent of kinlib's SVD)."""
-    J = _geometric_J_mr(chain, q)
-    Q, _ = np.linalg.qr(J[[2]].T, mode="complete")
-    return J[[3, 4]] @ Q[:, 1:]
-
-
-def test_explorer_at_a_singular_configuration_of_notebook_05(r3):
-    q = [math.pi / 6, -math.pi / 4, -math.pi / 3]
-    ex = widgets.explorer(r3, q=[math.pi / 6, math.pi / 6, -math.pi / 3], show_maximum=False)
-    assert "data-state='regular'" in ex.status.value and not ex.cannot_move.get_visible()
-    ex.update(q)
-    assert ex.state == "singular" and "class='kinlib-status' data-state='singular'" in ex.status.value
-    assert _span(ex.readout.value, "kinlib-det") == "0"
-    s = np.linalg.svd(_held_map(r3, q), compute_uv=False)
-    assert s[1] < 1e-12
-    assert _span(ex.readout.value, "kinlib-held") == f"{s[0]:.3g}, 0"
-    np.testing.assert_allclose(ex.held_ellipse.semi_axes, s, atol=1e-12)
-    # the free ṗ ellipse stays fat, as a second outline
-    assert ex.ellipse.semi_axes == pytest.approx([2.79, 1.03], abs=0.01)
-    # the red dashed line: the direction the tool cannot move with ω_z held (uᵀ J_ṗ N = 0)
-    assert ex.cannot_move.get_visible()
-    u = ex.cannot_move_direction
-    assert np.linalg.norm(u @ _held_map(r3, q)) < 1e-9
-    x, y = ex.cannot_move.get_data()
-    d = np.array([x[1] - x[0], y[1] - y[0]])
-    assert abs(d[0] * u[1] - d[1] * u[0]) < 1e-9 * np.linalg.norm(d)  # drawn along u
-    tool = mr.FKinSpace(np.array(r3.M, float), np.array(r3.screws, float), np.array(q))[:2, 3]
-    np.testing.assert_allclose([np.mean(x), np.mean(y)], tool, atol=1e-12)  # through the tool
-    # near, not at, the singularity: still drawn, and det is a signed number
-    ex.update([math.pi / 6, -math.pi / 4 + 0.03, -math.pi / 3])
-    assert ex.state == "near" and ex.cannot_move.get_visible() and "data-state='near'" in ex.status.value
-    det = _span(ex.readout.value, "kinlib-det")
-    assert det[0] in "+-" and float(det) == pytest.approx(ex.info["det"], rel=1e-3)
-    legend = [t.get_text() for t in ex.ax.get_legend().get_texts()]
-    assert any("held" in t for t in legend) and any("all joints free" in t for t in legend)
-    assert any("cannot move" in t for t in legend)
-
-
-def test_det_is_never_a_signed_zero(r3):
-    ex = widgets.explorer(r3, q=[0.0, -math.pi / 4, math.pi / 4])
-    assert ex.state == "singular" and _span(ex.readout.value, "kinlib-det") == "0"
-    assert "+0.0000" not in ex.readout.value and "-0.0000" not in ex.readout.value
-    assert "√det(JJᵀ) = 0<" in ex.readout.value and "σ_min/σ_max = 0," in ex.readout.value
-
-
-def test_explorer_without_orientation_rows_has_no_held_ellipse():
-    import sympy as sp
-
-    cp = robots.cart_pole(L=1, h=sp.Rational(1, 2))
-    ex = widgets.explorer(cp, q=[0.0, math.pi / 3], qdot=[0.3, 1.0], rows=("vx", "vy"))
-    assert ex.held_ellipse is None and _span(ex.readout.value, "kinlib-held") is None
-    ex.update([0.7, math.pi / 3])
-    c = ex.arm.sliders.get_paths()[0].vertices[:4].mean(axis=0)
-    np.testing.assert_allclose(c, [0.7, 0.0], atol=1e-12)  # the cart moved with θ1
-
-
-def test_spatial_explorer_holds_the_angular_rows():
-    ur5 = robots.ur5()
-    q = [0.3, -1.0, 1.2, 0.2, 1.0, 0.1]
-    ex = widgets.explorer(ur5, q=q)
-    assert ex.hold == (0, 1, 2)
-    J = _geometric_J_mr(ur5, q)
-    Q, _ = np.linalg.qr(J[:3].T, mode="complete")
-    s = np.linalg.svd(J[3:] @ Q[:, 3:], compute_uv=False)
-    np.testing.assert_allclose(ex.held_ellipse.semi_axes, s, rtol=1e-9)
-
-
-def test_display_bundles_carry_a_static_picture(r3):
-    import base64
-    import io
-
-    from PIL import Image
-
-    ex = widgets.explorer(r3, q=[0.3, 0.5, -0.2])
-    b = ex._repr_mimebundle_()
-    assert "application/vnd.jupyter.widget-view+json" in b
-    assert not b["text/plain"].startswith("Explorer(") and r3.name in b["text/plain"]
-    im = Image.open(io.BytesIO(base64.b64decode(b["image/png"])))
-    assert im.format == "PNG" and im.size == Image.open(io.BytesIO(ex.picture)).size
-    cp = widgets.config_picker(r3, {"a": [0.1, 0.2, 0.3]})
-    b = cp._repr_mimebundle_()
-    assert "application/vnd.jupyter.widget-view+json" in b and not b["text/plain"].startswith("ConfigPicker(")
-    assert Image.open(io.BytesIO(base64.b64decode(b["image/png"]))).format == "PNG"
-
-
-def test_indexed_png_keeps_the_picture(r3):
-    """The 8-bit PNG of a slider move is the full-colour picture to within the palette's rounding."""
-    import io
-
-    from PIL import Image
-
-    ex = widgets.explorer(r3, q=[0.3, -0.6, 0.4])
-    ex.update([0.5, -0.7, 0.2])
-    fast = np.asarray(Image.open(io.BytesIO(ex.picture)).convert("RGB"), float)
-    for a in ex._blit.artists:
-        a.set_animated(False)
-    full = np.asarray(Image.open(io.BytesIO(widgets_render.render_png(ex.fig))).convert("RGB"), float)
-    assert fast.shape == full.shape
-    white = np.all(full == 255, axis=2)
-    assert white.mean() > 0.5 and np.all(fast[white] == 255)  # the paper stays exactly white
-    assert np.mean(np.abs(fast - full)) < 2.0 and np.percentile(np.abs(fast - full).max(axis=2), 99) < 40
