@@ -3,7 +3,7 @@
 The kernel is a fresh ``python -P -B -c ... ipykernel`` process (no working directory on sys.path) in its
 own session (process group), with the scratch directory as its working directory, a unix-socket (ipc) connection, no history database,
 ``MPLBACKEND=Agg`` and resource limits (address space, file size, no core dumps). With a
-:class:`kinlib.course.sandbox.Sandbox` it runs under bubblewrap (own PID/network/user namespaces, read-only
+:class:`kinlib.course.grader.isolation.sandbox.Sandbox` it runs under bubblewrap (own PID/network/user namespaces, read-only
 system, only its own folder writable); stopping it kills its whole PID namespace, daemons included.
 Start-up and liveness are judged by the process itself (``poll()``), never by heartbeats: a start is
 retried up to :data:`START_ATTEMPTS` times with a generous time limit, and a kernel that still cannot
@@ -14,7 +14,7 @@ submission printing megabytes costs nothing but the time it spends printing), an
 (ename, evalue, cell index), truncated.
 
 :class:`NotebookRun` runs a whole notebook's code cells in such kernels (restarting past a cell that
-kills one), with the checker's probe (:mod:`kinlib.course.probe` and :mod:`kinlib.course.answers`, sent
+kills one), with the checker's probe (:mod:`kinlib.course.grader.in_kernel.probe` and :mod:`kinlib.course.answers.normalise`, sent
 as source text) loaded in a private module first.
 """
 
@@ -34,7 +34,7 @@ from pathlib import Path
 from jupyter_client import BlockingKernelClient
 from jupyter_client.connect import write_connection_file
 
-from .schema import cell_source, is_plain_selfcheck
+from ...schema import cell_source, is_plain_selfcheck
 
 __all__ = [
     "CellResult",
@@ -50,11 +50,12 @@ __all__ = [
     "KernelStartError",
 ]
 
-# the checker's code for the kernel, sent as text (see kinlib.course.probe)
-PROBE_SOURCE = (Path(__file__).parent / "probe.py").read_text()
-ANSWERS_SOURCE = (Path(__file__).parent / "answers.py").read_text()
-GUARD_SOURCE = (Path(__file__).parent / "guard.py").read_text()
-SREPR_SOURCE = (Path(__file__).parent / "srepr.py").read_text()
+# the checker's code for the kernel, sent as text (see kinlib.course.grader.in_kernel.probe)
+_IN_KERNEL = Path(__file__).parents[1] / "in_kernel"  # kinlib/course/grader/in_kernel
+PROBE_SOURCE = (_IN_KERNEL / "probe.py").read_text()
+ANSWERS_SOURCE = (Path(__file__).parents[2] / "answers" / "normalise.py").read_text()
+GUARD_SOURCE = (_IN_KERNEL / "guard.py").read_text()
+SREPR_SOURCE = (_IN_KERNEL / "srepr.py").read_text()
 MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
 MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
 START_ATTEMPTS = 3  # tries to start a kernel before it is an infrastructure failure
@@ -152,7 +153,7 @@ class Kernel:
     fsize_bytes: int = 200 * 2**20
     startup_timeout: float = 120.0
     grace: float = 3.0
-    sandbox: object | None = None  # a kinlib.course.sandbox.Sandbox, or None (a plain subprocess)
+    sandbox: object | None = None  # a kinlib.course.grader.isolation.sandbox.Sandbox, or None (a plain subprocess)
     proc: subprocess.Popen | None = None
     kc: BlockingKernelClient | None = None
     dead_reason: str = ""

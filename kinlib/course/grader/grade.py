@@ -3,7 +3,7 @@
     kinlib grade SUBMISSION.ipynb|FOLDER ... --out DIR [--timeout S] [--cell-timeout S] [--jobs N]
                  [--notebooks notebooks] [--cache build/grade-cache] [--quiet] [--secret FILE] [--no-sandbox]
 
-(the command line is :mod:`kinlib.course.cli`; the outputs are written by :mod:`kinlib.course.report`)
+(the command line is :mod:`kinlib.course.cli`; the outputs are written by :mod:`kinlib.course.grader.report`)
 
 Writes ``DIR/grades.csv`` (submission, notebook, part, status pass|fail|error, points, message),
 ``DIR/feedback/<submission>.md`` (one page a student can read) and prints a summary table. Exit status 0
@@ -23,26 +23,26 @@ How it works
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
   :mod:`kinlib.course.schema` reads them) the
   reference kernel (the grader's own, never a student's) returns each answer as data (``sympy.srepr``
-  text, read back by the strict parser :mod:`kinlib.course.srepr`, never ``eval``); the result is
+  text, read back by the strict parser :mod:`kinlib.course.grader.in_kernel.srepr`, never ``eval``); the result is
   cached in ``--cache/<id>-<hash>.json`` with an HMAC tag keyed by the grader secret
-  (:mod:`kinlib.course.refdata`), keyed by the notebook's bytes and the checker's version. Points per part:
+  (:mod:`kinlib.course.grader.refdata`), keyed by the notebook's bytes and the checker's version. Points per part:
   ``points`` in the solution cell's ``kinlib`` metadata if present, else "(N points)" parsed from the
   question cell (split evenly when several parts share one question cell).
-* **Each submission** runs in its own fresh kernel (:mod:`kinlib.course.kernel`) in the bubblewrap
-  sandbox (:mod:`kinlib.course.sandbox`) in a scratch copy (a temp dir as cwd), every code cell in
+* **Each submission** runs in its own fresh kernel (:mod:`kinlib.course.grader.isolation.kernel`) in the bubblewrap
+  sandbox (:mod:`kinlib.course.grader.isolation.sandbox`) in a scratch copy (a temp dir as cwd), every code cell in
   order with a per-cell and a total time limit. A cell that
   raises is recorded and the next one runs; a cell that kills the kernel (``os._exit``) or ignores the
   time limit is skipped after a restart (at most two), so the other parts are still graded. An answer
   is the value its variable has when its part ends (before the next ``question`` cell; the last part
   at the end of the notebook), so cells a student adds below a stub count and later reuse of the name
-  does not. Workbook self-check cells that only call ``kinlib.course.selfcheck.check`` are not run (they
+  does not. Workbook self-check cells that only call ``kinlib.course.workbook.selfcheck.check`` are not run (they
   cannot change an answer and cost seconds).
 * **Values cross the boundary as JSON numbers only.** Before the first student cell the checker
-  starts :mod:`kinlib.course.probe` in the kernel from its source text, with the answer normaliser
-  :mod:`kinlib.course.answers` (private modules under a random name) and snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
+  starts :mod:`kinlib.course.grader.in_kernel.probe` in the kernel from its source text, with the answer normaliser
+  :mod:`kinlib.course.answers.normalise` (private modules under a random name) and snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
   namespaces, then asks for each answer's *values* at checker-chosen random points (joint angles in
   (-π, π), positive symbols in (0.5, 2); random per submission, seeded by HMAC(grader secret,
-  submission bytes) (:mod:`kinlib.course.secret`): reruns are reproducible, and nobody without the
+  submission bytes) (:mod:`kinlib.course.grader.secret`): reruns are reproducible, and nobody without the
   secret can compute them from the file) as [re, im] floats, plus shape, symbol names and type. The
   worker process compares them
   with the reference evaluated at the same points: shapes first, then values, with diagnoses (wrong
@@ -54,7 +54,7 @@ How it works
   orthonormal bases), ``set`` (sets of configurations: members compared, angles modulo 2π whatever the
   set is keyed by; a list of {symbol: Set} conditions is their union, [] the empty set), ``choice``
   (ints/tuples compared as sets); ``properties`` beside ``answers`` grade an open-ended answer by the
-  property asked (``property:nonsingular``, 5.5: :mod:`kinlib.course.properties`). A default-kind answer
+  property asked (``property:nonsingular``, 5.5: :mod:`kinlib.course.answers.properties`). A default-kind answer
   that is a Set, a {symbol: Set} dict or a list of those is compared as a set; a bool or string as a
   choice; a dict with string keys entry by entry.
 
@@ -65,9 +65,9 @@ the grader's processes; everything it starts dies with it), a read-only system a
 the ``kinlib`` package folder but not the repository around it (no notebooks, build folder, reference
 cache, secret, output folder or home), and writable only its own scratch folder and a private /tmp.
 grades.csv and the feedback are written after every kernel of the batch, and every process a submission
-started, is gone (checked: :func:`kinlib.course.sandbox.reap_namespaces`). Without bubblewrap the grader
+started, is gone (checked: :func:`kinlib.course.grader.isolation.sandbox.reap_namespaces`). Without bubblewrap the grader
 refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.
-A kernel that cannot start is retried (:data:`kinlib.course.kernel.START_ATTEMPTS`), judged by its
+A kernel that cannot start is retried (:data:`kinlib.course.grader.isolation.kernel.START_ATTEMPTS`), judged by its
 process, not by heartbeats. Within the sandbox, the checker never evaluates student text in its own process
 (only JSON numbers and strings come back, read from a size-capped file), compares in its own
 process, and records failures from the kernel protocol, so a submission can *lie about the values it
@@ -75,7 +75,7 @@ computes* (equivalent to writing those values as its answer) but cannot make the
 without producing the right values, and cannot hide a missing answer, a crash or a timeout: those
 become fail/error rows. The result files the kernel writes are opened without following links, regular
 files only, and only known words from the advisory exact check reach the feedback. Redefining
-``kinlib.course.selfcheck.check`` changes nothing (the checker does not
+``kinlib.course.workbook.selfcheck.check`` changes nothing (the checker does not
 use it); monkeypatching SymPy (``sympy.simplify = ...``, class attributes) or builtins is undone
 before the answers are read. The random points are known to the kernel when the values are asked
 for, but the reference is not (it is sent only afterwards, for the advisory exact check).
@@ -94,8 +94,11 @@ from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
-from . import compare, credit
-from .kernel import KernelStartError, NotebookRun
+from ..answers import compare
+from ..schema import cell_meta, cell_part, match_notebook, notebook_id, stash_points
+from . import credit
+from .isolation.kernel import KernelStartError, NotebookRun
+from .isolation.sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
 from .refdata import (
     GRADE_VERSION,
     Reference,
@@ -106,8 +109,6 @@ from .refdata import (
     reference_description,
 )
 from .report import summary_table, write_outputs
-from .sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
-from .schema import cell_meta, cell_part, match_notebook, notebook_id, stash_points
 from .secret import default_secret_path, evaluation_seed, load_secret
 
 __all__ = [
@@ -200,9 +201,9 @@ def grade_submission(
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises).
 
-    ``sandbox``: a :class:`~kinlib.course.sandbox.Sandbox`, True (the default one) or False (no sandbox:
+    ``sandbox``: a :class:`~kinlib.course.grader.isolation.sandbox.Sandbox`, True (the default one) or False (no sandbox:
     said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
-    :func:`~kinlib.course.secret.default_secret_path`), which chooses the evaluation points.
+    :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points.
 
     A file that is not one of the notebooks gets one ``error`` row, without starting a kernel:
 
@@ -510,9 +511,9 @@ def grade_batch(
     ``summary = {"results": [per-submission dict], "rows": [...], "seconds": wall time,
     "per_minute": submissions per minute, "reference_seconds": ..., "infrastructure_errors": n,
     "sandbox": bool}``. Never raises for a bad submission. Each student kernel runs in the bubblewrap
-    sandbox (:mod:`kinlib.course.sandbox`); without it (bwrap missing) this raises SandboxUnavailable
+    sandbox (:mod:`kinlib.course.grader.isolation.sandbox`); without it (bwrap missing) this raises SandboxUnavailable
     unless ``sandbox=False`` (``--no-sandbox``), and then every feedback page and the summary say so.
-    ``secret``: the grader secret's file (default :func:`~kinlib.course.secret.default_secret_path`,
+    ``secret``: the grader secret's file (default :func:`~kinlib.course.grader.secret.default_secret_path`,
     created on first use) or bytes. grades.csv and the feedback are written only after every kernel of
     the batch (and every process a submission started) is gone.
 

@@ -7,9 +7,9 @@
   parser (only SymPy class calls, singletons, numbers, lists, tuples and dicts; nothing is ``eval``-ed),
   and evaluated at a submission's points here, in the grader (:func:`reference_description`).
 * **Signed.** The cache (``<cache>/<id>-<hash>.json``) holds the reference and an HMAC-SHA256 tag keyed
-  by the instructor's secret (:mod:`kinlib.course.secret`); a file whose tag does not verify (edited,
+  by the instructor's secret (:mod:`kinlib.course.grader.secret`); a file whose tag does not verify (edited,
   planted, or made with another secret) is ignored and rebuilt. The cache folder is never visible to a
-  sandboxed student kernel (:mod:`kinlib.course.sandbox`), nor is the notebooks folder.
+  sandboxed student kernel (:mod:`kinlib.course.grader.isolation.sandbox`), nor is the notebooks folder.
 """
 
 from __future__ import annotations
@@ -23,11 +23,12 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from . import answers, probe
-from .kernel import ANSWERS_SOURCE, GUARD_SOURCE, PROBE_SOURCE, SREPR_SOURCE, NotebookRun
-from .schema import notebook_id, notebook_title, parse_parts, stash_points
+from ..answers import normalise as answers
+from ..schema import notebook_id, notebook_title, parse_parts, stash_points
+from .in_kernel import probe
+from .in_kernel.srepr import parse_srepr
+from .isolation.kernel import ANSWERS_SOURCE, GUARD_SOURCE, PROBE_SOURCE, SREPR_SOURCE, NotebookRun
 from .secret import sign, verify
-from .srepr import parse_srepr
 
 __all__ = [
     "Reference",
@@ -73,7 +74,7 @@ def default_notebooks() -> Path:
     >>> default_notebooks().name
     'notebooks'
     """
-    p = Path(__file__).resolve().parents[2] / "notebooks"
+    p = Path(__file__).resolve().parents[3] / "notebooks"
     return p if p.is_dir() else Path("notebooks")
 
 

@@ -1,7 +1,7 @@
 """The platforms a class already uses, when it outgrows one machine: Gradescope, PrairieLearn, Canvas.
 
-Everything here reuses the one grading core (:func:`kinlib.course.grade.grade_submission`, scored by
-:mod:`kinlib.course.credit`): only the packaging around it and the results' format differ.
+Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.grade_submission`, scored by
+:mod:`kinlib.course.grader.credit`): only the packaging around it and the results' format differ.
 
 * ``kinlib grade gradescope --out autograder.zip`` writes a Gradescope autograder (Autograder
   Specifications, https://gradescope-autograders.readthedocs.io/en/latest/specs/): ``setup.sh`` and
@@ -53,7 +53,7 @@ import zipfile
 from dataclasses import asdict
 from pathlib import Path
 
-from . import credit, report
+from ..grader import credit, report
 
 __all__ = [
     "VISIBILITIES",
@@ -89,7 +89,7 @@ PY="${KINLIB_PYTHON:-$ROOT/venv/bin/python}"
 [ -x "$PY" ] || PY=python3
 export PYTHONPATH="$ROOT/source/kinlib-src${PYTHONPATH:+:$PYTHONPATH}"
 cd "$ROOT"
-exec "$PY" -m kinlib.course.lms run gradescope --root "$ROOT" --bundle "$ROOT/source"
+exec "$PY" -m kinlib.course.lms.bundles run gradescope --root "$ROOT" --bundle "$ROOT/source"
 """
 
 RUN_PL = """#!/usr/bin/env bash
@@ -99,7 +99,7 @@ HERE="$ROOT/serverFilesCourse/kinlib_grader"
 PY="${KINLIB_PYTHON:-python3}"
 export PYTHONPATH="$HERE/kinlib-src${PYTHONPATH:+:$PYTHONPATH}"
 mkdir -p "$ROOT/results"
-exec "$PY" -m kinlib.course.lms run prairielearn --root "$ROOT" --bundle "$HERE"
+exec "$PY" -m kinlib.course.lms.bundles run prairielearn --root "$ROOT" --bundle "$HERE"
 """
 
 
@@ -139,8 +139,8 @@ def build_bundle(
     >>> sorted(cfg)  # doctest: +SKIP
     ['cell_timeout', 'notebooks', 'points', 'sandbox', 'timeout', 'visibility']
     """
-    from . import grade
-    from . import secret as secret_mod
+    from ..grader import grade
+    from ..grader import secret as secret_mod
 
     if visibility not in VISIBILITIES:
         raise ValueError(f"visibility must be one of {', '.join(VISIBILITIES)}, got {visibility!r}")
@@ -168,7 +168,7 @@ def build_bundle(
     key.write_text(derived + "\n")
     key.chmod(0o600)
     _copy_package(dest / "kinlib-src")
-    env = Path(grade.__file__).resolve().parents[2] / "environment.txt"
+    env = Path(grade.__file__).resolve().parents[3] / "environment.txt"
     if env.is_file():
         shutil.copy(env, dest / "constraints.txt")
     else:
@@ -371,7 +371,7 @@ def prairielearn_results(results: list, sandbox: bool = True) -> dict:
 
 
 def _load_refs(bundle: Path) -> dict:
-    from .grade import Reference
+    from ..grader.grade import Reference
 
     data = json.loads((bundle / "references.json").read_text())
     return {k: Reference(**v) for k, v in data.items()}
@@ -380,7 +380,7 @@ def _load_refs(bundle: Path) -> dict:
 def _grade(path: Path, refs: dict, cfg: dict, bundle: Path) -> dict:
     import inspect
 
-    from . import grade
+    from ..grader import grade
 
     kw = {
         "cell_timeout": cfg.get("cell_timeout", 60.0),
@@ -412,7 +412,7 @@ def run_platform(platform: str, root=None, bundle=None) -> dict:
     ...
     ValueError: platform must be gradescope or prairielearn, got 'moodle'
     """
-    from .grade import find_submissions
+    from ..grader.grade import find_submissions
 
     if platform not in _ROOTS:
         raise ValueError(f"platform must be gradescope or prairielearn, got {platform!r}")
@@ -532,7 +532,7 @@ def canvas_csv(
 
 
 def main(argv=None) -> int:
-    """``python -m kinlib.course.lms run gradescope|prairielearn [--root R] [--bundle B]`` (inside the platform).
+    """``python -m kinlib.course.lms.bundles run gradescope|prairielearn [--root R] [--bundle B]`` (inside the platform).
 
     Always writes a results file: a failure of the grader becomes an error result (and exit status 1).
 
@@ -545,7 +545,7 @@ def main(argv=None) -> int:
     """
     import argparse
 
-    ap = argparse.ArgumentParser(prog="python -m kinlib.course.lms")
+    ap = argparse.ArgumentParser(prog="python -m kinlib.course.lms.bundles")
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run")
     r.add_argument("platform", choices=sorted(_ROOTS))

@@ -1,7 +1,7 @@
 """The checker's outputs: ``grades.csv``, ``totals.csv``, one feedback page per submission, the summary table.
 
-They read the per-submission results :func:`kinlib.course.grade.grade_submission` returns (plain dicts,
-``rows`` as dicts, scored per answer by :func:`kinlib.course.credit.score_parts`).
+They read the per-submission results :func:`kinlib.course.grader.grade.grade_submission` returns (plain dicts,
+``rows`` as dicts, scored per answer by :func:`kinlib.course.grader.credit.score_parts`).
 
 The class folder (``--out``) keeps every graded submission's result as ``results/<key>.json`` (key: the
 student id and the notebook), and ``grades.csv``, ``totals.csv`` and ``feedback/`` are written from all of
@@ -9,7 +9,7 @@ them, so **grading one student again replaces only that student's result**: ever
 files stays byte for byte the same. Files are written atomically (a temporary file, then a rename). The
 student id pattern is remembered in ``OUT/class.json`` (a later run without ``--id-pattern`` uses it; a new
 pattern re-keys every kept result from its stored path).
-Overrides (:mod:`kinlib.course.credit`) are applied each time from ``--overrides`` or, when it is not
+Overrides (:mod:`kinlib.course.grader.credit`) are applied each time from ``--overrides`` or, when it is not
 given, from ``OUT/overrides.toml`` / ``OUT/overrides.csv`` if present; the stored results stay automatic.
 
 ``grades.csv`` columns: student_id, submission, notebook, part, answer (a manual item's label), kind
@@ -357,8 +357,8 @@ def write_outputs(out: Path, results: list, id_pattern=None, overrides=None, mer
     """Keep ``results`` in the class folder ``out`` and write ``grades.csv``, ``totals.csv`` and
     ``feedback/<key>.md`` from every result kept there; sets each result's ``student_id`` and ``feedback``.
 
-    ``id_pattern``: :func:`kinlib.course.credit.student_id`'s pattern (searched in ``res["path"]``, else the
-    submission name). ``overrides``: a path or a list of :class:`kinlib.course.credit.Override` (default:
+    ``id_pattern``: :func:`kinlib.course.grader.credit.student_id`'s pattern (searched in ``res["path"]``, else the
+    submission name). ``overrides``: a path or a list of :class:`kinlib.course.grader.credit.Override` (default:
     ``out/overrides.toml`` or ``out/overrides.csv`` if present). ``merge=False`` forgets the results kept
     before. Returns the overrides' warnings (a ValueError is raised for a bad override, before writing).
 

@@ -1,7 +1,7 @@
 """Instructor side of the checker: compare the JSON a student kernel sent with the reference's.
 
 Everything here works on plain JSON data (numbers, strings, lists) produced by
-:mod:`kinlib.course.probe`; nothing from a submission is evaluated. Each comparison returns
+:mod:`kinlib.course.grader.in_kernel.probe`; nothing from a submission is evaluated. Each comparison returns
 ``(ok, message)``; messages name the mistake when it is recognizable (wrong shape, transposed,
 wrong sign, columns swapped, [v; ω] instead of [ω; v], degrees instead of radians, a missing or
 extra variable) without printing the reference answer or anything that gives it away (a factor, the
@@ -13,7 +13,7 @@ student can read off their own answer.
 * **set**: members compared modulo 2π whenever the reference is a set of angles (members that are simple
   multiples of π, or a joint angle's family), whatever the set is keyed by; FiniteSets, ImageSets, unions
   and ``solveset`` results alike; degrees named; **choice**: as sets;
-* **property:<p>** (:mod:`kinlib.course.properties`): open-ended answers by the property asked, decided
+* **property:<p>** (:mod:`kinlib.course.answers.properties`): open-ended answers by the property asked, decided
   exactly, never by one design's value (5.5: det(J Jᵀ) ≠ 0 for every θ).
 """
 
@@ -26,7 +26,8 @@ from fractions import Fraction
 
 import numpy as np
 
-from . import answers, mistakes
+from . import mistakes
+from . import normalise as answers
 from .properties import PROPERTIES, exact_ranks
 
 __all__ = [
@@ -206,7 +207,7 @@ def _no_key(msg: str) -> str:
 
 def _diagnose(S, R, shape, stu) -> str:
     """What is wrong with values S (points × entries) against R: a named mistake of
-    :mod:`kinlib.course.mistakes` (the self-check's too), else which entries differ; never a value."""
+    :mod:`kinlib.course.answers.mistakes` (the self-check's too), else which entries differ; never a value."""
     P = S.shape[0]
     r, c = (shape + [1, 1])[:2] if len(shape) == 2 else (1, 1)
     S3, R3 = S.reshape(P, r, c), R.reshape(P, r, c)
@@ -637,7 +638,7 @@ def _choice_items(v) -> list:
 
 
 def compare_choice(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
-    """Choices (joint numbers, 1-based; ties as tuples) compared as sets, by :func:`kinlib.course.answers.choice_key`
+    """Choices (joint numbers, 1-based; ties as tuples) compared as sets, by :func:`kinlib.course.answers.normalise.choice_key`
     (the self-check's definition too: ``True`` is not joint 1).
 
     >>> compare_choice({"tag": "choice", "value": [2, 1]}, {"value": [1, 2]}, "j")

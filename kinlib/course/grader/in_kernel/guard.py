@@ -4,7 +4,7 @@
 last one, before the answers are read, and undoes replaced or added functions and classes in SymPy's,
 NumPy's, mpmath's and the builtins' namespaces (and SymPy's class attributes), so
 ``sympy.simplify = lambda e: 0`` and the like do not change what the checker measures. Like
-:mod:`kinlib.course.probe` it is sent to the kernel as source text and imports only the standard library
+:mod:`kinlib.course.grader.in_kernel.probe` it is sent to the kernel as source text and imports only the standard library
 (and SymPy and NumPy, to snapshot them).
 """
 

@@ -1,6 +1,6 @@
 """``npm pack`` into a vendor folder, once: the offline copies of the JavaScript packages the handouts use
-(the widget embedder, require.js, font-awesome: :mod:`kinlib.course.pages`; the JupyterLite site's Pyodide:
-:mod:`kinlib.course.lite`; axe-core for the accessibility test)."""
+(the widget embedder, require.js, font-awesome: :mod:`kinlib.course.publish.pages`; the JupyterLite site's Pyodide:
+:mod:`kinlib.course.publish.lite`; axe-core for the accessibility test)."""
 
 from __future__ import annotations
 

@@ -154,7 +154,7 @@ def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool, links
 
 
 # ---------------------------------------------------------------------------------------------------
-# What export_html adds to nbconvert's page: the print stylesheet and header (kinlib.course.printing), a bar
+# What export_html adds to nbconvert's page: the print stylesheet and header (kinlib.course.publish.printing), a bar
 # of links (index, PDF, workbook, "open in the browser"), and a text alternative for every figure.
 
 COURSE = "Problem Set 4"  # the course name in the PDF page headers

@@ -3,25 +3,25 @@ executed notebooks.
 
     kinlib handouts notebooks --out build/handouts [--jobs 2] [--timeout 120] [--no-verify] [--only 05]
 
-(the command line is :mod:`kinlib.course.cli`; the pages and assets are :mod:`kinlib.course.pages`).
+(the command line is :mod:`kinlib.course.cli`; the pages and assets are :mod:`kinlib.course.publish.pages`).
 
 For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with nbconvert) it writes
 
 - ``solutions/NN_*.html``: the whole notebook with its outputs;
 - ``problems/NN_*.html``: questions, narrative, the student's set-up and figures; left out: ``solution`` and
   ``check`` cells, the set-up's imports and helper functions that only they use (they would give the
-  method away: :func:`kinlib.course.analysis.trim_setup`), the untagged markdown inside a worked solution (between a ``question`` and the last
+  method away: :func:`kinlib.course.publish.analysis.trim_setup`), the untagged markdown inside a worked solution (between a ``question`` and the last
   ``solution``/``check`` cell answering it), cells that read answer variables (and their markdown
   caption just above), any output that repeats an answer cell's output; no prompt numbers; the saved
   widget state pruned to the widgets still shown;
 - ``workbooks/NN_*.ipynb``: the student notebook: each ``solution`` code cell becomes a stub
   (``Js = ...  # TODO: ...``, keeping its ``kinlib`` metadata), each solution markdown cell a prompt,
-  each ``check`` cell a self-check (:mod:`kinlib.course.selfcheck`) that compares a fingerprint of the
+  each ``check`` cell a self-check (:mod:`kinlib.course.workbook.selfcheck`) that compares a fingerprint of the
   student's answer with the reference's made here (a part without a check cell gets one after its
   last solution cell); worked-solution markdown left out as above; the set-up imports only what the
   student starts with (as in the problems); cells that use answer variables run only once those are
   filled in, and say "fix the answer above first" if they fail on a wrong one (``%%needs``,
-  :mod:`kinlib.course.needs`); outputs cleared. Unless ``--no-verify``, each
+  :mod:`kinlib.course.workbook.needs`); outputs cleared. Unless ``--no-verify``, each
   workbook is then run top to bottom (the stubs must not crash it);
 - ``index.html`` linking everything, and ``assets/``: MathJax 2 (copied from the installed
   ``jupyter-server-mathjax``), require.js and the ``@jupyter-widgets/html-manager`` embed bundle
@@ -43,9 +43,7 @@ from pathlib import Path
 
 import nbformat
 
-from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
-from .pages import HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_index
-from .schema import (
+from ..schema import (
     ANSWER_TAGS,
     CHECK,
     SELFCHECK,
@@ -60,7 +58,9 @@ from .schema import (
     notebook_sections,
     notebook_title,
 )
-from .selfcheck import FINGERPRINT_MARK, emit_fingerprints
+from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
+from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
+from .pages import HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_index
 
 __all__ = [
     "build",
@@ -409,7 +409,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
 
     >>> from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
     >>> from kinlib.course.schema import answer_groups
-    >>> from kinlib.course.selfcheck import fingerprint
+    >>> from kinlib.course.workbook.selfcheck import fingerprint
     >>> nb = new_notebook(cells=[
     ...     new_markdown_cell("**1.1 (2 points).** What is 6 * 7?", metadata={"tags": ["question"]}),
     ...     new_code_cell("x = 6 * 7", metadata={"tags": ["solution"], "kinlib": {"part": "1.1", "answers": ["x"]}}),
@@ -589,8 +589,8 @@ def build(
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
     ``index.html``, ``problems/`` and ``solutions/`` (HTML), ``workbooks/`` (.ipynb), and unless switched off
-    ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.lite.build_lite`) and ``pdf/`` (``pdfs``:
-    every page printed by Chromium, :func:`kinlib.course.printing.print_pdfs`); the pages link only what is built.
+    ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.publish.lite.build_lite`) and ``pdf/`` (``pdfs``:
+    every page printed by Chromium, :func:`kinlib.course.publish.printing.print_pdfs`); the pages link only what is built.
 
     A folder without ``NN_*.ipynb`` notebooks is refused before anything is written:
 

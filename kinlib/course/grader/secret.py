@@ -9,7 +9,7 @@ named by ``$KINLIB_GRADER_SECRET`` (the test suite's), or a path given with ``ki
 * :func:`evaluation_seed`: the seed of a submission's random evaluation points, HMAC(secret, submission
   bytes), so the points cannot be computed from the file alone (a student cannot search offline for a
   wrong answer that agrees with the right one at the grader's points). The workbook self-checks use
-  other, public points (:mod:`kinlib.course.selfcheck`).
+  other, public points (:mod:`kinlib.course.workbook.selfcheck`).
 """
 
 from __future__ import annotations

@@ -6,7 +6,7 @@ aborted, and prints each page only once it is finished: MathJax has typeset (its
 queue), the saved widgets are drawn, every image is decoded and the fonts are loaded. Nothing waits a fixed
 time, so a loaded machine makes the same PDF, only later.
 
-The pages carry :data:`PRINT_HEAD` (written by :func:`kinlib.course.pages.export_html`): a print stylesheet
+The pages carry :data:`PRINT_HEAD` (written by :func:`kinlib.course.publish.pages.export_html`): a print stylesheet
 (code and text outputs wrap, figures stay with their captions, sliders give way to their values, the
 links bar is hidden) and ``kinlibFitPrint()``, which scales down what is still wider than the paper (the
 6×3 SymPy matrices) with CSS ``zoom``. :func:`print_pdfs` calls it at the paper's printable width; a

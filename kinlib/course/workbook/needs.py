@@ -1,7 +1,7 @@
-"""The workbook's ``%%needs NAME...`` cell magic (loaded by ``%load_ext kinlib.course.selfcheck``).
+"""The workbook's ``%%needs NAME...`` cell magic (loaded by ``%load_ext kinlib.course.workbook.selfcheck``).
 
 ``kinlib handouts`` starts every workbook cell that reads the student's answers (the pictures drawn from
-them: :func:`kinlib.course.analysis.answer_dependents`) with ``%%needs`` and the answer names. Such a cell
+them: :func:`kinlib.course.publish.analysis.answer_dependents`) with ``%%needs`` and the answer names. Such a cell
 
 - is skipped, with a note, while an answer it uses is still ``...``;
 - runs as usual when the self-check said every answer it uses is right (an error there is a real error,
@@ -19,7 +19,7 @@ import html
 import sys
 import traceback
 
-from . import answers
+from ..answers import normalise as answers
 
 __all__ = ["needs", "friendly_error", "answer_status", "last_results"]
 

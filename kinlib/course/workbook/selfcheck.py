@@ -6,11 +6,11 @@ name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA
 holds only the fingerprint; the student's answer is fingerprinted the same way when the self-check
 cell runs, so a right answer in any equivalent form (simplified or not, floats or exact) passes::
 
-    from kinlib.course.selfcheck import check
+    from kinlib.course.workbook.selfcheck import check
     check("2.2", Js="matrix|6x3|3f0c1b9e5a7d2c44")
 
 Kinds of answer (``kinds`` in the solution cell's ``kinlib`` metadata; the forms each accepts are
-those of :mod:`kinlib.course.answers`, the normaliser the instructor checker uses too):
+those of :mod:`kinlib.course.answers.normalise`, the normaliser the instructor checker uses too):
 
 - default / ``"expr"``: a SymPy Matrix, expression or number, compared as a function of its symbols;
 - ``"choice"``: an int, string or tuple of them (joint numbers 1-based; order and repeats ignored);
@@ -19,13 +19,13 @@ those of :mod:`kinlib.course.answers`, the normaliser the instructor checker use
   end points;
 - ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector.
 
-A wrong answer is tried against the known mistakes of :mod:`kinlib.course.mistakes` (transposed, wrong
+A wrong answer is tried against the known mistakes of :mod:`kinlib.course.answers.mistakes` (transposed, wrong
 sign, [v; ω] order, columns swapped, degrees, wrong shape, ...; the instructor checker uses the same):
 each undone version of the student's answer is fingerprinted too, and a match names the mistake ("it is
 transposed"), never the answer.
 
-In a workbook, ``%load_ext kinlib.course.selfcheck`` adds the cell magic ``%%needs NAME...``
-(:mod:`kinlib.course.needs`): the cell runs only once the names it uses from the student's answers are
+In a workbook, ``%load_ext kinlib.course.workbook.selfcheck`` adds the cell magic ``%%needs NAME...``
+(:mod:`kinlib.course.workbook.needs`): the cell runs only once the names it uses from the student's answers are
 filled in, and if it fails while their self-check has not passed, says "fix the answer above first".
 """
 
@@ -39,9 +39,10 @@ import sys
 import numpy as np
 import sympy as sp
 
-from . import answers, mistakes
+from ..answers import mistakes
+from ..answers import normalise as answers
+from ..schema import KINDS
 from .needs import answer_status, last_results, needs
-from .schema import KINDS
 
 __all__ = [
     "check",
@@ -74,7 +75,7 @@ class Unanswered(Exception):
     >>> fingerprint(...)
     Traceback (most recent call last):
         ...
-    kinlib.course.selfcheck.Unanswered: the value is missing or ...
+    kinlib.course.workbook.selfcheck.Unanswered: the value is missing or ...
     >>> check("1.1", _namespace={}, J=fingerprint(sp.eye(2), salt="1.1:J"))
     part 1.1 · J: … not answered yet: replace the ... in `J = ...` above with your answer (a 2×2 matrix)
     """
@@ -90,7 +91,7 @@ class CannotCheck(Exception):
     >>> fingerprint(f)
     Traceback (most recent call last):
         ...
-    kinlib.course.selfcheck.CannotCheck: it does not evaluate to a number (Cannot convert expression to float)
+    kinlib.course.workbook.selfcheck.CannotCheck: it does not evaluate to a number (Cannot convert expression to float)
     >>> verdict(f, fingerprint(sp.Symbol("t")))
     ('error', 'cannot check it automatically: it does not evaluate to a number (Cannot convert expression to float)')
     """
@@ -104,7 +105,7 @@ class WrongForm(Exception):
     >>> fingerprint([[1, 2], [3]])  # doctest: +ELLIPSIS
     Traceback (most recent call last):
         ...
-    kinlib.course.selfcheck.WrongForm: it should be a SymPy Matrix, expression or number, yours is a list of ...
+    kinlib.course.workbook.selfcheck.WrongForm: it should be a SymPy Matrix, expression or number, yours is a list of ...
     >>> check("1.1", _namespace={"J": sp.eye(3)}, J=fingerprint(sp.eye(2), salt="1.1:J"))
     part 1.1 · J: ✗ wrong form: it should be a 2×2 matrix, yours is a 3×3 matrix
     """
@@ -193,7 +194,7 @@ _FORM_WORDS = {
 
 
 def _as_sympy_value(value, vectors: bool = False):
-    """The answer as a SymPy Matrix or expression (:func:`kinlib.course.answers.to_sympy`), or WrongForm."""
+    """The answer as a SymPy Matrix or expression (:func:`kinlib.course.answers.normalise.to_sympy`), or WrongForm."""
     tag, v = answers.to_sympy(value, vectors=vectors)
     if v is not None:
         return v
@@ -253,7 +254,7 @@ def _canon_default(value, shape: str | None = None):
 
 
 def _choice_canon(x):
-    """A choice value as :func:`kinlib.course.answers.choice_key` gives it (the grader's definition too)."""
+    """A choice value as :func:`kinlib.course.answers.normalise.choice_key` gives it (the grader's definition too)."""
     try:
         return answers.choice_key(x)
     except TypeError as e:
@@ -472,7 +473,7 @@ _FORM_KIND = {
 def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     """``(status, message)`` for an answer against a spec; status is correct/incorrect/unanswered/error.
 
-    A wrong answer is tried against the known mistakes (:mod:`kinlib.course.mistakes`: the same as the
+    A wrong answer is tried against the known mistakes (:mod:`kinlib.course.answers.mistakes`: the same as the
     instructor checker's): the message names the mistake, never the answer.
 
     >>> spec = fingerprint(sp.Rational(1, 2), salt="1.1:x")
@@ -634,7 +635,7 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
 
 
 # ---------------------------------------------------------------------------------------------------
-# Build side: used by kinlib.course.handouts inside the kernel, right after a part's solution cells ran.
+# Build side: used by kinlib.course.publish.handouts inside the kernel, right after a part's solution cells ran.
 
 
 def emit_fingerprints(specs: dict, ns: dict) -> None:
@@ -664,8 +665,8 @@ def emit_fingerprints(specs: dict, ns: dict) -> None:
 
 
 def load_ipython_extension(ip) -> None:
-    """``%load_ext kinlib.course.selfcheck``: registers the ``%%needs NAME...`` cell magic
-    (:func:`kinlib.course.needs.needs`: skips a cell until its answers are filled in, and turns an error in
+    """``%load_ext kinlib.course.workbook.selfcheck``: registers the ``%%needs NAME...`` cell magic
+    (:func:`kinlib.course.workbook.needs.needs`: skips a cell until its answers are filled in, and turns an error in
     it into "fix the answer above first" while the self-check has not passed them).
 
     IPython calls it with the shell; any object with ``register_magic_function`` does here:

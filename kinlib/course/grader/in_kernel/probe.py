@@ -2,8 +2,8 @@
 
 This module runs in two places with the same code:
 
-* inside each **student kernel**: :mod:`kinlib.course.kernel` sends this file's *source text* (and
-  those of :mod:`kinlib.course.answers`, the answer normaliser it uses, and :mod:`kinlib.course.guard`, bound
+* inside each **student kernel**: :mod:`kinlib.course.grader.isolation.kernel` sends this file's *source text* (and
+  those of :mod:`kinlib.course.answers.normalise`, the answer normaliser it uses, and :mod:`kinlib.course.grader.in_kernel.guard`, bound
   here as ``answers`` and ``guard``) and executes it in a private module (registered in ``sys.modules`` under
   a random name), so nothing the student did to ``kinlib`` reaches it; ``guard.snapshot`` runs before the
   first student cell and ``guard.restore`` puts SymPy's, NumPy's, mpmath's and the builtins' namespaces (and SymPy's class
@@ -14,7 +14,7 @@ This module runs in two places with the same code:
   code path.
 
 It imports only the standard library, SymPy and NumPy (and, outside a kernel, its sibling
-:mod:`kinlib.course.answers`).
+:mod:`kinlib.course.answers.normalise`).
 """
 
 import json
@@ -22,7 +22,8 @@ import math
 import random
 
 if "answers" not in globals():  # in a student kernel the checker binds private copies before running this
-    from . import answers, guard, srepr
+    from ...answers import normalise as answers
+    from . import guard, srepr
 
 parse_srepr = srepr.parse_srepr  # reference data in, SymPy out (a strict parser, never eval)
 
@@ -48,7 +49,7 @@ _DEGREE_CONSTANTS = {15, 30, 45, 60, 75, 90, 105, 120, 135, 150, 165, 180, 210, 
 _MISSING = object()
 
 
-# ----------------------------------------------------------------------------- coercion (kinlib.course.answers)
+# ----------------------------------------------------------------------------- coercion (kinlib.course.answers.normalise)
 
 
 def _shape(obj):
@@ -595,7 +596,7 @@ SNAP = None
 def restore_saved(path):
     """Restore the snapshot taken before the first student cell; write how many attributes changed.
 
-    Without the ``SNAP`` the checker takes in a kernel (:func:`kinlib.course.guard.snapshot`), nothing is
+    Without the ``SNAP`` the checker takes in a kernel (:func:`kinlib.course.grader.in_kernel.guard.snapshot`), nothing is
     restored:
 
     >>> import pathlib, tempfile

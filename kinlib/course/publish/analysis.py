@@ -1,6 +1,6 @@
 """Which cells of a notebook depend on its answers: name analysis of code cells, and worked solutions.
 
-Used by :mod:`kinlib.course.handouts` to leave answers out of the problem pages and the workbooks: cells
+Used by :mod:`kinlib.course.publish.handouts` to leave answers out of the problem pages and the workbooks: cells
 that read answer variables (computed by ``solution`` cells), the untagged markdown of worked
 solutions, and the imports and helper functions only the solutions use (:func:`trim_setup`).
 """
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import ast
 
-from .schema import ANSWER_TAGS, CHECK, QUESTION, SOLUTION, cell_tags
+from ..schema import ANSWER_TAGS, CHECK, QUESTION, SOLUTION, cell_tags
 
 __all__ = ["cell_names", "loaded_names", "trim_setup", "worked_narrative", "answer_dependents"]
 

@@ -1,6 +1,6 @@
 """The notebooks in the browser: a JupyterLite site (``build/handouts/lite/``) on Pyodide, no install, no server.
 
-``make handouts`` (:func:`kinlib.course.handouts.build`) ends with :func:`build_lite`: a static JupyterLite site
+``make handouts`` (:func:`kinlib.course.publish.handouts.build`) ends with :func:`build_lite`: a static JupyterLite site
 holding the student workbooks (``workbooks/NN_*.ipynb``) and the executed solution notebooks
 (``solutions/NN_*.ipynb``), whose Python kernel (Pyodide, CPython compiled to WebAssembly) imports numpy, sympy,
 matplotlib, ipywidgets and kinlib without ``%pip`` and fetches nothing from outside the site. ``make site`` (or
@@ -140,7 +140,7 @@ EXTRA_LOCK = {
     "ipywidgets": (["ipywidgets"], ["comm", "ipython", "traitlets"]),
     "kinlib": (["kinlib"], ["numpy", "sympy", "mpmath", "matplotlib", "pillow", "ipywidgets"]),
 }
-#: loaded when the kernel starts (so ``%load_ext kinlib.course.needs`` works in a workbook's first cell)
+#: loaded when the kernel starts (so ``%load_ext kinlib.course.workbook.needs`` works in a workbook's first cell)
 PRELOAD = ["micropip", "ssl", "sqlite3", "jedi", "ipython", "comm", "kinlib"]
 #: what kinlib runs on in the browser (tests/test_lite.py checks these against the site's lock)
 SUPPORTED = {
@@ -178,7 +178,7 @@ class IntegrityError(RuntimeError):
     >>> raise IntegrityError("numpy-2.0.2-cp312-cp312-pyodide_2024_0_wasm32.whl: missing")
     Traceback (most recent call last):
         ...
-    kinlib.course.lite.IntegrityError: numpy-2.0.2-cp312-cp312-pyodide_2024_0_wasm32.whl: missing
+    kinlib.course.publish.lite.IntegrityError: numpy-2.0.2-cp312-cp312-pyodide_2024_0_wasm32.whl: missing
     """
 
 
@@ -330,9 +330,9 @@ def _pypi(pin: Pin, cache: Path, log=print) -> Path:
                     f"{pin.filename}: pip download {pin.name}=={pin.version} failed (exit {r.returncode}):\n"
                     + r.stderr.strip()[-2000:]
                 )
-            verify_file(got, pin.sha256, f"{pin.name} {pin.version}, pinned in kinlib/course/lite.py")
+            verify_file(got, pin.sha256, f"{pin.name} {pin.version}, pinned in kinlib/course/publish/lite.py")
             shutil.move(str(got), path)
-    return verify_file(path, pin.sha256, f"{pin.name} {pin.version}, pinned in kinlib/course/lite.py")
+    return verify_file(path, pin.sha256, f"{pin.name} {pin.version}, pinned in kinlib/course/publish/lite.py")
 
 
 def _core(cache: Path) -> tuple[Path, dict]:
@@ -392,7 +392,7 @@ def copy_lock_files(entries: dict, sources: dict, dest: Path) -> list[Path]:
 
 def _kinlib_wheel(work: Path, log=print) -> Path:
     """kinlib's wheel, built from this checkout (pure Python; no network: no build isolation)."""
-    root = Path(__file__).resolve().parents[2]
+    root = Path(__file__).resolve().parents[3]
     if not (root / "pyproject.toml").is_file():
         raise FileNotFoundError(f"kinlib's wheel is built from a checkout: no pyproject.toml in {root}")
     src = work / "src"  # a copy: setuptools writes build/ and *.egg-info next to the sources

@@ -2,11 +2,11 @@
 
 A ``property`` answer (kind "property:<name>" in the grader; declared by ``properties`` in the solution cell's
 metadata, see :func:`kinlib.course.schema.grading_kind`) crosses the kernel boundary as a JSON expression tree
-(:func:`kinlib.course.probe.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
+(:func:`kinlib.course.grader.in_kernel.probe.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
 with bounded size, so a hostile tree cannot run code or exhaust the grader. :data:`PROPERTIES` maps each
 property to its decision, ``(ok, message)``; the message talks about the student's own answer only.
 
-:func:`exact_ranks` compares constant exact subspaces exactly (:func:`kinlib.course.compare.compare_subspace`).
+:func:`exact_ranks` compares constant exact subspaces exactly (:func:`kinlib.course.answers.compare.compare_subspace`).
 
 * ``nonsingular`` (problem 5.5): det(J Jᵀ) of the student's redesign (or its task Jacobian J) is nonzero for
   every joint value, proved exactly by :func:`kinlib.singularities.singular_configurations` (trigonometric

@@ -1,7 +1,7 @@
 """The answer normaliser: what form a student's (or the reference's) answer value has, in SymPy terms.
 
-One implementation for both the workbook self-checks (:mod:`kinlib.course.selfcheck`) and the
-instructor checker (:mod:`kinlib.course.probe`, which runs it inside each student kernel), so an answer
+One implementation for both the workbook self-checks (:mod:`kinlib.course.workbook.selfcheck`) and the
+instructor checker (:mod:`kinlib.course.grader.in_kernel.probe`, which runs it inside each student kernel), so an answer
 form one of them accepts, the other accepts too:
 
 * **matrices and expressions** (:func:`to_sympy`): SymPy matrices; NumPy arrays (0-d: a number, 1-D:
@@ -302,7 +302,7 @@ _TREE_MAX_NODES = 4000
 def expr_tree(obj, max_nodes=_TREE_MAX_NODES):
     """A SymPy expression or matrix as a JSON tree of plain lists: a ``property`` answer (or a constant exact
     subspace) is decided exactly in the grader, which rebuilds it from a whitelist of numbers, symbols, π,
-    +, ×, powers and sin/cos/tan (:func:`kinlib.course.properties.from_tree`). Raises ValueError for
+    +, ×, powers and sin/cos/tan (:func:`kinlib.course.answers.properties.from_tree`). Raises ValueError for
     anything else or more than ``max_nodes`` nodes.
 
     >>> import sympy as sp

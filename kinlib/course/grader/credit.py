@@ -1,6 +1,6 @@
 """Course credit: points per answer (partial credit), manual rows, instructor overrides, student ids, totals.
 
-The grader (:func:`kinlib.course.grade.grade_submission`) judges each answer pass/fail/error; this module
+The grader (:func:`kinlib.course.grader.grade.grade_submission`) judges each answer pass/fail/error; this module
 turns those verdicts into points, the way the solution notebook's ``kinlib`` cell metadata declares them
 (read by :func:`kinlib.course.schema.parse_parts`):
 

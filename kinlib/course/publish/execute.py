@@ -20,7 +20,7 @@ random ids are renamed by their order of appearance: widget model ids (uuid4 fro
 ``sha1(notebook stem, k)`` in the state, in every ``IPY_MODEL_`` reference and in the outputs, and the
 element ids of matplotlib ``to_jshtml`` players (``_anim_img<uuid>``) become ``sha1(stem, cell id, k)``.
 
->>> from kinlib.course.execute import stable_id
+>>> from kinlib.course.publish.execute import stable_id
 >>> stable_id("05_singularities_planar", 0) == stable_id("05_singularities_planar", 0)
 True
 >>> len(stable_id("x", 1))
