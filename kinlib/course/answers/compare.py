@@ -1,7 +1,7 @@
-"""Instructor side of the checker: compare the JSON a student kernel sent with the reference's.
+"""Grader side: compare the description of a student's answer with the reference's.
 
-Everything here works on plain JSON data (numbers, strings, lists) produced by
-:mod:`kinlib.course.grader.in_kernel.probe`; nothing from a submission is evaluated. Each comparison returns
+Everything here works on plain data (numbers, strings, lists) produced by :mod:`.describe` in the grader's
+process, from the answer a kernel exported as data; non-finite values are never equal to anything. Each comparison returns
 ``(ok, message)``; messages name the mistake when it is recognizable (wrong shape, transposed,
 wrong sign, columns swapped, [v; ω] instead of [ω; v], degrees instead of radians, a missing or
 extra variable) without printing the reference answer or anything that gives it away (a factor, the

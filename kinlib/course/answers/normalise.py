@@ -1,8 +1,9 @@
 """The answer normaliser: what form a student's (or the reference's) answer value has, in SymPy terms.
 
 One implementation for both the workbook self-checks (:mod:`kinlib.course.workbook.selfcheck`) and the
-instructor checker (:mod:`kinlib.course.grader.in_kernel.probe`, which runs it inside each student kernel), so an answer
-form one of them accepts, the other accepts too:
+grader (which applies it in its own process to the answer a kernel exported as data, :mod:`.describe`), so an
+answer form one of them accepts, the other accepts too; :func:`choice_key` is the one definition of the same
+choice for both:
 
 * **matrices and expressions** (:func:`to_sympy`): SymPy matrices; NumPy arrays (0-d: a number, 1-D:
   a column, 2-D: the matrix); a flat list/tuple of numbers (a column); a list of vectors (column or
@@ -17,8 +18,7 @@ form one of them accepts, the other accepts too:
   of them (ties as tuples); strings compare without case or extra spaces, integral floats as ints;
 * **yes/no** (:func:`is_bool`) and **not answered** (:func:`is_unanswered`: ``...`` or ``None``).
 
-It imports only the standard library, NumPy and SymPy (never kinlib): the checker sends its source text
-into each student kernel, where it must not depend on anything the submission could have changed.
+It imports only the standard library, NumPy and SymPy (it runs in the student's notebook too).
 """
 
 import math
