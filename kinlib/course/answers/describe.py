@@ -171,27 +171,16 @@ def _real(e, subs):
 
 
 def _enum1d(S, subs, window):
-    """Members of the 1-D set ``S`` in [-window, window]: (points, intervals); raises ValueError if unknown."""
+    """Members of the 1-D set ``S`` in [-window, window]: (points, intervals); raises ValueError if unknown or
+    if it lists more than :data:`MAX_SET_MEMBERS` members."""
     import sympy as sp
 
     if not isinstance(S, sp.Set):
         S = answers.to_set(S)
     if S is sp.S.EmptySet:
         return [], []
-    if S in (sp.S.Reals, sp.S.UniversalSet) or isinstance(S, sp.sets.sets.UniversalSet):
+    if S in (sp.S.Reals, sp.S.UniversalSet, sp.S.Complexes) or isinstance(S, sp.sets.sets.UniversalSet):
         return [], [[-math.inf, math.inf]]
-    if S is sp.S.Complexes:
-        return [], [[-math.inf, math.inf]]
-    if isinstance(S, sp.FiniteSet):
-        if len(S.args) > MAX_SET_MEMBERS:
-            raise ValueError(f"more than {MAX_SET_MEMBERS} members: too large to grade")
-        pts = []
-        for e in S.args:
-            x = _real(sp.sympify(e), subs)
-            if x is None:
-                raise ValueError(f"member {e} is not a real number")
-            pts.append(x)
-        return pts, []
     if isinstance(S, sp.Interval):
         return [], [[_real(S.start, subs), _real(S.end, subs)]]
     if isinstance(S, sp.Union):
@@ -200,57 +189,101 @@ def _enum1d(S, subs, window):
             p, i = _enum1d(a, subs, window)
             pts += p
             ivs += i
+            _cap(pts)
         return pts, ivs
-    if isinstance(S, sp.ImageSet):
-        lam = S.lamda
-        base = S.base_sets[0] if hasattr(S, "base_sets") else S.base_set
-        if len(lam.variables) != 1 or base not in (sp.S.Integers, sp.S.Naturals, sp.S.Naturals0):
-            raise ValueError("only image sets over the integers can be compared")
-        v = lam.variables[0]
-        f = lam.expr.xreplace(subs) if subs else lam.expr
-        f0, f1 = _real(f.xreplace({v: 0}), {}), _real(f.xreplace({v: 1}), {})
-        step = abs(f1 - f0) if f0 is not None and f1 is not None else 0.0
-        K = min(2000, int(2 * window / step) + 3) if step > 1e-9 else 50
-        # centred on the member nearest 0 (a family 2πn + 1000π, or one in degrees, has members in the window)
-        c = 0 if step <= 1e-9 or base is not sp.S.Integers else int(max(-1e6, min(1e6, round(-f0 / (f1 - f0)))))
-        lo = 0 if base is sp.S.Naturals0 else (1 if base is sp.S.Naturals else c - K)
-        pts, near = [], []
-        for n in range(lo, c + K + 1):
-            x = _real(f.xreplace({v: n}), {})
-            if x is not None and abs(x) <= window:
-                pts.append(x)
-            elif x is not None and abs(n - c) <= 3:
-                near.append(x)
-        return (pts or near), []
-    if isinstance(S, sp.Intersection):
-        enumerable = []
-        filters = []
-        for a in S.args:
-            if isinstance(a, sp.Interval) or a in (sp.S.Reals,):
-                filters.append(a)
-            else:
-                enumerable.append(a)
-        if not enumerable:
-            raise ValueError("an intersection of intervals cannot be compared")
-        pts, ivs = _enum1d(enumerable[0], subs, window)
-        if ivs:
-            raise ValueError("cannot compare an intersection with a continuous set")
-        for other in enumerable[1:]:
-            p2, i2 = _enum1d(other, subs, window)
-            pts = [x for x in pts if any(abs(x - y) < 1e-7 for y in p2) or any(a <= x <= b for a, b in i2)]
-        for fset in filters:
-            if fset is sp.S.Reals:
-                continue
-            a, b = _real(fset.start, subs), _real(fset.end, subs)
-            pts = [
-                x
-                for x in pts
-                if (a < x < b)
-                or (not fset.left_open and abs(x - a) < 1e-12)
-                or (not fset.right_open and abs(x - b) < 1e-12)
-            ]
-        return pts, []
+    for kind, enum in _ENUMERATE:
+        if isinstance(S, kind()):
+            return _cap(enum(S, subs, window)), []
     raise ValueError(f"a {type(S).__name__} cannot be enumerated (use FiniteSet, ImageSet or Union)")
+
+
+def _cap(pts):
+    if len(pts) > MAX_SET_MEMBERS:
+        raise ValueError(f"more than {MAX_SET_MEMBERS} members: too large to grade")
+    return pts
+
+
+def _finite(S, subs, window):
+    import sympy as sp
+
+    _cap(S.args)
+    pts = []
+    for e in S.args:
+        x = _real(sp.sympify(e), subs)
+        if x is None:
+            raise ValueError(f"member {e} is not a real number")
+        pts.append(x)
+    return pts
+
+
+def _image(S, subs, window):
+    """The members of an image set over the integers {f(n)} in the window (those nearest 0 if none is)."""
+    import sympy as sp
+
+    lam = S.lamda
+    base = S.base_sets[0] if hasattr(S, "base_sets") else S.base_set
+    if len(lam.variables) != 1 or base not in (sp.S.Integers, sp.S.Naturals, sp.S.Naturals0):
+        raise ValueError("only image sets over the integers can be compared")
+    v = lam.variables[0]
+    f = lam.expr.xreplace(subs) if subs else lam.expr
+    f0, f1 = _real(f.xreplace({v: 0}), {}), _real(f.xreplace({v: 1}), {})
+    step = abs(f1 - f0) if f0 is not None and f1 is not None else 0.0
+    K = min(2000, int(2 * window / step) + 3) if step > 1e-9 else 50
+    # centred on the member nearest 0 (a family 2πn + 1000π, or one in degrees, has members in the window)
+    c = 0 if step <= 1e-9 or base is not sp.S.Integers else int(max(-1e6, min(1e6, round(-f0 / (f1 - f0)))))
+    lo = 0 if base is sp.S.Naturals0 else (1 if base is sp.S.Naturals else c - K)
+    pts, near = [], []
+    for n in range(lo, c + K + 1):
+        x = _real(f.xreplace({v: n}), {})
+        if x is not None and abs(x) <= window:
+            pts.append(x)
+        elif x is not None and abs(n - c) <= 3:
+            near.append(x)
+    return pts or near
+
+
+def _intersection(S, subs, window):
+    """The members of an intersection of enumerable sets, filtered by the intervals in it."""
+    import sympy as sp
+
+    filters = [a for a in S.args if isinstance(a, sp.Interval) or a is sp.S.Reals]
+    enumerable = [a for a in S.args if not (isinstance(a, sp.Interval) or a is sp.S.Reals)]
+    if not enumerable:
+        raise ValueError("an intersection of intervals cannot be compared")
+    pts, ivs = _enum1d(enumerable[0], subs, window)
+    if ivs:
+        raise ValueError("cannot compare an intersection with a continuous set")
+    for other in enumerable[1:]:
+        p2, i2 = _enum1d(other, subs, window)
+        pts = [x for x in pts if any(abs(x - y) < 1e-7 for y in p2) or any(a <= x <= b for a, b in i2)]
+    for fset in filters:
+        if fset is sp.S.Reals:
+            continue
+        a, b = _real(fset.start, subs), _real(fset.end, subs)
+        pts = [
+            x
+            for x in pts
+            if (a < x < b)
+            or (not fset.left_open and abs(x - a) < 1e-12)
+            or (not fset.right_open and abs(x - b) < 1e-12)
+        ]
+    return pts
+
+
+def _set_class(name):
+    def get():
+        import sympy as sp
+
+        return getattr(sp, name)
+
+    return get
+
+
+_ENUMERATE = (  # (the SymPy class, lazily, its members' enumeration)
+    (_set_class("FiniteSet"), _finite),
+    (_set_class("ImageSet"), _image),
+    (_set_class("Intersection"), _intersection),
+)
 
 
 def _component(key, S, p, seed, window):

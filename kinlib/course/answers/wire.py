@@ -74,8 +74,8 @@ _SINGLETON_ATTR = {"BooleanTrue": "true", "BooleanFalse": "false"}
 class WireError(ValueError):
     """The tree is not an answer in this format, or is over a cap (the message says which).
 
-    >>> str(WireError("the answer is nested too deeply (more than 200 levels)"))
-    'the answer is nested too deeply (more than 200 levels)'
+    >>> str(WireError("nested more than 200 levels deep"))
+    'nested more than 200 levels deep'
     """
 
 
@@ -125,7 +125,7 @@ def load(tree, max_nodes: int = MAX_NODES, max_depth: int = MAX_DEPTH):
             raise bad("malformed integer")
         left["digits"] -= len(s)
         if left["digits"] < 0:
-            raise bad("numbers with too many digits in all")
+            raise bad(f"numbers with more than {MAX_DIGITS} digits in all")
         return int(s)
 
     def small(x, cap):
@@ -136,9 +136,9 @@ def load(tree, max_nodes: int = MAX_NODES, max_depth: int = MAX_DEPTH):
     def build(t, depth):
         left["nodes"] -= 1
         if left["nodes"] < 0:
-            raise bad(f"the answer is too large (more than {max_nodes} parts)")
+            raise bad(f"more than {max_nodes} parts")
         if depth > max_depth:
-            raise bad(f"the answer is nested too deeply (more than {max_depth} levels)")
+            raise bad(f"nested more than {max_depth} levels deep")
         if not isinstance(t, list) or not t or not isinstance(t[0], str):
             raise bad("malformed answer data")
         op, args = t[0], t[1:]

@@ -121,7 +121,8 @@ def _read(exported, name):
     try:
         return wire.load(exported["tree"]), None
     except WireError as exc:
-        return None, {"tag": "too-large" if "too" in str(exc) else "unreadable", "error": str(exc)[:200]}
+        big = str(exc).startswith(("more than", "nested more", "numbers with more", "a power too large"))
+        return None, {"tag": "too-large" if big else "unreadable", "error": str(exc)[:200]}
     except RecursionError:
         return None, {"tag": "too-large", "error": "nested too deeply"}
 

@@ -59,7 +59,8 @@ def _basic(e, walk):
     if isinstance(e, sp.Float):
         return ["Float", libmp.to_str(e._mpf_, libmp.repr_dps(e._prec)), int(e._prec)]
     if isinstance(e, sp.Symbol) and not isinstance(e, sp.Wild):
-        assumptions = {k: v for k, v in e._assumptions_orig.items() if isinstance(v, bool)}
+        given = getattr(e, "_assumptions_orig", None) or e.assumptions0  # (SymPy < 1.12 has only the latter)
+        assumptions = {k: v for k, v in given.items() if isinstance(v, bool)}
         if isinstance(e, sp.Dummy):  # one Dummy, however often it appears (an ImageSet's bound variable)
             return ["Dummy", e.name, assumptions, int(e.dummy_index) % 2**31]
         return ["Symbol", e.name, assumptions]
