@@ -99,6 +99,7 @@ from ..schema import cell_meta, cell_part, match_notebook, notebook_id, stash_po
 from . import credit
 from .isolation.kernel import NotebookRun
 from .isolation.sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
+from .judge import N_POINTS
 from .refdata import (
     GRADE_VERSION,
     Reference,
@@ -129,7 +130,6 @@ __all__ = [
 NO_SANDBOX_NOTE = (
     "graded WITHOUT the sandbox (--no-sandbox): the submission's code ran with the grader's files and network"
 )
-N_POINTS = 5
 MAX_SUBMISSION_BYTES = 50 * 2**20
 
 
