@@ -16,7 +16,6 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from kinlib.course.answers import compare
 from kinlib.course.answers.normalise import (
     choice_value,
     is_bool,
@@ -26,7 +25,9 @@ from kinlib.course.answers.normalise import (
     to_set,
     to_sympy,
 )
-from kinlib.course.grader.in_kernel import probe
+from kinlib.course.grader.in_kernel.export import exported
+from kinlib.course.grader.judge import judge_answer
+from kinlib.course.grader.refdata import Reference, reference_answers
 from kinlib.course.workbook.selfcheck import fingerprint, verdict
 
 x, th1, th2 = sp.symbols("x theta1 theta2")
@@ -204,14 +205,12 @@ def _selfcheck(value, ref, kind):
 
 
 def _checker(value, ref, kind):
-    """The checker's path: the reference dumped and parsed as the worker does, both described, compared."""
-    dumped = probe.dump_reference({"a": ref}, {"a": kind})["a"]
-    assert "error" not in dumped, dumped
-    kind = dumped["kind"]
-    ref_desc = (
-        dumped["choice"] if kind == "choice" else probe.describe(kind, probe.parse_srepr(dumped["srepr"]), POINTS, 1)
-    )
-    return compare.compare(kind, probe.describe(kind, value, POINTS, 1), ref_desc, "a")
+    """The checker's path: both answers exported as a kernel exports them, the reference read as
+    build_reference reads it, the student's judged in the grader (read, described at the points, compared)."""
+    entry = reference_answers({"a": exported(ref)}, {"a": kind})
+    assert "error" not in entry["a"], entry
+    v = judge_answer("a", entry["a"]["kind"], exported(value), Reference("t", "t", "p", "0" * 64, [], entry), POINTS, 1)
+    return v.passed, v.message
 
 
 SAME = [  # (kind, reference, an equivalent answer in another form)

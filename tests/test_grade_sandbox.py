@@ -23,9 +23,9 @@ from pathlib import Path
 
 import pytest
 
+from kinlib.course.answers.srepr import parse_srepr
 from kinlib.course.cli import main
 from kinlib.course.grader import grade
-from kinlib.course.grader.in_kernel.srepr import parse_srepr
 from kinlib.course.grader.isolation import sandbox
 from kinlib.course.grader.isolation.kernel import Kernel
 from kinlib.course.grader.refdata import reference_description

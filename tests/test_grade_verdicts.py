@@ -1,7 +1,7 @@
 """Right verdicts from the grader's comparisons (issue 14, item 3), with messages that never give the key away.
 
 Every false pass and false fail reported in the issue is a test here, with the verdict it must get. The answers
-are described exactly as the grader describes them (:func:`kinlib.course.grader.in_kernel.probe.describe`, the code a student
+are described exactly as the grader describes them (:func:`kinlib.course.answers.describe.describe`, the code a student
 kernel runs; the reference side uses the same function) and compared by :func:`kinlib.course.answers.compare.compare`.
 Oracles are independent of the comparison: the subspaces are built from known bases and mixings (numpy), the
 angle sets from known rational multiples of π, the redesigns' det(J Jᵀ) from modern_robotics' Jacobian.
@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 from kinlib import robots
 from kinlib.course import schema
 from kinlib.course.answers import compare as C
-from kinlib.course.grader.in_kernel import probe
+from kinlib.course.answers import describe as probe
 from kinlib.singularities import task_rows
 
 pi = sp.pi

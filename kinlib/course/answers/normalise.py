@@ -1,8 +1,9 @@
 """The answer normaliser: what form a student's (or the reference's) answer value has, in SymPy terms.
 
 One implementation for both the workbook self-checks (:mod:`kinlib.course.workbook.selfcheck`) and the
-instructor checker (:mod:`kinlib.course.grader.in_kernel.probe`, which runs it inside each student kernel), so an answer
-form one of them accepts, the other accepts too:
+grader (which applies it in its own process to the answer a kernel exported as data, :mod:`.describe`), so an
+answer form one of them accepts, the other accepts too; :func:`choice_key` is the one definition of the same
+choice for both:
 
 * **matrices and expressions** (:func:`to_sympy`): SymPy matrices; NumPy arrays (0-d: a number, 1-D:
   a column, 2-D: the matrix); a flat list/tuple of numbers (a column); a list of vectors (column or
@@ -20,8 +21,7 @@ form one of them accepts, the other accepts too:
   object with a 6×n ``screws`` matrix (a kinlib ``SerialChain``, found by duck typing: this module never
   imports kinlib), or its task Jacobian as a matrix.
 
-It imports only the standard library, NumPy and SymPy (never kinlib): the checker sends its source text
-into each student kernel, where it must not depend on anything the submission could have changed.
+It imports only the standard library, NumPy and SymPy (it runs in the student's notebook too).
 """
 
 import math
@@ -38,6 +38,7 @@ __all__ = [
     "to_set",
     "looks_like_set",
     "choice_value",
+    "choice_key",
     "type_name",
     "expr_tree",
     "robot_screws",
@@ -64,11 +65,14 @@ def is_bool(value) -> bool:
 
 
 def type_name(value) -> str:
-    """The type of ``value`` as students know it (``Matrix``'s module spelled out, builtins bare).
+    """The type of ``value`` as students know it (``Matrix``'s module spelled out, builtins bare; an object that
+    crossed from a kernel as its type name only, :class:`kinlib.course.answers.wire.Other`, by that name).
 
     >>> type_name(3), type_name(sp.Integer(3))
     ('int', 'sympy.core.numbers.Integer')
     """
+    if type(value).__name__ == "Other" and isinstance(getattr(value, "type_name", None), str):
+        return value.type_name
     t = type(value)
     return f"{t.__module__}.{t.__qualname__}" if t.__module__ not in ("builtins",) else t.__qualname__
 
@@ -263,6 +267,37 @@ def choice_value(value):
     if math.isfinite(f) and f == int(f):
         return int(f)
     return f
+
+
+def choice_key(cv):
+    """The one definition of "the same choice" (the self-check hashes it, the grader compares it): a choice value
+    (:func:`choice_value`'s output) as sorted tagged strings, ties nested. A bool is never a joint number
+    (``True`` is not joint 1); floats to 8 significant digits, non-finite ones never equal a number. Raises
+    TypeError for an item that is not a number or a string.
+
+    >>> choice_key([2, 1, 2]) == choice_key([1, 2]), choice_key(True) == choice_key(1), choice_key([[1, 2], 3])
+    (True, False, ['T', [['i:1', 'i:2'], ['i:3']]])
+    """
+    if isinstance(cv, list):
+        if all(not isinstance(e, list) for e in cv):
+            return sorted({_choice_item(e) for e in cv})
+        return ["T", [choice_key(e) for e in cv]]
+    return [_choice_item(cv)]
+
+
+def _choice_item(x) -> str:
+    if isinstance(x, bool):
+        return f"b:{x}"
+    if isinstance(x, str):
+        return "s:" + x
+    if isinstance(x, int):
+        return f"i:{x}"
+    if isinstance(x, float):
+        if not math.isfinite(x):
+            return "n:nan"
+        return "n:" + ("0" if abs(x) < 1e-10 else f"{x:.7e}")
+    name = x.get("other", "object") if isinstance(x, dict) else type(x).__name__
+    raise TypeError(f"choices are numbers or strings, yours holds a {str(name).rsplit('.', 1)[-1]}")
 
 
 _TREE_FUNCS = ("sin", "cos", "tan")

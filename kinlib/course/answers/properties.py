@@ -1,8 +1,8 @@
 """Open-ended answers graded by the property asked (the grader's side, trusted process), never by one design's value.
 
 A ``property`` answer (kind "property:<name>" in the grader; declared by ``properties`` in the solution cell's
-metadata, see :func:`kinlib.course.schema.grading_kind`) crosses the kernel boundary as a JSON expression tree
-(:func:`kinlib.course.grader.in_kernel.probe.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
+metadata, see :func:`kinlib.course.schema.grading_kind`) is described in the grader as a JSON expression tree
+(:func:`kinlib.course.answers.normalise.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
 with bounded size, so a hostile tree cannot run code or exhaust the grader. :data:`PROPERTIES` maps each
 property to its decision, ``(ok, message)``; the message talks about the student's own answer only.
 

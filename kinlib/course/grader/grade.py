@@ -22,8 +22,9 @@ How it works
   installed package, which holds no answer key). For each graded part (a ``question`` markdown cell,
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
   :mod:`kinlib.course.schema` reads them) the
-  reference kernel (the grader's own, never a student's) returns each answer as data (``sympy.srepr``
-  text, read back by the strict parser :mod:`kinlib.course.grader.in_kernel.srepr`, never ``eval``); the result is
+  reference kernel (the grader's own, never a student's) exports each answer as data exactly as a student's
+  kernel does (below); the grader reads it and keeps it as ``sympy.srepr`` text (read back by the strict parser
+  :mod:`kinlib.course.answers.srepr`, never ``eval``); the result is
   cached in ``--cache/<id>-<hash>.json`` with an HMAC tag keyed by the grader secret
   (:mod:`kinlib.course.grader.refdata`), keyed by the notebook's bytes and the checker's version. Points per part:
   ``points`` in the solution cell's ``kinlib`` metadata if present, else "(N points)" parsed from the
@@ -37,18 +38,20 @@ How it works
   at the end of the notebook), so cells a student adds below a stub count and later reuse of the name
   does not. Workbook self-check cells that only call ``kinlib.course.workbook.selfcheck.check`` are not run (they
   cannot change an answer and cost seconds).
-* **Values cross the boundary as JSON numbers only.** Before the first student cell the checker
-  starts :mod:`kinlib.course.grader.in_kernel.probe` in the kernel from its source text, with the answer normaliser
-  :mod:`kinlib.course.answers.normalise` (private modules under a random name) and snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
-  namespaces, then asks for each answer's *values* at checker-chosen random points (joint angles in
-  (-π, π), positive symbols in (0.5, 2); random per submission, seeded by HMAC(grader secret,
-  submission bytes) (:mod:`kinlib.course.grader.secret`): reruns are reproducible, and nobody without the
-  secret can compute them from the file) as [re, im] floats, plus shape, symbol names and type. The
-  worker process compares them
-  with the reference evaluated at the same points: shapes first, then values, with diagnoses (wrong
-  sign, transposed, columns swapped, [v; ω] rows, degrees, a missing or extra variable). Only after
-  all values are in does the checker send the reference's srepr into the kernel for an exact check
-  (expand_trig/expand, then simplify), reported as advice: it cannot turn a numeric failure into a pass.
+* **Answers leave the kernel as data and are judged outside it** (the steps of :mod:`kinlib.course.grader.steps`).
+  Before the first student cell the grader starts the only code it ships into a kernel,
+  :mod:`kinlib.course.grader.in_kernel` (``guard`` and ``export``, private modules under a random name, from
+  their source text), which snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
+  namespaces, then asks for each answer *as data*: a JSON tree of the SymPy expression, matrix, set, array,
+  list, number or string (:mod:`kinlib.course.answers.wire`), and stops the kernel. Everything else happens in
+  the grader (:func:`kinlib.course.grader.judge.judge_answer`, per answer with caps and a time limit): the
+  tree is rebuilt by a whitelist parser (never ``eval``), evaluated at random points (joint angles in
+  (-π, π), positive symbols in (0.5, 2); random per submission, seeded by HMAC(grader secret, submission
+  bytes) (:mod:`kinlib.course.grader.secret`): reruns are reproducible, and nobody without the secret can
+  compute them from the file), compared with the reference at the same points (shapes first, then values,
+  with diagnoses: wrong sign, transposed, columns swapped, [v; ω] rows, degrees, a missing or extra
+  variable; non-finite values are wrong), and checked exactly (expand_trig/expand, then simplify), reported
+  as advice: it cannot turn a numeric failure into a pass. No point, seed or reference is ever sent to a kernel.
 * **Kinds** (``kinds`` beside ``answers``): ``expr`` (default: matrices/expressions as functions of
   the symbols), ``subspace`` (by span, whatever the basis and its scaling: principal angles between
   orthonormal bases), ``set`` (sets of configurations: members compared, angles modulo 2π whatever the
@@ -68,17 +71,15 @@ grades.csv and the feedback are written after every kernel of the batch, and eve
 started, is gone (checked: :func:`kinlib.course.grader.isolation.sandbox.reap_namespaces`). Without bubblewrap the grader
 refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.
 A kernel that cannot start is retried (:data:`kinlib.course.grader.isolation.kernel.START_ATTEMPTS`), judged by its
-process, not by heartbeats. Within the sandbox, the checker never evaluates student text in its own process
-(only JSON numbers and strings come back, read from a size-capped file), compares in its own
-process, and records failures from the kernel protocol, so a submission can *lie about the values it
-computes* (equivalent to writing those values as its answer) but cannot make the comparison pass
-without producing the right values, and cannot hide a missing answer, a crash or a timeout: those
-become fail/error rows. The result files the kernel writes are opened without following links, regular
+process, not by heartbeats. The kernel is told nothing secret (no point, seed or reference: only the names of
+the answers), and what it reports is only a claim of "this is my answer": a JSON tree read from a size-capped
+file by a whitelist parser with caps, never evaluated as code. A submission that replaces or patches the
+in-kernel export (it is reachable from ``sys.modules``) can claim any answer, which scores only if it *is*
+the answer; it cannot hide a missing answer, a crash or a timeout: those become fail/error rows. The result files the kernel writes are opened without following links, regular
 files only, and only known words from the advisory exact check reach the feedback. Redefining
 ``kinlib.course.workbook.selfcheck.check`` changes nothing (the checker does not
-use it); monkeypatching SymPy (``sympy.simplify = ...``, class attributes) or builtins is undone
-before the answers are read. The random points are known to the kernel when the values are asked
-for, but the reference is not (it is sent only afterwards, for the advisory exact check).
+use it); monkeypatching SymPy (``sympy.simplify = ...``, class attributes) or builtins in the kernel is
+undone before the answers are exported, and cannot reach the grader's SymPy, which does the evaluating.
 """
 
 from __future__ import annotations
@@ -91,14 +92,14 @@ import shutil
 import tempfile
 import time
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict
 from pathlib import Path
 
-from ..answers import compare
 from ..schema import cell_meta, cell_part, match_notebook, notebook_id, stash_points
 from . import credit
-from .isolation.kernel import KernelStartError, NotebookRun
+from .isolation.kernel import NotebookRun
 from .isolation.sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
+from .judge import N_POINTS
 from .refdata import (
     GRADE_VERSION,
     Reference,
@@ -106,10 +107,10 @@ from .refdata import (
     code_cells,
     default_notebooks,
     load_references,
-    reference_description,
 )
 from .report import summary_table, write_outputs
 from .secret import default_secret_path, evaluation_seed, load_secret
+from .steps import Grading, Row, run_steps
 
 __all__ = [
     "grade_batch",
@@ -129,30 +130,7 @@ __all__ = [
 NO_SANDBOX_NOTE = (
     "graded WITHOUT the sandbox (--no-sandbox): the submission's code ran with the grader's files and network"
 )
-N_POINTS = 5
-N_SET_POINTS = 2
 MAX_SUBMISSION_BYTES = 50 * 2**20
-PROBE_TIMEOUT = 20.0
-EXACT_TIMEOUT = 15.0
-
-
-@dataclass
-class Row:
-    """One line of grades.csv: a part of a submission and its result.
-
-    >>> from dataclasses import asdict
-    >>> asdict(Row("ann.ipynb", "02_planar", "2.1", "pass", 5.0, "", max_points=5.0))["status"]
-    'pass'
-    """
-
-    submission: str
-    notebook: str
-    part: str
-    status: str  # pass | fail | error
-    points: float  # points earned
-    message: str
-    max_points: float = 0.0
-    answers: list = field(default_factory=list)  # [{answer, status, message}]: credit.score_parts scores them
 
 
 # ----------------------------------------------------------------------------------------- one submission
@@ -329,103 +307,10 @@ def grade_submission(
 
 
 def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out):
-    """Execute the submission, read every answer's values, compare; then the advisory exact check."""
-    results: dict = {}
-    exact: dict = {}
-    fatal = ""
-    t0 = time.monotonic()
-    timing = out.setdefault("timing", {})
-    try:
-        run.execute()
-    except KernelStartError as exc:
-        fatal = out["infrastructure"] = f"infrastructure: {exc}"
-    except RuntimeError as exc:
-        fatal = str(exc)
-    if not fatal and run.kernel is None:
-        fatal = "the kernel died and could not be restarted"
-    timing["execute"] = round(time.monotonic() - t0, 3)
-    t1 = time.monotonic()
-    if not fatal:
-        got, e = run.call("restore_saved(PATH)", 30)
-        out["restored"] = (got or {}).get("restored", 0) if got else f"restore failed: {e}"
-        for p in parts:
-            for name in p["answers"]:
-                kind = ref.answers.get(name, {}).get("kind") or p["kinds"].get(name, "expr")
-                n = N_SET_POINTS if kind == "set" else (0 if kind == "choice" else N_POINTS)
-                got, e = run.call(
-                    f"probe_answer(globals(), {name!r}, {kind!r}, {points[:n]!r}, {seed}, PATH)", PROBE_TIMEOUT
-                )
-                if got is None:
-                    got = {"tag": "probe-error", "error": e, "kernel": run.kernel is None or not run.kernel.alive()}
-                results[name] = got
-    timing["probe"] = round(time.monotonic() - t1, 3)
-    t2 = time.monotonic()
-    rows = []
-    pending_exact = []
-    for p in parts:
-        if fatal:
-            rows.append(Row(sub, nid, p["part"], "error", 0, f"not graded: {fatal}", p["points"]))
-            continue
-        msgs, ok_all, err, verdicts = [], True, False, []
-        for name in p["answers"]:
-            kind = ref.answers.get(name, {}).get("kind") or p["kinds"].get(name, "expr")
-            ra = ref.answers.get(name, {})
-            stu = results.get(name) or {"tag": "probe-error", "error": "no result"}
-            if not isinstance(stu, dict):
-                stu = {"tag": "probe-error", "error": "malformed result"}
-            if stu.get("tag") == "probe-error" and stu.get("kernel"):
-                err, ok_all = True, False
-                msgs.append(f"{name} could not be read: {stu.get('error')}")
-                verdicts.append({"answer": name, "status": "error", "message": msgs[-1]})
-                continue
-            n = N_SET_POINTS if kind == "set" else (0 if kind == "choice" else N_POINTS)
-            try:
-                rd = reference_description(ref, name, kind, points[:n], seed)
-            except Exception as exc:  # noqa: BLE001
-                err, ok_all = True, False
-                msgs.append(f"{name}: the reference could not be evaluated ({exc})")
-                verdicts.append({"answer": name, "status": "error", "message": msgs[-1]})
-                continue
-            ok, msg = compare.compare(kind, stu, rd, name)
-            verdicts.append({"answer": name, "status": "pass" if ok else "fail", "message": "" if ok else msg})
-            if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "srepr" in ra:
-                pending_exact.append((p["part"], name, ra["srepr"]))
-            if not ok:
-                ok_all = False
-                msgs.append(msg + _cell_hint(p, run.results, part_of_cell))
-            elif msg:
-                msgs.append(f"{name}: {msg}")
-        status = "pass" if ok_all else ("error" if err else "fail")
-        rows.append(
-            Row(sub, nid, p["part"], status, p["points"] if ok_all else 0, "; ".join(msgs), p["points"], verdicts)
-        )
-    timing["compare"] = round(time.monotonic() - t2, 3)
-    t3 = time.monotonic()
-    # the advisory exact check, only now that every value is in
-    if not fatal and run.kernel is not None and run.kernel.alive():
-        for part, name, text in pending_exact:
-            got, e = run.call(f"probe_exact(globals(), {name!r}, {text!r}, PATH)", EXACT_TIMEOUT)
-            exact[name] = (got or {}).get("exact", "not checked") if isinstance(got, dict) else "not checked"
-            if exact[name] not in ("equal", "not proved", "not sympy", "missing", "error"):
-                exact[name] = "not checked"  # the kernel wrote the file: only known words reach the feedback
-            if exact[name] != "equal":
-                for r in rows:
-                    if r.part == part and r.status == "pass":
-                        note = (
-                            f"{name}: equal at {N_POINTS} random points, but SymPy did not prove it exactly "
-                            f"({'timed out' if got is None else exact[name]})"
-                        )
-                        r.message = "; ".join(x for x in (r.message, note) if x)
-    timing["exact"] = round(time.monotonic() - t3, 3)
-    return rows, exact
-
-
-def _cell_hint(part, results, part_of_cell) -> str:
-    bad = [(i, r) for i, r in sorted(results.items()) if part_of_cell.get(i) == part["part"] and r.status != "ok"]
-    if not bad:
-        return ""
-    i, r = bad[0]
-    return f" (your code cell {i + 1} for this part {r.summary()})"
+    """The grading steps (:data:`kinlib.course.grader.steps.STEPS`: execute, restore, export, stop, judge, rows)
+    on the submission's run; returns (rows, {answer: exact-check word})."""
+    g = run_steps(Grading(run, sub, nid, ref, parts, points, seed, part_of_cell, out))
+    return g.rows, out.get("exact", {})
 
 
 def _done(out, t0):

@@ -23,11 +23,11 @@ import time
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ..answers import describe, wire
 from ..answers import normalise as answers
+from ..answers.srepr import parse_srepr
 from ..schema import notebook_id, notebook_title, parse_parts, stash_points
-from .in_kernel import probe
-from .in_kernel.srepr import parse_srepr
-from .isolation.kernel import ANSWERS_SOURCE, GUARD_SOURCE, PROBE_SOURCE, SREPR_SOURCE, NotebookRun
+from .isolation.kernel import SHIPPED, NotebookRun
 from .secret import sign, verify
 
 __all__ = [
@@ -39,9 +39,10 @@ __all__ = [
     "code_cells",
     "reference_description",
     "read_cache",
+    "reference_answers",
 ]
 
-GRADE_VERSION = "2"
+GRADE_VERSION = "3"  # 3: answers exported as data (in_kernel.export), described in the grader
 _CACHE_PURPOSE = "kinlib-reference-cache"
 
 
@@ -89,7 +90,8 @@ def code_cells(nb: dict) -> list:
 
 def _hash(data: bytes) -> str:
     h = hashlib.sha256(data)
-    for s in (PROBE_SOURCE, ANSWERS_SOURCE, GUARD_SOURCE, SREPR_SOURCE, GRADE_VERSION):
+    host = [Path(m.__file__).read_text() for m in (describe, wire, answers)]
+    for s in (*SHIPPED.values(), *host, GRADE_VERSION):
         h.update(s.encode())
     return h.hexdigest()
 
@@ -124,6 +126,29 @@ def _write_cache(cfile: Path, secret: bytes, ref: Reference) -> None:
     tmp = cfile.with_name(cfile.name + f".{time.monotonic_ns()}.tmp")
     tmp.write_text(json.dumps({"reference": d, "mac": sign(secret, _CACHE_PURPOSE, _canonical(d))}))
     tmp.replace(cfile)
+
+
+def reference_answers(exported: dict, kinds: dict) -> dict:
+    """{name: {"kind", "srepr", "symbols"} | {"kind", "choice"} | {"error"}} for the reference answers ``kinds`` =
+    {name: kind}, from what the reference kernel exported (``{"tree": ...}`` per name, as
+    :func:`kinlib.course.grader.in_kernel.export.export_answer` writes it): each read by the same parser as a
+    student's (:func:`kinlib.course.answers.wire.load`) and normalised here (:func:`~kinlib.course.answers.describe.dump_reference`).
+
+    >>> reference_answers({"n": {"tree": ["int", "2"]}, "J": {"missing": True}}, {"n": "choice", "J": "expr"})
+    {'n': {'choice': {'tag': 'choice', 'type': 'int', 'value': 2}, 'kind': 'choice'}, 'J': {'error': 'J is not defined after the solution notebook ran'}}
+    """
+    values, errors = {}, {}
+    for name in kinds:
+        got = exported.get(name)
+        if isinstance(got, dict) and "tree" in got:
+            try:
+                values[name] = wire.load(got["tree"], max_nodes=10 * wire.MAX_NODES)
+            except (wire.WireError, RecursionError) as exc:
+                errors[name] = {"error": f"{name}: {exc}"[:500]}
+        elif isinstance(got, dict) and not got.get("missing"):
+            errors[name] = {"error": f"{name}: {got.get('error') or got.get('too_large') or 'not exported'}"[:500]}
+    dumped = describe.dump_reference(values, {n: k for n, k in kinds.items() if n not in errors})
+    return {n: errors.get(n) or dumped[n] for n in kinds}
 
 
 def build_reference(
@@ -171,11 +196,11 @@ def build_reference(
         bad = [r for r in run.results.values() if r.status != "ok"]
         if bad:
             err = f"code cell {bad[0].index + 1} of the solution notebook: {bad[0].summary()}"
-        got, e = run.call(f"probe_reference(globals(), {kinds!r}, PATH)", timeout=120)
-        if got is None:
-            err = err or f"could not read the reference answers: {e}"
-        else:
-            ans = got
+        exported = {}
+        for name in kinds:  # each answer as data, as a student's is exported; read and described here
+            got, e = run.call(f"export_answer(globals(), {name!r}, PATH)", timeout=120)
+            exported[name] = got if got is not None else {"error": f"could not read the reference answer: {e}"}
+        ans = reference_answers(exported, kinds)
     except RuntimeError as exc:
         err = str(exc)
     finally:
@@ -246,7 +271,7 @@ def _fast_expr(obj):
     import numpy as np
     import sympy as sp
 
-    tmpl = probe.describe_expr(obj, [], 0)
+    tmpl = describe.describe_expr(obj, [], 0)
     syms = sorted((s for s in obj.free_symbols if isinstance(s, sp.Symbol)), key=lambda s: s.name)
     entries = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
     try:
@@ -266,8 +291,8 @@ def _fast_expr(obj):
 
 
 def reference_description(ref: Reference, name: str, kind: str, points: list, seed: int) -> dict:
-    """The reference answer ``name`` described like a student's, at ``points`` (same code path as the
-    kernel's probe; the parsed tree and its lambdified form are cached per process).
+    """The reference answer ``name`` described like a student's, at ``points`` (the same code path as a
+    student's, :func:`kinlib.course.answers.describe.describe`; the parsed tree and its lambdified form are cached per process).
 
     >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
     ...                                                      "symbols": {"x": {}}}})
@@ -299,4 +324,4 @@ def reference_description(ref: Reference, name: str, kind: str, points: list, se
             return out
         except Exception:  # noqa: BLE001  fall back to SymPy's evaluation
             pass
-    return probe.describe(kind, obj, points, seed)
+    return describe.describe(kind, obj, points, seed)

@@ -1,8 +1,8 @@
-"""The code the grader sends as source text into the untrusted student kernel (see
-:mod:`kinlib.course.grader.isolation.kernel`): :mod:`.probe` (answers to JSON), :mod:`.guard` (namespaces saved
-and put back) and :mod:`.srepr` (the strict ``srepr`` parser, also used on the host for reference data).
-The answer normaliser :mod:`kinlib.course.answers.normalise` is sent with them. These modules import only the
-standard library, SymPy and NumPy; this package's ``__init__`` is never sent.
+"""The only code the grader ships into a kernel, as source text (see
+:data:`kinlib.course.grader.isolation.kernel.SHIPPED`): :mod:`.export` (each answer written out as data, never
+judged in the kernel) and :mod:`.guard` (namespaces saved and put back). They import only the standard library,
+SymPy, NumPy and mpmath; this package's ``__init__`` is never sent. No evaluation point, seed or reference
+answer is ever sent to a kernel: all of that stays in the grader (:mod:`kinlib.course.grader.judge`).
 
 Importing this package imports nothing (import the modules you need).
 """

@@ -3,9 +3,9 @@
 :func:`snapshot` runs in each student kernel before the first student cell; :func:`restore` runs after the
 last one, before the answers are read, and undoes replaced or added functions and classes in SymPy's,
 NumPy's, mpmath's and the builtins' namespaces (and SymPy's class attributes), so
-``sympy.simplify = lambda e: 0`` and the like do not change what the checker measures. Like
-:mod:`kinlib.course.grader.in_kernel.probe` it is sent to the kernel as source text and imports only the standard library
-(and SymPy and NumPy, to snapshot them).
+``sympy.simplify = lambda e: 0`` and the like do not change the answer the kernel exports (the grader
+evaluates it in its own process anyway). Like :mod:`.export` it is sent to the kernel as source text and imports
+only the standard library (and SymPy and NumPy, to snapshot them).
 """
 
 import sys

@@ -14,8 +14,8 @@ submission printing megabytes costs nothing but the time it spends printing), an
 (ename, evalue, cell index), truncated.
 
 :class:`NotebookRun` runs a whole notebook's code cells in such kernels (restarting past a cell that
-kills one), with the checker's probe (:mod:`kinlib.course.grader.in_kernel.probe` and :mod:`kinlib.course.answers.normalise`, sent
-as source text) loaded in a private module first.
+kills one), with the only code the grader ships into a kernel (:data:`SHIPPED`: the modules of
+:mod:`kinlib.course.grader.in_kernel`, sent as source text) loaded in a private module first.
 """
 
 from __future__ import annotations
@@ -40,22 +40,20 @@ __all__ = [
     "CellResult",
     "Kernel",
     "NotebookRun",
-    "PROBE_SOURCE",
-    "ANSWERS_SOURCE",
-    "GUARD_SOURCE",
-    "SREPR_SOURCE",
+    "IN_KERNEL_MODULES",
+    "SHIPPED",
+    "setup_code",
     "MAX_RESTARTS",
     "MAX_RESULT_BYTES",
     "START_ATTEMPTS",
     "KernelStartError",
 ]
 
-# the checker's code for the kernel, sent as text (see kinlib.course.grader.in_kernel.probe)
-_IN_KERNEL = Path(__file__).parents[1] / "in_kernel"  # kinlib/course/grader/in_kernel
-PROBE_SOURCE = (_IN_KERNEL / "probe.py").read_text()
-ANSWERS_SOURCE = (Path(__file__).parents[2] / "answers" / "normalise.py").read_text()
-GUARD_SOURCE = (_IN_KERNEL / "guard.py").read_text()
-SREPR_SOURCE = (_IN_KERNEL / "srepr.py").read_text()
+# The only code the grader ships into a kernel (student's or reference's), as source text: see
+# kinlib.course.grader.in_kernel. No evaluation point, seed or reference is ever sent after it.
+IN_KERNEL_DIR = Path(__file__).parents[1] / "in_kernel"
+IN_KERNEL_MODULES = ("guard", "export")
+SHIPPED = {name: (IN_KERNEL_DIR / f"{name}.py").read_text() for name in IN_KERNEL_MODULES}
 MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
 MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
 START_ATTEMPTS = 3  # tries to start a kernel before it is an infrastructure failure
@@ -383,6 +381,29 @@ class Kernel:
         return res
 
 
+def setup_code(nonce: str, snapshot: bool) -> str:
+    """The code run in a fresh kernel before any cell: :data:`SHIPPED` (``guard``, then ``export`` with ``guard``
+    bound) as private modules, ``export`` registered as ``sys.modules[nonce]``; with ``snapshot``, SymPy's, NumPy's,
+    mpmath's and the builtins' namespaces saved (``guard.snapshot``) for ``restore_saved``.
+
+    >>> code = setup_code("_kinlib_grade_0", snapshot=False)
+    >>> all(repr(src) in code for src in SHIPPED.values())
+    True
+    """
+    return (
+        "def __kg_setup():\n"
+        "    import sys, types\n"
+        f"    g = types.ModuleType({nonce + '_guard'!r})\n"
+        f"    exec(compile({SHIPPED['guard']!r}, '<kinlib-grade-guard>', 'exec'), g.__dict__)\n"
+        f"    m = types.ModuleType({nonce!r})\n"
+        "    m.guard = g\n"
+        f"    exec(compile({SHIPPED['export']!r}, '<kinlib-grade-export>', 'exec'), m.__dict__)\n"
+        f"    sys.modules[{nonce!r}] = m\n"
+        f"    m.SNAP = g.snapshot() if {bool(snapshot)!r} else None\n"
+        "__kg_setup(); del __kg_setup\n"
+    )
+
+
 class NotebookRun:
     """A submission (or reference) notebook executed cell by cell in a fresh kernel, with restarts.
 
@@ -399,8 +420,8 @@ class NotebookRun:
     >>> run = NotebookRun(cells, cwd=".", tmp="/tmp", cell_timeout=10, total_timeout=60).execute()  # doctest: +SKIP
     >>> [run.results[i].status for i in range(2)], run.restarts  # doctest: +SKIP
     (['ok', 'died'], 1)
-    >>> run.call("probe_answer(globals(), 'J', 'choice', [], 0, PATH)", 10)  # doctest: +SKIP
-    ({'tag': 'choice', 'type': 'int', 'value': 6}, '')
+    >>> run.call("export_answer(globals(), 'J', PATH)", 10)  # doctest: +SKIP
+    ({'tree': ['int', '6']}, '')
     >>> run.close()  # doctest: +SKIP
     """
 
@@ -438,22 +459,7 @@ class NotebookRun:
             self.start_failures += self.kernel.start_failures
             if self.kernel.record is not None:
                 self.namespaces.append(self.kernel.record)
-        code = (
-            f"def __kg_setup():\n"
-            f"    import sys, types\n"
-            f"    a = types.ModuleType({self.nonce + '_answers'!r})\n"
-            f"    exec(compile({ANSWERS_SOURCE!r}, '<kinlib-grade-answers>', 'exec'), a.__dict__)\n"
-            f"    m = types.ModuleType({self.nonce!r})\n"
-            f"    g = types.ModuleType({self.nonce + '_guard'!r})\n"
-            f"    exec(compile({GUARD_SOURCE!r}, '<kinlib-grade-guard>', 'exec'), g.__dict__)\n"
-            f"    r = types.ModuleType({self.nonce + '_srepr'!r})\n"
-            f"    exec(compile({SREPR_SOURCE!r}, '<kinlib-grade-srepr>', 'exec'), r.__dict__)\n"
-            f"    m.answers, m.guard, m.srepr = a, g, r\n"
-            f"    exec(compile({PROBE_SOURCE!r}, '<kinlib-grade-probe>', 'exec'), m.__dict__)\n"
-            f"    sys.modules[{self.nonce!r}] = m\n"
-            f"    m.SNAP = g.snapshot() if {self.snapshot!r} else None\n"
-            f"__kg_setup(); del __kg_setup\n"
-        )
+        code = setup_code(self.nonce, self.snapshot)
         r = self.kernel.run(code, timeout=180, silent=True)
         if r.status != "ok":
             raise KernelStartError(f"could not start the checker's probe in the kernel: {r.summary()}")
@@ -504,7 +510,8 @@ class NotebookRun:
                     del self.results[j]
 
     def call(self, expr: str, timeout: float) -> tuple[dict | None, str]:
-        """Run ``probe.<expr with PATH>`` in the kernel; return (JSON result, error text)."""
+        """Run ``export.<expr with PATH>`` in the kernel (:mod:`kinlib.course.grader.in_kernel.export`); return
+        (JSON result, error text). ``expr`` names only answers: never a point, seed or reference."""
         if self.kernel is None or not self.kernel.alive():
             return None, "the kernel was not running"
         path = os.path.join(self.tmp, "r-" + os.urandom(8).hex() + ".json")

@@ -1,12 +1,12 @@
 """Reference answers as data: SymPy objects read back from their ``srepr`` text by a strict parser, never ``eval``.
 
-The grader keeps each reference answer as the ``srepr`` text the reference kernel produced
+The grader keeps each reference answer (in its signed cache) as ``srepr`` text
 (:mod:`kinlib.course.grader.refdata`); :func:`parse_srepr` rebuilds the object from Python's syntax tree of that
 text, accepting only calls of SymPy classes (subclasses of ``Basic`` or matrices), SymPy singletons
 (``pi``, ``oo``, ``Reals``, ``EmptySet``, ``true``...), numbers, lists, tuples and dicts, and strings
 only as dict keys, the name of a Symbol/Dummy/Function or the digits of a Float. Nothing else (names, attributes,
-lambdas, strings that SymPy would ``sympify``) is accepted, so a tampered text cannot run code. Like
-:mod:`kinlib.course.grader.in_kernel.probe` it is also sent to student kernels as source text (imports: ``ast``, SymPy).
+lambdas, strings that SymPy would ``sympify``) is accepted, so a tampered text cannot run code. It runs on the
+trusted side only; answers from a kernel are read by :mod:`kinlib.course.answers.wire`.
 """
 
 __all__ = ["parse_srepr"]

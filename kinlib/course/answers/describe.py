@@ -1,55 +1,41 @@
-"""Kernel side of the instructor checker: turn answer values into plain JSON numbers and strings.
+"""An answer described for the comparison, on the trusted side: its values at the grader's secret points.
 
-This module runs in two places with the same code:
+The grader rebuilds each answer from the data a kernel exported (:mod:`.wire`) and describes it here, in its
+own process, exactly as it describes the reference answer: shape, symbols and values at the points (``expr``,
+``subspace``, ``property``), members per point (``set``), the plain value (``choice``). The comparers
+(:mod:`.compare`) read these descriptions. The points, the seed and the reference never leave the grader.
 
-* inside each **student kernel**: :mod:`kinlib.course.grader.isolation.kernel` sends this file's *source text* (and
-  those of :mod:`kinlib.course.answers.normalise`, the answer normaliser it uses, and :mod:`kinlib.course.grader.in_kernel.guard`, bound
-  here as ``answers`` and ``guard``) and executes it in a private module (registered in ``sys.modules`` under
-  a random name), so nothing the student did to ``kinlib`` reaches it; ``guard.snapshot`` runs before the
-  first student cell and ``guard.restore`` puts SymPy's, NumPy's, mpmath's and the builtins' namespaces (and SymPy's class
-  attributes) back before the answers are read, so ``sympy.simplify = lambda e: 0`` and the like do
-  not change what the checker measures;
-* in the **instructor's worker process**, on the reference answers only (instructor data, parsed
-  from the ``srepr`` strings the reference kernel produced), so both sides are described by one
-  code path.
-
-It imports only the standard library, SymPy and NumPy (and, outside a kernel, its sibling
-:mod:`kinlib.course.answers.normalise`).
+Non-finite values (inf, nan) are described as ``None`` (cannot be evaluated) and are a wrong answer.
 """
 
-import json
 import math
 import random
 
-if "answers" not in globals():  # in a student kernel the checker binds private copies before running this
-    from ...answers import normalise as answers
-    from . import guard, srepr
-
-parse_srepr = srepr.parse_srepr  # reference data in, SymPy out (a strict parser, never eval)
+from . import normalise as answers
+from .srepr import parse_srepr
 
 __all__ = [
     "describe",
     "describe_expr",
     "describe_set",
     "describe_choice",
+    "describe_subspace",
     "describe_property",
     "normalize_reference",
     "dump_reference",
-    "parse_srepr",
     "exact_equal",
-    "stash",
-    "probe_answer",
-    "probe_exact",
-    "restore_saved",
-    "probe_reference",
     "DESCRIBE",
+    "MAX_SET_MEMBERS",
 ]
+
+MAX_SET_MEMBERS = 5000  # members of one set listed per point (more: the answer is too large to grade)
+
 
 _DEGREE_CONSTANTS = {15, 30, 45, 60, 75, 90, 105, 120, 135, 150, 165, 180, 210, 225, 240, 270, 300, 315, 330, 360}
 _MISSING = object()
 
 
-# ----------------------------------------------------------------------------- coercion (kinlib.course.answers.normalise)
+# ----------------------------------------------------------------------------- coercion (kinlib.course.answers)
 
 
 def _shape(obj):
@@ -185,25 +171,16 @@ def _real(e, subs):
 
 
 def _enum1d(S, subs, window):
-    """Members of the 1-D set ``S`` in [-window, window]: (points, intervals); raises ValueError if unknown."""
+    """Members of the 1-D set ``S`` in [-window, window]: (points, intervals); raises ValueError if unknown or
+    if it lists more than :data:`MAX_SET_MEMBERS` members."""
     import sympy as sp
 
     if not isinstance(S, sp.Set):
         S = answers.to_set(S)
     if S is sp.S.EmptySet:
         return [], []
-    if S in (sp.S.Reals, sp.S.UniversalSet) or isinstance(S, sp.sets.sets.UniversalSet):
+    if S in (sp.S.Reals, sp.S.UniversalSet, sp.S.Complexes) or isinstance(S, sp.sets.sets.UniversalSet):
         return [], [[-math.inf, math.inf]]
-    if S is sp.S.Complexes:
-        return [], [[-math.inf, math.inf]]
-    if isinstance(S, sp.FiniteSet):
-        pts = []
-        for e in S.args:
-            x = _real(sp.sympify(e), subs)
-            if x is None:
-                raise ValueError(f"member {e} is not a real number")
-            pts.append(x)
-        return pts, []
     if isinstance(S, sp.Interval):
         return [], [[_real(S.start, subs), _real(S.end, subs)]]
     if isinstance(S, sp.Union):
@@ -212,57 +189,101 @@ def _enum1d(S, subs, window):
             p, i = _enum1d(a, subs, window)
             pts += p
             ivs += i
+            _cap(pts)
         return pts, ivs
-    if isinstance(S, sp.ImageSet):
-        lam = S.lamda
-        base = S.base_sets[0] if hasattr(S, "base_sets") else S.base_set
-        if len(lam.variables) != 1 or base not in (sp.S.Integers, sp.S.Naturals, sp.S.Naturals0):
-            raise ValueError("only image sets over the integers can be compared")
-        v = lam.variables[0]
-        f = lam.expr.xreplace(subs) if subs else lam.expr
-        f0, f1 = _real(f.xreplace({v: 0}), {}), _real(f.xreplace({v: 1}), {})
-        step = abs(f1 - f0) if f0 is not None and f1 is not None else 0.0
-        K = min(2000, int(2 * window / step) + 3) if step > 1e-9 else 50
-        # centred on the member nearest 0 (a family 2πn + 1000π, or one in degrees, has members in the window)
-        c = 0 if step <= 1e-9 or base is not sp.S.Integers else int(max(-1e6, min(1e6, round(-f0 / (f1 - f0)))))
-        lo = 0 if base is sp.S.Naturals0 else (1 if base is sp.S.Naturals else c - K)
-        pts, near = [], []
-        for n in range(lo, c + K + 1):
-            x = _real(f.xreplace({v: n}), {})
-            if x is not None and abs(x) <= window:
-                pts.append(x)
-            elif x is not None and abs(n - c) <= 3:
-                near.append(x)
-        return (pts or near), []
-    if isinstance(S, sp.Intersection):
-        enumerable = []
-        filters = []
-        for a in S.args:
-            if isinstance(a, sp.Interval) or a in (sp.S.Reals,):
-                filters.append(a)
-            else:
-                enumerable.append(a)
-        if not enumerable:
-            raise ValueError("an intersection of intervals cannot be compared")
-        pts, ivs = _enum1d(enumerable[0], subs, window)
-        if ivs:
-            raise ValueError("cannot compare an intersection with a continuous set")
-        for other in enumerable[1:]:
-            p2, i2 = _enum1d(other, subs, window)
-            pts = [x for x in pts if any(abs(x - y) < 1e-7 for y in p2) or any(a <= x <= b for a, b in i2)]
-        for fset in filters:
-            if fset is sp.S.Reals:
-                continue
-            a, b = _real(fset.start, subs), _real(fset.end, subs)
-            pts = [
-                x
-                for x in pts
-                if (a < x < b)
-                or (not fset.left_open and abs(x - a) < 1e-12)
-                or (not fset.right_open and abs(x - b) < 1e-12)
-            ]
-        return pts, []
+    for kind, enum in _ENUMERATE:
+        if isinstance(S, kind()):
+            return _cap(enum(S, subs, window)), []
     raise ValueError(f"a {type(S).__name__} cannot be enumerated (use FiniteSet, ImageSet or Union)")
+
+
+def _cap(pts):
+    if len(pts) > MAX_SET_MEMBERS:
+        raise ValueError(f"more than {MAX_SET_MEMBERS} members: too large to grade")
+    return pts
+
+
+def _finite(S, subs, window):
+    import sympy as sp
+
+    _cap(S.args)
+    pts = []
+    for e in S.args:
+        x = _real(sp.sympify(e), subs)
+        if x is None:
+            raise ValueError(f"member {e} is not a real number")
+        pts.append(x)
+    return pts
+
+
+def _image(S, subs, window):
+    """The members of an image set over the integers {f(n)} in the window (those nearest 0 if none is)."""
+    import sympy as sp
+
+    lam = S.lamda
+    base = S.base_sets[0] if hasattr(S, "base_sets") else S.base_set
+    if len(lam.variables) != 1 or base not in (sp.S.Integers, sp.S.Naturals, sp.S.Naturals0):
+        raise ValueError("only image sets over the integers can be compared")
+    v = lam.variables[0]
+    f = lam.expr.xreplace(subs) if subs else lam.expr
+    f0, f1 = _real(f.xreplace({v: 0}), {}), _real(f.xreplace({v: 1}), {})
+    step = abs(f1 - f0) if f0 is not None and f1 is not None else 0.0
+    K = min(2000, int(2 * window / step) + 3) if step > 1e-9 else 50
+    # centred on the member nearest 0 (a family 2πn + 1000π, or one in degrees, has members in the window)
+    c = 0 if step <= 1e-9 or base is not sp.S.Integers else int(max(-1e6, min(1e6, round(-f0 / (f1 - f0)))))
+    lo = 0 if base is sp.S.Naturals0 else (1 if base is sp.S.Naturals else c - K)
+    pts, near = [], []
+    for n in range(lo, c + K + 1):
+        x = _real(f.xreplace({v: n}), {})
+        if x is not None and abs(x) <= window:
+            pts.append(x)
+        elif x is not None and abs(n - c) <= 3:
+            near.append(x)
+    return pts or near
+
+
+def _intersection(S, subs, window):
+    """The members of an intersection of enumerable sets, filtered by the intervals in it."""
+    import sympy as sp
+
+    filters = [a for a in S.args if isinstance(a, sp.Interval) or a is sp.S.Reals]
+    enumerable = [a for a in S.args if not (isinstance(a, sp.Interval) or a is sp.S.Reals)]
+    if not enumerable:
+        raise ValueError("an intersection of intervals cannot be compared")
+    pts, ivs = _enum1d(enumerable[0], subs, window)
+    if ivs:
+        raise ValueError("cannot compare an intersection with a continuous set")
+    for other in enumerable[1:]:
+        p2, i2 = _enum1d(other, subs, window)
+        pts = [x for x in pts if any(abs(x - y) < 1e-7 for y in p2) or any(a <= x <= b for a, b in i2)]
+    for fset in filters:
+        if fset is sp.S.Reals:
+            continue
+        a, b = _real(fset.start, subs), _real(fset.end, subs)
+        pts = [
+            x
+            for x in pts
+            if (a < x < b)
+            or (not fset.left_open and abs(x - a) < 1e-12)
+            or (not fset.right_open and abs(x - b) < 1e-12)
+        ]
+    return pts
+
+
+def _set_class(name):
+    def get():
+        import sympy as sp
+
+        return getattr(sp, name)
+
+    return get
+
+
+_ENUMERATE = (  # (the SymPy class, lazily, its members' enumeration)
+    (_set_class("FiniteSet"), _finite),
+    (_set_class("ImageSet"), _image),
+    (_set_class("Intersection"), _intersection),
+)
 
 
 def _component(key, S, p, seed, window):
@@ -280,6 +301,8 @@ def _component(key, S, p, seed, window):
             and all(isinstance(a, (tuple, list, sp.Tuple)) for a in S)
         ):
             tuples = []
+            if len(S.args if isinstance(S, sp.FiniteSet) else S) > MAX_SET_MEMBERS:
+                raise ValueError(f"more than {MAX_SET_MEMBERS} members: too large to grade")
             for a in S.args if isinstance(S, sp.FiniteSet) else S:
                 t = []
                 for e in a:
@@ -339,7 +362,12 @@ def describe_choice(value, points=(), seed=0):
 
 def describe_subspace(value, points, seed=0):
     """Subspace answer: a matrix whose columns span it (a list of lists: the spanning vectors); a constant
-    exact matrix also as its ``answers.expr_tree`` (``tree``), so the grader can compare spans exactly."""
+    exact matrix also as its ``answers.expr_tree`` (``tree``), so the grader can compare spans exactly.
+
+    >>> d = describe_subspace([[1, 0], [0, 1]], [{}])
+    >>> d["shape"], d["tree"][:3]
+    ([2, 2], ['matrix', 2, 2])
+    """
     out = describe_expr(value, points, seed, vectors=True)
     if out.get("tag") == "matrix" and not out.get("symbols") and not out.get("has_float"):
         try:
@@ -471,7 +499,7 @@ def dump_reference(ns, kinds):
 # ----------------------------------------------------------------------------- exact equivalence (student kernel)
 
 
-def exact_equal(value, ref_text, budget=5.0):
+def exact_equal(value, ref, budget=5.0):
     """'equal' when value - reference simplifies to exactly zero, else 'not proved' (advisory only).
 
     >>> import sympy as sp
@@ -487,7 +515,7 @@ def exact_equal(value, ref_text, budget=5.0):
     tag, obj = answers.to_sympy(value)
     if obj is None:
         return "not sympy"
-    ref = parse_srepr(ref_text)
+    ref = parse_srepr(ref) if isinstance(ref, str) else ref
     ref_syms = {s.name: s for s in ref.free_symbols if isinstance(s, sp.Symbol)}
     obj = obj.xreplace(
         {s: ref_syms[s.name] for s in obj.free_symbols if isinstance(s, sp.Symbol) and s.name in ref_syms}
@@ -507,124 +535,3 @@ def exact_equal(value, ref_text, budget=5.0):
             continue
         return "not proved"
     return "equal"
-
-
-# ----------------------------------------------------------------------------- entry points used in a kernel
-
-STASH = {}
-
-
-def stash(ns, names):
-    """Keep the values of ``names`` as they are when their part ends (read by ``probe_answer``).
-
-    A shallow copy, so later cells that change or rebind the name do not change the answer:
-
-    >>> ns = {"J": [1, 2]}
-    >>> stash(ns, ["J", "K"])
-    >>> ns["J"].append(3); ns["J"] = 0
-    >>> STASH.pop("J")
-    [1, 2]
-    """
-    import copy
-
-    for n in names:
-        if n in ns:
-            try:
-                STASH[n] = copy.copy(ns[n])
-            except Exception:  # noqa: BLE001
-                STASH[n] = ns[n]
-
-
-def _value(ns, name):
-    """The answer as it was when its part ended; the final value if it was not there yet (or ``...``)."""
-    v = STASH.get(name, _MISSING)
-    if v is _MISSING or v is Ellipsis:
-        final = ns.get(name, _MISSING)
-        if final is not _MISSING and final is not Ellipsis:
-            return final
-    return v if v is not _MISSING else ns.get(name, _MISSING)
-
-
-def probe_answer(ns, name, kind, points, seed, path):
-    """Describe the answer ``name`` and write the JSON to ``path`` (once per answer, in the kernel).
-
-    >>> import pathlib, tempfile
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     path = pathlib.Path(d, "r.json")
-    ...     probe_answer({"n": 2}, "n", "choice", [], 0, path)
-    ...     print(path.read_text())
-    ...     probe_answer({}, "J", "expr", [{}], 0, path)
-    ...     print(path.read_text())
-    {"tag": "choice", "type": "int", "value": 2}
-    {"tag": "missing"}
-    """
-    value = _value(ns, name)
-    if value is _MISSING:
-        res = {"tag": "missing"}
-    else:
-        try:
-            res = describe(kind, value, points, seed)
-        except Exception as exc:  # noqa: BLE001
-            res = {"tag": "probe-error", "error": f"{type(exc).__name__}: {exc}"[:500]}
-    with open(path, "w") as f:
-        json.dump(res, f)
-
-
-def probe_exact(ns, name, ref_text, path):
-    """The advisory exact check of answer ``name`` against the reference's srepr, as JSON to ``path``.
-
-    >>> import pathlib, tempfile, sympy as sp
-    >>> x = sp.Symbol("x")
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     path = pathlib.Path(d, "r.json")
-    ...     probe_exact({"c": sp.sin(x)**2 + sp.cos(x)**2}, "c", "Integer(1)", path)
-    ...     print(path.read_text())
-    {"exact": "equal"}
-    """
-    value = _value(ns, name)
-    try:
-        res = {"exact": exact_equal(value, ref_text)} if value is not _MISSING else {"exact": "missing"}
-    except Exception as exc:  # noqa: BLE001
-        res = {"exact": "error", "error": f"{type(exc).__name__}: {exc}"[:300]}
-    with open(path, "w") as f:
-        json.dump(res, f)
-
-
-SNAP = None
-
-
-def restore_saved(path):
-    """Restore the snapshot taken before the first student cell; write how many attributes changed.
-
-    Without the ``SNAP`` the checker takes in a kernel (:func:`kinlib.course.grader.in_kernel.guard.snapshot`), nothing is
-    restored:
-
-    >>> import pathlib, tempfile
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     path = pathlib.Path(d, "r.json")
-    ...     restore_saved(path)
-    ...     print(path.read_text())
-    {"restored": []}
-    """
-    names = guard.restore(SNAP) if SNAP is not None else []
-    with open(path, "w") as f:
-        json.dump({"restored": names[:50]}, f)
-
-
-def probe_reference(ns, kinds, path):
-    """The reference answers ``kinds`` = {name: kind} (see ``dump_reference``), as JSON to ``path``.
-
-    >>> import pathlib, tempfile, sympy as sp
-    >>> with tempfile.TemporaryDirectory() as d:
-    ...     path = pathlib.Path(d, "r.json")
-    ...     probe_reference({"L": sp.Symbol("L", positive=True)}, {"L": "expr"}, path)
-    ...     json.loads(path.read_text())
-    {'L': {'kind': 'expr', 'srepr': "Symbol('L', positive=True)", 'symbols': {'L': {'positive': True}}}}
-    """
-    values = {}
-    for name in kinds:
-        v = _value(ns, name)
-        if v is not _MISSING:
-            values[name] = v
-    with open(path, "w") as f:
-        json.dump(dump_reference(values, kinds), f)

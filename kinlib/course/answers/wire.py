@@ -1,0 +1,346 @@
+"""The format in which an answer leaves a kernel, and its parser on the trusted side (never ``eval``).
+
+A kernel (:mod:`kinlib.course.grader.in_kernel.export`, the only grader code shipped into it) writes each
+answer as a JSON tree of plain lists; :func:`load` rebuilds the value in the grader from a whitelist, with
+caps on size, depth, digits and powers, so a hostile tree cannot run code, nor make the grader build an
+object that takes minutes or gigabytes. A tree over a cap raises :class:`WireError` (the answer is then
+wrong, with a message that says why).
+
+Nodes (``T`` a tree):
+
+====================================  =================================================================
+``["none"]``, ``["ellipsis"]``          None, ``...``
+``["bool", b]``                         a bool (also NumPy's)
+``["int", "digits"]``                   an int (also NumPy's); ``["float", repr]``, ``["complex", re, im]``
+``["str", s]``                          a string (at most :data:`MAX_STR` characters)
+``["list"|"tuple"|"set"|"frozenset",    Python containers; ``["dict", [T, T], ...]`` a dict
+T, ...]``
+``["ndarray", [shape], T, ...]``        a NumPy array (entries flattened, row-major)
+``["robot", T]``                        a robot (an object with ``screws``, e.g. a kinlib ``SerialChain``):
+                                        only its screw axes cross, as the 6×n matrix T (answers judged by a
+                                        property of the student's own design, problem 5.5)
+``["other", "module.Type"]``            an object of another type (only its type name crosses)
+``["Integer", "digits"]``,              SymPy numbers (a Float by its decimal digits and precision in bits)
+``["Rational", p, q]``,
+``["Float", "digits", prec]``
+``["Symbol", name, {a: b}]``            a symbol with its assumptions (known assumption names only)
+``["Dummy", name, {a: b}, index]``      a dummy symbol: one per (name, index) within the answer
+``["UndefinedFunction", name, T...]``   ``Function(name)(T, ...)``
+``["Matrix", rows, cols, T, ...]``      a SymPy matrix (entries row-major)
+``["<SymPy class>", T, ...]``           one of :data:`CLASSES` applied to its arguments, or one of
+                                        :data:`SINGLETONS` (``["Pi"]``, ``["Reals"]``, ``["BooleanTrue"]``)
+====================================  =================================================================
+
+>>> load(["Matrix", 1, 2, ["Symbol", "L", {"positive": True}], ["Rational", "1", "2"]])
+Matrix([[L, 1/2]])
+>>> load(["other", "os.system"])
+<other: os.system>
+>>> load(["Pow", ["Integer", "10"], ["Integer", "100000000"]])
+Traceback (most recent call last):
+...
+kinlib.course.answers.wire.WireError: a power too large to compute (exponent 100000000)
+"""
+
+from __future__ import annotations
+
+import json
+
+__all__ = ["load", "WireError", "Other", "Robot", "MAX_NODES", "MAX_DEPTH", "MAX_DIGITS", "CLASSES", "SINGLETONS"]
+
+MAX_NODES = 100_000  # nodes in one answer (a 250,000-point set is refused, not compared for minutes)
+MAX_DEPTH = 200  # nesting depth
+MAX_DIGITS = 20_000  # digits of all integers of one answer together (and of one number: 1000)
+MAX_NUMBER_DIGITS = 1000
+MAX_POWER = 1000  # |exponent| of a power of an exact number (of anything else: 100)
+MAX_STR = 10_000
+MAX_ENTRIES = 40_000  # entries of one matrix or array
+MAX_PREC = 4000  # bits of a Float
+
+CLASSES = (
+    # arithmetic and elementary functions
+    "Add Mul Pow sin cos tan cot sec csc asin acos atan acot atan2 sinh cosh tanh asinh acosh atanh "
+    "exp log Abs sign re im conjugate arg floor ceiling Min Max Piecewise ExprCondPair Mod "
+    # relations and logic (an equation given as an answer must be readable to be named)
+    "Equality Unequality StrictLessThan LessThan StrictGreaterThan GreaterThan And Or Not "
+    # sets of configurations and containers
+    "FiniteSet Interval Union Intersection Complement ImageSet Lambda ProductSet ConditionSet Range "
+    "Contains Tuple Dict"
+).split()
+SINGLETONS = (
+    "Pi Exp1 ImaginaryUnit Infinity NegativeInfinity ComplexInfinity NaN EulerGamma GoldenRatio Catalan "
+    "Reals Integers Naturals Naturals0 Complexes Rationals EmptySet UniversalSet BooleanTrue BooleanFalse "
+    "Zero One NegativeOne Half"
+).split()
+_SINGLETON_ATTR = {"BooleanTrue": "true", "BooleanFalse": "false"}
+
+
+class WireError(ValueError):
+    """The tree is not an answer in this format, or is over a cap (the message says which).
+
+    >>> str(WireError("nested more than 200 levels deep"))
+    'nested more than 200 levels deep'
+    """
+
+
+class Robot:
+    """A robot answer as it crossed the boundary: its screw axes (``screws``, what the property judges read).
+
+    >>> load(["robot", ["Matrix", 6, 1, *[["Integer", d] for d in "001000"]]]).screws.T
+    Matrix([[0, 0, 1, 0, 0, 0]])
+    """
+
+    __slots__ = ("screws",)
+
+    def __init__(self, screws):
+        self.screws = screws
+
+    def __repr__(self):
+        return f"<robot: {getattr(self.screws, 'shape', '?')} screws>"
+
+
+class Other:
+    """An answer object of a type the format does not carry: only its type name crossed the boundary.
+
+    >>> Other("pandas.DataFrame")
+    <other: pandas.DataFrame>
+    """
+
+    __slots__ = ("type_name",)
+
+    def __init__(self, type_name: str):
+        self.type_name = str(type_name)[:200]
+
+    def __repr__(self):
+        return f"<other: {self.type_name}>"
+
+
+def load(tree, max_nodes: int = MAX_NODES, max_depth: int = MAX_DEPTH):
+    """The answer value that ``tree`` describes (see the module's table), or :class:`WireError`.
+
+    >>> load(["list", ["Symbol", "theta1", {"real": True}], ["float", "0.5"], ["str", "joint 2"]])
+    [theta1, 0.5, 'joint 2']
+    >>> load(["Symbol", "x", {"__class__": True}])
+    Traceback (most recent call last):
+    ...
+    kinlib.course.answers.wire.WireError: unknown assumptions
+    """
+    import sympy as sp
+
+    left = {"nodes": max_nodes, "digits": MAX_DIGITS * max(1, max_nodes // MAX_NODES)}
+    classes = {name: getattr(sp, name, None) or _sympy_class(name) for name in CLASSES}
+    dummies: dict = {}  # (name, assumptions, index) -> the one Dummy of that answer
+
+    def bad(why):
+        return WireError(why)
+
+    def text(x, cap=MAX_STR):
+        if not isinstance(x, str) or len(x) > cap:
+            raise bad("malformed text")
+        return x
+
+    def integer(x):
+        s = text(x, MAX_NUMBER_DIGITS + 1)
+        if not s.lstrip("-").isdigit():
+            raise bad("malformed integer")
+        left["digits"] -= len(s)
+        if left["digits"] < 0:
+            raise bad(f"numbers with more than {MAX_DIGITS} digits in all")
+        return int(s)
+
+    def small(x, cap):
+        if not isinstance(x, int) or isinstance(x, bool) or not 0 <= x <= cap:
+            raise bad("malformed size")
+        return x
+
+    def build(t, depth):
+        left["nodes"] -= 1
+        if left["nodes"] < 0:
+            raise bad(f"more than {max_nodes} parts")
+        if depth > max_depth:
+            raise bad(f"nested more than {max_depth} levels deep")
+        if not isinstance(t, list) or not t or not isinstance(t[0], str):
+            raise bad("malformed answer data")
+        op, args = t[0], t[1:]
+        fn = _PLAIN.get(op)
+        if fn is not None:
+            return fn(args, lambda x: build(x, depth + 1), text, integer, small)
+        return _sympy(op, args, lambda x: build(x, depth + 1), text, integer, small, classes, dummies)
+
+    return build(tree, 0)
+
+
+def _sympy_class(name):
+    import sympy as sp
+
+    return {"Equality": sp.Eq, "Unequality": sp.Ne, "ExprCondPair": sp.functions.elementary.piecewise.ExprCondPair}.get(
+        name
+    ) or getattr(sp.sets.sets, name, None)
+
+
+# ----------------------------------------------------------------------------- plain Python and NumPy values
+
+
+def _container(kind):
+    def make(args, build, *_):
+        items = [build(a) for a in args]
+        if kind == "list":
+            return items
+        if kind == "tuple":
+            return tuple(items)
+        try:
+            return set(items) if kind == "set" else frozenset(items)
+        except TypeError:
+            raise WireError("a set of unhashable items") from None
+
+    return make
+
+
+def _dict(args, build, *_):
+    out = {}
+    for kv in args:
+        if not isinstance(kv, list) or len(kv) != 2:
+            raise WireError("malformed dict")
+        k = build(kv[0])
+        try:
+            out[k] = build(kv[1])
+        except TypeError:
+            raise WireError("a dict with an unhashable key") from None
+    return out
+
+
+def _number(kind):
+    def make(args, build, text, integer, small):
+        if kind == "int" and len(args) == 1:
+            return integer(args[0])
+        if kind == "float" and len(args) == 1:
+            return _float(text(args[0], 40))
+        if kind == "complex" and len(args) == 2:
+            return complex(_float(text(args[0], 40)), _float(text(args[1], 40)))
+        raise WireError("malformed number")
+
+    return make
+
+
+def _float(s):
+    try:
+        return float(s)
+    except ValueError:
+        raise WireError("malformed number") from None
+
+
+def _ndarray(args, build, text, integer, small):
+    import math
+
+    import numpy as np
+
+    if not args or not isinstance(args[0], list) or len(args[0]) > 8:
+        raise WireError("malformed array")
+    shape = [small(n, MAX_ENTRIES) for n in args[0]]
+    if math.prod(shape) != len(args) - 1 or len(args) - 1 > MAX_ENTRIES:
+        raise WireError("malformed array (shape and entries disagree, or too many entries)")
+    out = np.empty(len(args) - 1, dtype=object)
+    for i, a in enumerate(args[1:]):
+        out[i] = build(a)
+    try:  # numbers as NumPy numbers (as the student's array held them), anything else as objects
+        typed = np.array(out.tolist())
+        if typed.dtype.kind in "biufc":
+            out = typed
+    except (ValueError, TypeError):
+        pass
+    return out.reshape(shape)
+
+
+_PLAIN = {
+    "none": lambda args, *_: None if not args else _malformed(),
+    "ellipsis": lambda args, *_: ... if not args else _malformed(),
+    "bool": lambda args, *_: args[0] if len(args) == 1 and isinstance(args[0], bool) else _malformed(),
+    "str": lambda args, build, text, *_: text(args[0]) if len(args) == 1 else _malformed(),
+    "other": lambda args, build, text, *_: Other(text(args[0], 200)) if len(args) == 1 else _malformed(),
+    "robot": lambda args, build, *_: Robot(build(args[0])) if len(args) == 1 else _malformed(),
+    "int": _number("int"),
+    "float": _number("float"),
+    "complex": _number("complex"),
+    "list": _container("list"),
+    "tuple": _container("tuple"),
+    "set": _container("set"),
+    "frozenset": _container("frozenset"),
+    "dict": _dict,
+    "ndarray": _ndarray,
+}
+
+
+def _malformed():
+    raise WireError("malformed answer data")
+
+
+# ----------------------------------------------------------------------------- SymPy objects
+
+
+_ASSUMPTIONS: set = set()
+
+
+def _assumptions(d):
+    if not _ASSUMPTIONS:
+        from sympy.core.assumptions import _assume_defined
+
+        _ASSUMPTIONS.update(_assume_defined)
+    if not isinstance(d, dict) or len(d) > 40:
+        raise WireError("malformed assumptions")
+    if not all(k in _ASSUMPTIONS and isinstance(v, bool) for k, v in d.items()):
+        raise WireError("unknown assumptions")
+    return d
+
+
+def _sympy(op, args, build, text, integer, small, classes, dummies):
+    import sympy as sp
+
+    if op == "Integer" and len(args) == 1:
+        return sp.Integer(integer(args[0]))
+    if op == "Rational" and len(args) == 2:
+        p, q = integer(args[0]), integer(args[1])
+        if q == 0:
+            raise WireError("a fraction with denominator 0")
+        return sp.Rational(p, q)
+    if op == "Float" and len(args) == 2:
+        digits = text(args[0], 1300)
+        if not all(c in "0123456789.eE+-infa" for c in digits):
+            raise WireError("malformed Float")
+        return sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
+    if op == "Symbol" and len(args) == 2:
+        return sp.Symbol(text(args[0], 100), **_assumptions(args[1]))
+    if op == "Dummy" and len(args) == 3:
+        key = (text(args[0], 100), json.dumps(_assumptions(args[1]), sort_keys=True), small(args[2], 2**31))
+        if key not in dummies:
+            dummies[key] = sp.Dummy(key[0], **args[1])
+        return dummies[key]
+    if op == "UndefinedFunction" and args:
+        return sp.Function(text(args[0], 100))(*[build(a) for a in args[1:]])
+    if op == "Matrix" and len(args) >= 2:
+        r, c = small(args[0], MAX_ENTRIES), small(args[1], MAX_ENTRIES)
+        if r * c != len(args) - 2 or r * c > MAX_ENTRIES:
+            raise WireError("malformed matrix (shape and entries disagree, or too many entries)")
+        return sp.Matrix(r, c, [build(a) for a in args[2:]])
+    if op in SINGLETONS and not args:
+        return getattr(sp.S, _SINGLETON_ATTR.get(op, op))
+    cls = classes.get(op)
+    if cls is None:
+        raise WireError(f"{op[:40]} is not an answer the grader reads")
+    items = [build(a) for a in args]
+    if op == "Pow" and len(items) == 2:
+        _check_power(*items)
+    if op == "Dict":
+        return sp.Dict(*items)
+    try:
+        return cls(*items)
+    except (TypeError, ValueError, AttributeError, NotImplementedError) as exc:
+        raise WireError(f"{op} could not be rebuilt ({type(exc).__name__})") from None
+
+
+def _check_power(base, exp):
+    """Refuse a power of exact numbers SymPy would compute into a huge number (10**(10**8))."""
+    import sympy as sp
+
+    if isinstance(exp, sp.Rational) and isinstance(base, sp.Number) and abs(exp.p) > MAX_POWER:
+        raise WireError(f"a power too large to compute (exponent {exp.p})")
+    if isinstance(exp, sp.Rational) and abs(exp.p) > MAX_POWER // 10:
+        raise WireError(f"a power too large to compute (exponent {exp.p})")

@@ -1,0 +1,189 @@
+"""Judging one answer on the trusted side: the data a kernel exported, read, evaluated at the secret points,
+compared with the reference, and checked exactly — all in the grader's process, within caps and a time limit.
+
+The kernel only *claims* an answer (:mod:`kinlib.course.grader.in_kernel.export`); :func:`judge_answer`
+decides whether it is the answer, in named steps:
+
+1. **read**: the exported tree rebuilt by the whitelist parser :func:`kinlib.course.answers.wire.load`
+   (size, depth and digit caps; a tree over a cap is a wrong answer that says so);
+2. **describe**: the value at the secret points (:mod:`kinlib.course.answers.describe`), the reference's too
+   (:func:`kinlib.course.grader.refdata.reference_description`);
+3. **compare**: :func:`kinlib.course.answers.compare.compare` (non-finite values are wrong everywhere);
+4. **exact**: for a passing expression, whether SymPy proves it equal to the reference (advisory: it never
+   turns a numeric failure into a pass).
+
+All of it runs under :func:`time_limit` (:data:`JUDGE_SECONDS` per answer): an answer that takes longer to
+judge is wrong ("too large to grade in N s"), never a stopped batch.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+from ..answers import compare, describe, wire
+from ..answers.normalise import to_sympy
+
+__all__ = ["Verdict", "judge_answer", "time_limit", "JudgeTimeout", "JUDGE_SECONDS", "EXACT_SECONDS", "n_points"]
+
+JUDGE_SECONDS = 30.0  # the most one answer may take to read, evaluate and compare in the grader
+EXACT_SECONDS = 5.0  # of which the advisory exact check may take (SymPy simplify)
+N_POINTS = 5  # secret points for an expression or subspace
+N_SET_POINTS = 2  # for a set (its members are listed at each)
+
+
+class JudgeTimeout(Exception):
+    """The answer took longer than its time limit to judge.
+
+    >>> with time_limit(0.05):
+    ...     while True:
+    ...         pass
+    Traceback (most recent call last):
+    ...
+    kinlib.course.grader.judge.JudgeTimeout: over the 0.05 s limit
+    """
+
+
+@dataclass
+class Verdict:
+    """The grader's decision on one answer (one entry of ``Row.answers``; read by :mod:`.credit` and the reports).
+
+    >>> Verdict("J", "fail", "J is transposed: yours is 3×6, expected 6×3").passed
+    False
+    """
+
+    answer: str  # the answer's variable name
+    status: str  # pass | fail | error (error: the kernel could not report it; never the answer's own fault)
+    message: str = ""  # what is wrong (or a note on a pass); never shows the reference
+    exact: str = ""  # the advisory exact check: equal | not proved | timed out | "" (not run)
+    seconds: float = 0.0  # time spent judging it in the grader
+
+    @property
+    def passed(self) -> bool:
+        return self.status == "pass"
+
+    def as_dict(self) -> dict:
+        """The entry of ``Row.answers`` (keys: answer, status, message)."""
+        return {"answer": self.answer, "status": self.status, "message": self.message}
+
+
+def n_points(kind: str) -> int:
+    """How many secret points an answer of ``kind`` is evaluated at.
+
+    >>> n_points("expr"), n_points("set"), n_points("choice")
+    (5, 2, 0)
+    """
+    return N_SET_POINTS if kind == "set" else (0 if kind == "choice" else N_POINTS)
+
+
+@contextmanager
+def time_limit(seconds: float):
+    """Raise :class:`JudgeTimeout` in the block after ``seconds`` (SIGALRM; in the main thread only, elsewhere
+    the block runs without a limit). Nested limits keep the outer one's deadline.
+
+    >>> with time_limit(5):
+    ...     sum(range(10))
+    45
+    """
+    if threading.current_thread() is not threading.main_thread() or seconds <= 0:
+        yield
+        return
+
+    def alarm(signum, frame):
+        raise JudgeTimeout(f"over the {seconds:g} s limit")
+
+    start = time.monotonic()
+    old_handler = signal.signal(signal.SIGALRM, alarm)
+    old_left, _ = signal.getitimer(signal.ITIMER_REAL)
+    signal.setitimer(signal.ITIMER_REAL, min(seconds, old_left) if old_left > 0 else seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, old_handler)
+        if old_left > 0:  # an outer limit: put its remaining time back (at least a moment)
+            signal.setitimer(signal.ITIMER_REAL, max(old_left - (time.monotonic() - start), 1e-3))
+
+
+def _read(exported, name):
+    """(value, None) from the kernel's export, or (None, description of why it is not an answer)."""
+    if not isinstance(exported, dict):
+        return None, {"tag": "probe-error", "error": "malformed result"}
+    if exported.get("missing"):
+        return None, {"tag": "missing"}
+    if "too_large" in exported:
+        return None, {"tag": "too-large", "error": str(exported["too_large"])[:200]}
+    if "tree" not in exported:
+        return None, {"tag": "probe-error", "error": str(exported.get("error", "no answer"))[:300]}
+    try:
+        return wire.load(exported["tree"]), None
+    except WireError as exc:
+        big = str(exc).startswith(("more than", "nested more", "numbers with more", "a power too large"))
+        return None, {"tag": "too-large" if big else "unreadable", "error": str(exc)[:200]}
+    except RecursionError:
+        return None, {"tag": "too-large", "error": "nested too deeply"}
+
+
+WireError = wire.WireError
+
+
+def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS) -> Verdict:
+    """The verdict on answer ``name`` (of ``kind``) that a kernel exported (``{"tree"|"missing"|...}``),
+    against the reference ``ref`` (:class:`kinlib.course.grader.refdata.Reference`), at ``points``.
+
+    >>> from kinlib.course.grader.refdata import Reference
+    >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
+    ...                                                      "symbols": {"x": {}}}})
+    >>> pts = [{"x": 0.3}, {"x": -1.1}]
+    >>> x2 = ["Pow", ["Symbol", "x", {}], ["Integer", "2"]]
+    >>> judge_answer("x2", "expr", {"tree": x2}, ref, pts, 0).status
+    'pass'
+    >>> judge_answer("x2", "expr", {"tree": ["Infinity"]}, ref, pts, 0).message
+    'x2 could not be evaluated at some joint values (division by zero, or undefined symbols?)'
+    """
+    from .refdata import reference_description
+
+    t0 = time.monotonic()
+    pts = points[: n_points(kind)]
+    try:
+        with time_limit(seconds):
+            value, stu = _read(exported, name)
+            if stu is None:
+                stu = describe.describe(kind, value, pts, seed)
+            rd = reference_description(ref, name, kind, pts, seed)
+            ok, msg = compare.compare(kind, stu, rd, name)
+            verdict = Verdict(name, "pass" if ok else "fail", msg if (ok and msg) or not ok else "")
+            if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "srepr" in ref.answers[name]:
+                verdict.exact = _exact(value, ref.answers[name]["srepr"], min(EXACT_SECONDS, seconds / 3))
+    except JudgeTimeout:
+        verdict = Verdict(name, "fail", f"{name} is too large to grade (it took over {seconds:g} s to evaluate)")
+    except (MemoryError, RecursionError) as exc:
+        verdict = Verdict(name, "fail", f"{name} is too large to grade ({type(exc).__name__})")
+    except Exception as exc:  # noqa: BLE001  a grader bug on one answer must not stop the submission
+        verdict = Verdict(
+            name, "error", f"{name}: the reference could not be evaluated ({type(exc).__name__}: {exc})"[:300]
+        )
+    verdict.seconds = round(time.monotonic() - t0, 3)
+    return verdict
+
+
+def _exact(value, ref_text, seconds) -> str:
+    """'equal' | 'not proved' | 'timed out' | 'not sympy' (advisory). Not tried on powers of sums with large
+    exponents (expanding (a + b + c)**90 would take the grader's memory before its time limit)."""
+    import sympy as sp
+
+    obj = to_sympy(value)[1]
+    if obj is None:
+        return "not sympy"
+    if any(p.base.is_Add and p.exp.is_Number and abs(p.exp) > 12 for p in obj.atoms(sp.Pow)):
+        return "not proved"
+    try:
+        with time_limit(seconds):
+            return describe.exact_equal(value, ref_text, budget=seconds / 2)
+    except JudgeTimeout:
+        return "timed out"
+    except Exception:  # noqa: BLE001
+        return "not proved"
