@@ -426,7 +426,15 @@ def _exact_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
     fast = _field_dls(M, lam, v) if const else None
     if fast is not None:
         return fast if not v.free_symbols else (fast * v).applyfunc(sp.radsimp)
-    kw = {"iszerofunc": lambda e: decide_zero(e, "a pivot")} if const else {}
+    if not const:  # in the joint symbols: G = J Jᵀ + λ²I is positive definite, G⁻¹ = adj G / det G, each
+        # simplified modulo sin² + cos² = 1 (LUsolve + cancel on the raw entries took > 900 s for the 2R arm)
+        from .singularities import trig_simplify
+
+        G = trig_simplify(M * M.T if m <= n else M.T * M) + lam**2 * sp.eye(min(m, n))
+        det = trig_simplify(G.det(method="berkowitz"))
+        num = M.T * (G.adjugate(method="berkowitz") * v) if m <= n else G.adjugate(method="berkowitz") * (M.T * v)
+        return num.applyfunc(lambda e: trig_simplify(e) / det)
+    kw = {"iszerofunc": lambda e: decide_zero(e, "a pivot")}
     if m <= n:
         out = M.T * (M * M.T + lam**2 * sp.eye(m)).LUsolve(v, **kw)
     else:
