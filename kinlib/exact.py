@@ -40,6 +40,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
+from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
 from .display import readable, readable_fold, readable_ratio
 from .exactfield import (
     FALLBACK_DIGITS,
@@ -64,7 +65,13 @@ __all__ = [
     "exact_det",
     "MAX_MULTIPLE",
     "FALLBACK_DIGITS",
+    "TIME_BUDGET",
+    "ExactTimeoutError",
 ]
+
+#: the default ``time_budget`` (seconds) of the exact functions here; past it, the 60-digit fallback answers
+#: (no parameters left) or :class:`~kinlib.budget.ExactTimeoutError` says what would work
+TIME_BUDGET = 60.0
 
 
 def exact_det(M: sp.Matrix) -> sp.Expr:
@@ -416,7 +423,11 @@ MAX_MINORS = 60
 def _vanishing_factors(D: sp.Expr, an: _Analysis) -> list:
     """The factors of D that involve the parameters and can vanish for positive parameters (sign-normalised)."""
     params = set(an.fld.params)
-    _, factors = sp.factor_list(sp.factor_terms(D))
+    try:  # factored in the parameters, the configuration's constants as coefficients (nested radicals such
+        # as √(5 + √5) make SymPy's factor_list over all atoms fail: "Cannot construct a polynomial from 1")
+        _, factors = sp.factor_list(sp.factor_terms(D), *sorted(params, key=str))
+    except sp.PolynomialError:
+        factors = [(sp.expand(D), 1)]  # one factor: a sufficient condition all the same
     out = []
     for f, _mult in factors:
         if not (f.free_symbols & params):
@@ -471,12 +482,13 @@ def _fallback_rank(A: sp.Matrix) -> tuple:
 
 
 def _fallback_rref(A: sp.Matrix) -> sp.Matrix:
-    """Nonzero rows of rref(A), 60-digit arithmetic with partial pivoting, entries as 30-digit Floats."""
+    """Nonzero rows of rref(A) as ``FALLBACK_DIGITS``-digit Floats: the rank from the 60-digit SVD, the elimination
+    (partial pivoting) with 20 guard digits, so each entry carries the 60 digits it shows (entries of A to ~100)."""
     import mpmath
 
     X = mp_matrix(A)
     r, sv = _fallback_rank(A)
-    with mpmath.workdps(FALLBACK_DIGITS):
+    with mpmath.workdps(FALLBACK_DIGITS + 20):
         m, n = X.rows, X.cols
         X = X.copy()
         tol = (sv[0] if sv else 0) * mpmath.mpf(10) ** (-FALLBACK_ZERO_DIGITS)
@@ -495,7 +507,10 @@ def _fallback_rref(A: sp.Matrix) -> sp.Matrix:
             piv.append(j)
             row += 1
         rows = [
-            [sp.Float(mpmath.nstr(X[i, j], 30), 30) if abs(X[i, j]) > tol else sp.S.Zero for j in range(n)]
+            [
+                sp.Float(mpmath.nstr(X[i, j], FALLBACK_DIGITS), FALLBACK_DIGITS) if abs(X[i, j]) > tol else sp.S.Zero
+                for j in range(n)
+            ]
             for i in range(row)
         ]
     return sp.Matrix(rows) if rows else sp.zeros(0, n)
@@ -537,7 +552,7 @@ def _is_numeric_input(J: Any, subs: Any) -> bool:
     )
 
 
-def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
+def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None, *, time_budget=TIME_BUDGET):
     """J(θ₀): the Jacobian at a configuration, exact, with every zero entry proved zero.
 
     ``subs``: a mapping {joint symbol: value} or a sequence of values matched to ``thetas``. Values are exact
@@ -545,7 +560,8 @@ def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = N
     (Python, NumPy or SymPy) says the configuration is approximate and selects the numeric backend (a float array,
     and for :func:`rank_at` and the bases a float SVD). The result may still contain positive parameters, never a joint. Entries are written
     readably (sin² + cos² = 1 applied, angle sums folded); an entry is 0 exactly when it is 0 (decided exactly,
-    see the module docstring). A numeric J (an array, no subs) comes back as a float array.
+    see the module docstring). A numeric J (an array, no subs) comes back as a float array. The zero tests get
+    ``time_budget`` seconds (None: no limit); past it :class:`~kinlib.budget.ExactTimeoutError` is raised.
 
     >>> import sympy as sp
     >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
@@ -555,15 +571,23 @@ def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = N
     [-2*sin(10), -sin(10)],
     [ 2*cos(10),  cos(10)]])
     """
+    seconds = budget_seconds(time_budget)
     if _is_numeric_input(J, subs):
         return _numeric_J(J)
     M, numeric = _evaluated(J, subs, thetas)
     if numeric:
         return _as_float(M)
     try:
-        zero = [decide_zero(e) for e in M]
-    except NotExact:
-        zero = [e == 0 for e in M]
+        with within(seconds, "evaluate_at"):
+            try:
+                zero = [decide_zero(e) for e in M]
+            except NotExact:
+                zero = [e == 0 for e in M]
+    except OutOfTime:
+        raise ExactTimeoutError(
+            f"evaluate_at: {_late(seconds)} (deciding which entries are zero); give a larger time_budget "
+            "(None: no limit), or float joint values for a numeric J"
+        ) from None
     return sp.Matrix(M.rows, M.cols, [sp.S.Zero if z else readable(e) for e, z in zip(M, zero)])
 
 
@@ -575,13 +599,31 @@ def _analyse(M: sp.Matrix, what: str):
         return None, str(err)
 
 
-def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None) -> int:
+def _late(seconds) -> str:
+    return f"the exact computation did not finish within time_budget={seconds} s"
+
+
+def _numbers_only(M: sp.Matrix, what: str, why: str, seconds) -> sp.Matrix:
+    """M for the 60-digit fallback: refused with a clear error when parameters are left (no numbers to use)."""
+    if M.free_symbols and why.startswith("the exact computation did not finish"):
+        params = ", ".join(map(str, sorted(M.free_symbols, key=str)))
+        raise ExactTimeoutError(
+            f"{what}: {why}, and the {FALLBACK_DIGITS}-digit fallback needs numbers for the parameters {params}: "
+            "substitute them (J.subs({...})), or give a larger time_budget (None: no limit)"
+        )
+    return M
+
+
+def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None, *, time_budget=TIME_BUDGET) -> int:
     """rank J(θ₀) at a configuration, proved exactly (see the module docstring); a :class:`Rank` (an int).
 
     ``subs`` as in :func:`evaluate_at` (float values: a float SVD, and a plain int). With symbolic link lengths the rank holds for all their positive values,
     or ``Rank.unless`` names the minor whose vanishing would lower it. Out of reach of the exact method (e.g. an
-    angle √2), a 60-digit SVD decides and ``Rank.exact`` is False. A numeric J (float array, no subs) or float
-    joint values: the float SVD with tolerance 100·max(m, n)·ε·σ_max, a plain int.
+    angle √2) or past ``time_budget`` seconds (default :data:`TIME_BUDGET`; None: no limit; see
+    :mod:`kinlib.budget` for how it is enforced), a 60-digit SVD decides and ``Rank.exact`` is False; with
+    parameters left there are no numbers for it, and :class:`~kinlib.budget.ExactTimeoutError` (a ValueError)
+    says so. A numeric J (float array, no subs) or float joint values: the float SVD with tolerance
+    100·max(m, n)·ε·σ_max, a plain int.
 
     >>> import sympy as sp
     >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
@@ -589,6 +631,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None)
     >>> rank_at(J, {t1: 10, t2: 0}), rank_at(J, {t1: sp.Rational(1, 2), t2: sp.Rational(1, 2)})
     (1, 2)
     """
+    seconds = budget_seconds(time_budget)
     if _is_numeric_input(J, subs):
         A = _numeric_J(J)
         s = np.linalg.svd(A, compute_uv=False)
@@ -596,12 +639,16 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None)
     M, numeric = _evaluated(J, subs, thetas)
     if numeric:
         return rank_at(_as_float(M))
-    an, why = _analyse(M, "rank_at")
-    if an is None:
-        r, _ = _fallback_rank(M)
-        return Rank(r, exact=False, note=f"{FALLBACK_DIGITS}-digit SVD ({why})")
-    unless = _conditions(M, an)
-    return Rank(an.rank, unless=unless, note="exact elimination in K(tan(g/2), parameters)")
+    try:
+        with within(seconds, "rank_at"):
+            an, why = _analyse(M, "rank_at")
+            if an is not None:
+                unless = _conditions(M, an)
+                return Rank(an.rank, unless=unless, note="exact elimination in K(tan(g/2), parameters)")
+    except OutOfTime:
+        why = _late(seconds)
+    r, _ = _fallback_rank(_numbers_only(M, "rank_at", why, seconds))
+    return Rank(r, exact=False, note=f"{FALLBACK_DIGITS}-digit SVD ({why})")
 
 
 def _warn_conditions(what: str, unless: tuple):
@@ -613,12 +660,14 @@ def _warn_conditions(what: str, unless: tuple):
         )
 
 
-def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
+def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None, *, time_budget=TIME_BUDGET):
     """A basis of range J(θ₀) (the twists/velocities the robot can produce there), as columns (m×r).
 
     Exact J: the canonical basis, the nonzero rows of rref(Jᵀ) (leading entries 1), so equal subspaces give
     equal matrices; proved exactly as in :func:`rank_at`, entries written with the configuration's sines and
-    cosines. Numeric J: an orthonormal basis from the SVD.
+    cosines. Out of reach of the exact method or past ``time_budget`` seconds (as in :func:`rank_at`): the same
+    basis in 60-digit Floats, with a :class:`NumericFallbackWarning` (parameters left: ExactTimeoutError).
+    Numeric J: an orthonormal basis from the SVD.
 
     >>> import sympy as sp
     >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
@@ -626,6 +675,7 @@ def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = 
     >>> column_space(J, {t1: 3, t2: 0}).T
     Matrix([[1, -cos(3)/sin(3)]])
     """
+    seconds = budget_seconds(time_budget)
     if _is_numeric_input(J, subs):
         A = _numeric_J(J)
         U, s, _ = np.linalg.svd(A)
@@ -634,19 +684,27 @@ def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = 
     if numeric:
         return column_space(_as_float(M))
     A = M.T
-    an, why = _analyse(A, "column_space")
-    if an is None:
-        _fallback_warning("column_space", why)
-        return _fallback_rref(A).T
-    _warn_conditions("column_space", _conditions(A, an))
-    return _canonical_rows(A, an).T
+    try:
+        with within(seconds, "column_space"):
+            an, why = _analyse(A, "column_space")
+            if an is not None:
+                unless = _conditions(A, an)
+                out = _canonical_rows(A, an).T
+                _warn_conditions("column_space", unless)
+                return out
+    except OutOfTime:
+        why = _late(seconds)
+    A = _numbers_only(A, "column_space", why, seconds)
+    _fallback_warning("column_space", why)
+    return _fallback_rref(A).T
 
 
-def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None):
+def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None, *, time_budget=TIME_BUDGET):
     """A basis of null J(θ₀)ᵀ (the directions y the robot cannot move along: yᵀJ = 0), as columns (m×(m − r)).
 
     Exact J: the canonical (rref) basis, proved exactly as in :func:`rank_at`; empty (m×0) at full row rank.
-    Numeric J: orthonormal, from the SVD.
+    Out of reach of the exact method or past ``time_budget`` seconds: 60-digit Floats with a
+    :class:`NumericFallbackWarning`, as :func:`column_space`. Numeric J: orthonormal, from the SVD.
 
     >>> import sympy as sp
     >>> t1, t2 = sp.symbols("theta1 theta2", real=True)
@@ -654,6 +712,7 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
     >>> left_null_space(J, {t1: 3, t2: 0}).T
     Matrix([[1, sin(3)/cos(3)]])
     """
+    seconds = budget_seconds(time_budget)
     if _is_numeric_input(J, subs):
         A = _numeric_J(J)
         U, s, _ = np.linalg.svd(A)
@@ -663,17 +722,23 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
         return left_null_space(_as_float(M))
     A = M.T  # null(Mᵀ) = null(A)
     m = A.cols
-    an, why = _analyse(A, "left_null_space")
-    if an is None:
-        _fallback_warning("left_null_space", why)
-        R = _fallback_rref(A)
-        return _null_from_rref(R, m, fallback=True)
-    _warn_conditions("left_null_space", _conditions(A, an))
-    if an.rank == m:
-        return sp.zeros(m, 0)
-    R = _canonical_rows(A, an)
-    N = _null_from_rref(R, m)
-    return _canonical_rows(N, _Analysis(N)).T if N.rows else sp.zeros(m, 0)
+    try:
+        with within(seconds, "left_null_space"):
+            an, why = _analyse(A, "left_null_space")
+            if an is not None:
+                unless = _conditions(A, an)
+                if an.rank == m:
+                    out = sp.zeros(m, 0)
+                else:
+                    N = _null_from_rref(_canonical_rows(A, an), m)
+                    out = _canonical_rows(N, _Analysis(N)).T if N.rows else sp.zeros(m, 0)
+                _warn_conditions("left_null_space", unless)
+                return out
+    except OutOfTime:
+        why = _late(seconds)
+    A = _numbers_only(A, "left_null_space", why, seconds)
+    _fallback_warning("left_null_space", why)
+    return _null_from_rref(_fallback_rref(A), m, fallback=True)
 
 
 def _null_from_rref(R: sp.Matrix, m: int, fallback: bool = False) -> sp.Matrix:

@@ -176,8 +176,12 @@ class ExactField:
             scan(e)
         self.extra = sorted(extra, key=str)  # π, e: generators (transcendental; no trig angle then)
         algebraic_consts = sorted((c for c in consts if not c.is_Rational), key=sp.default_sort_key)
+        self._known: dict = {}
         if algebraic_consts:
-            K, _ = construct_domain(algebraic_consts, extension=True)
+            K, elems = construct_domain(algebraic_consts, extension=True)
+            # the constants come out of the primitive-element construction already written in K: converting
+            # them again (to_number_field: a field isomorphism per constant) took minutes for π/7 next to 3π/5
+            self._known = dict(zip(algebraic_consts, elems))
             if K.is_EX:
                 raise NotExact(
                     f"the constants {algebraic_consts} are not algebraic numbers SymPy can do arithmetic with"
@@ -230,6 +234,8 @@ class ExactField:
         return out
 
     def _kconst(self, c):
+        if c in self._known:
+            return self.ring(self._known[c])
         return self.ring(_field_constant(self.K, c))
 
     def to_ratio(self, x) -> tuple[sp.Expr, sp.Expr]:

@@ -16,6 +16,7 @@ batch of Jacobians (N, m, n) gives (N,) results.
 
 from __future__ import annotations
 
+import warnings
 from typing import Any
 
 import numpy as np
@@ -30,8 +31,9 @@ from ._backend import (
     numeric_jacobian,
     numeric_vectors,
 )
-from .exact import exact_det
-from .exactfield import decide_zero
+from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
+from .exact import TIME_BUDGET, NumericFallbackWarning, exact_det
+from .exactfield import FALLBACK_DIGITS, decide_zero, mp_matrix
 from .singularities import trig_simplify
 from .taskspace import task_row_indices, task_rows
 from .trigpoly import TrigRing, angles_in
@@ -314,14 +316,19 @@ def isotropy(J: Any):
     return sp.factor_terms(parts[2] / parts[1])
 
 
-def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None):
+def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None, *, time_budget=TIME_BUDGET):
     """The velocity ellipsoid {J_r θ̇ : ‖θ̇‖ ≤ 1}: (semi-axis lengths σ_i, unit directions u_i as columns).
 
     ``rows``: pick task rows first (see :func:`~kinlib.taskspace.task_rows`); by default a 6-row J
     uses its linear rows ("linear" = vx vy vz, the tool velocity ṗ for the geometric Jacobian), any other J
     all of its rows. Numeric J: lengths (k,) sorted descending and directions (m, k), k = min(m, n) (a
     batch gives (N, k), (N, m, k)). SymPy J: exact eigen-decomposition of J Jᵀ (lengths √λ, orthonormal
-    directions), for small or evaluated J.
+    directions), for small or evaluated J. An eigenvalue that is a root of an irreducible polynomial of degree
+    ≥ 3 with rational coefficients is written as ``CRootOf`` (exact; its direction as polynomials in that
+    root); with other coefficients (sin 1, …) there is no closed form and, as past ``time_budget`` seconds
+    (default 60; None: no limit; :mod:`kinlib.budget`), a constant J gets the eigen-decomposition in
+    ``FALLBACK_DIGITS`` = 60-digit Floats with a :class:`~kinlib.exact.NumericFallbackWarning`; a J with free
+    symbols is refused (a ValueError saying to substitute numbers).
 
     ``hold``: task rows kept at zero (e.g. ``("wz",)``: the tool's orientation held). The ellipsoid is then
     {J_r θ̇ : J_h θ̇ = 0, ‖θ̇‖ ≤ 1} = {J_r N z : ‖z‖ ≤ 1} with N an orthonormal basis of null(J_h) (d columns):
@@ -351,8 +358,9 @@ def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None):
     >>> velocity_ellipsoid(sp.Matrix([[1, 1, 1], [0, 0, 1], [0, -1, 0]]), rows=[1, 2], hold=[0])[0]   # exact
     [1, sqrt(3)/3]
     """
+    seconds = budget_seconds(time_budget)
     if hold is not None:
-        return _held_ellipsoid(J, rows, hold)
+        return _held_ellipsoid(J, rows, hold, seconds)
     if rows is None:
         shape = J.shape if hasattr(J, "shape") else np.shape(np.asarray(J, dtype=object))
         rows = "linear" if len(shape) >= 2 and shape[-2] == 6 else None
@@ -363,20 +371,125 @@ def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None):
         U, s, _ = np.linalg.svd(A, full_matrices=False)
         return s, U
     M = exact_jacobian(J)
-    return _exact_axes(M * M.T, min(M.rows, M.cols))
+    return budgeted_axes(lambda: M * M.T, min(M.rows, M.cols), seconds, "velocity_ellipsoid")
+
+
+class _NoClosedForm(Exception):
+    pass
+
+
+def budgeted_axes(gram, k: int, seconds, what: str):
+    """:func:`_exact_axes` of ``gram()`` within ``seconds``; the 60-digit fallback for a constant Gram matrix
+    (with a NumericFallbackWarning), a clear ValueError for a symbolic one."""
+    why = ""
+    G = None
+    try:
+        with within(seconds, what):
+            G = gram()
+            return _exact_axes(G, k)
+    except OutOfTime:
+        why = f"the exact eigen-decomposition did not finish within time_budget={seconds} s"
+    except _NoClosedForm as err:
+        why = str(err)
+    if G is None or G.free_symbols:
+        syms = ", ".join(sorted(map(str, G.free_symbols))) if G is not None else "J's symbols"
+        raise ExactTimeoutError(
+            f"{what}: {why}; J has the free symbols {syms}: substitute numbers for them (floats: the fast numeric "
+            "backend; exact values: this exact path), or give a larger time_budget (None: no limit)"
+        )
+    warnings.warn(
+        f"{what}: no exact eigen-decomposition here ({why}); computed with {FALLBACK_DIGITS}-digit numerics "
+        f"(eigenvalues below 1e-40·λ_max counted as zero, not proven)",
+        NumericFallbackWarning,
+        stacklevel=3,
+    )
+    return _numeric_axes(G, k)
+
+
+def _numeric_axes(G: sp.Matrix, k: int):
+    """(lengths, directions) of the k largest eigenvalues of the symmetric constant G, as 60-digit Floats."""
+    import mpmath
+
+    X = mp_matrix(G)
+    with mpmath.workdps(FALLBACK_DIGITS + 20):
+        X = (X + X.T) / 2
+        E, Q = mpmath.eigsy(X)
+        order = sorted(range(len(E)), key=lambda i: -E[i])[:k]
+        top = max((abs(e) for e in E), default=mpmath.mpf(0))
+        tol = top * mpmath.mpf(10) ** -40
+
+        def fl(x):
+            return sp.Float(mpmath.nstr(x, FALLBACK_DIGITS), FALLBACK_DIGITS) if abs(x) > tol else sp.S.Zero
+
+        lengths = [fl(mpmath.sqrt(E[i])) if E[i] > tol else sp.S.Zero for i in order]
+        vecs = [[fl(Q[r, i]) for i in order] for r in range(G.rows)]
+    return lengths, sp.Matrix(vecs) if order else sp.zeros(G.rows, 0)
+
+
+def _charpoly_factors(G: sp.Matrix):
+    """The factors (f, multiplicity) of det(x I − G) in the Dummy x, and x."""
+    x = sp.Dummy("x")
+    p = G.charpoly(x).as_expr(x)  # (a PurePoly keeps a generator of its own)
+    _, facs = sp.factor_list(p, x)
+    return [(f, m) for f, m in facs if f.has(x)], x
+
+
+def _root_axes(G: sp.Matrix, f: sp.Expr, x: sp.Symbol) -> list:
+    """(λ, unit eigenvector) for each root λ = CRootOf(f, i) of an irreducible rational f of degree ≥ 3 that is
+    a simple factor of the characteristic polynomial: the eigenvector is a nonzero column of adj(G − λI), written
+    as polynomials in λ reduced modulo f (a reduced polynomial that is not 0 cannot vanish at a root of the
+    irreducible f: a proof that the column is nonzero)."""
+    n = G.rows
+    f, x = f.subs(x, sp.Symbol("x")), sp.Symbol("x")  # G is constant here: x only names CRootOf's polynomial
+    P = sp.Poly(f, x)
+    adj = (G - x * sp.eye(n)).adjugate(method="berkowitz")
+    for j in range(n):
+        col = [sp.Poly(adj[i, j], x).rem(P) for i in range(n)]
+        if any(not c.is_zero for c in col):
+            break
+    else:  # pragma: no cover - a simple root has a rank-(n−1) G − λI, so adj ≠ 0
+        raise _NoClosedForm("an eigenvector could not be found exactly")
+    n2 = sum((c * c for c in col), sp.Poly(0, x)).rem(P)
+    out = []
+    for i in range(P.degree()):
+        lam = sp.CRootOf(P, i)
+        norm = sp.sqrt(n2.as_expr().subs(x, lam))
+        out.append((lam, sp.Matrix([c.as_expr().subs(x, lam) / norm for c in col])))
+    return out
 
 
 def _exact_axes(G: sp.Matrix, k: int):
     """Exact (lengths √λ, orthonormal directions) of the k largest eigenvalues of the Gram matrix G."""
     G = trig_simplify(G) if angles_in(list(G)) else G.applyfunc(sp.simplify)
     pairs = []
-    try:
-        eig = G.eigenvects(simplify=True)
-    except NotImplementedError:
-        raise ValueError(
-            "J: SymPy cannot find exact eigenvectors of this Gram matrix (J with free joint symbols is too "
-            "big): give J at a configuration (exact values, no free joint symbols) or numbers"
-        ) from None
+    facs, x = _charpoly_factors(G) if G.rows >= 3 else ([], None)
+    high = [(f, m) for f, m in facs if sp.degree(f, x) >= 3]
+    if high:
+        if G.free_symbols:
+            raise _NoClosedForm(
+                f"the eigenvalues of the {G.rows}×{G.rows} Gram matrix include roots of an irreducible polynomial of "
+                f"degree {max(sp.degree(f, x) for f, _ in high)} in them: no closed form"
+            )
+        if any(m > 1 or not sp.Poly(f, x).domain.is_QQ and not sp.Poly(f, x).domain.is_ZZ for f, m in high):
+            raise _NoClosedForm(
+                "the eigenvalues include roots of an irreducible polynomial of degree ≥ 3 whose coefficients are "
+                "not rational: no closed form"
+            )
+        for f, _m in high:
+            pairs += _root_axes(G, f, x)
+        low = [(f, m) for f, m in facs if sp.degree(f, x) <= 2]
+        eig = []
+        for f, _m in low:
+            for lam in sp.roots(sp.Poly(f, x)):
+                eig.append((lam, None, (G - lam * sp.eye(G.rows)).nullspace(simplify=True)))
+    else:
+        try:
+            eig = G.eigenvects(simplify=True)
+        except NotImplementedError:
+            raise ValueError(
+                "J: SymPy cannot find exact eigenvectors of this Gram matrix (J with free joint symbols is too "
+                "big): give J at a configuration (exact values, no free joint symbols) or numbers"
+            ) from None
     for lam, _mult, vecs in eig:
         lam = sp.simplify(lam)
         ortho = sp.GramSchmidt(vecs, orthonormal=True)
@@ -397,7 +510,7 @@ def _exact_axes(G: sp.Matrix, k: int):
     return lengths, sp.Matrix.hstack(*[v for _, v in pairs])
 
 
-def _held_ellipsoid(J: Any, rows: Any, hold: Any):
+def _held_ellipsoid(J: Any, rows: Any, hold: Any, seconds):
     """velocity_ellipsoid(J, rows, hold): the ellipsoid of J_r θ̇ over θ̇ ∈ null(J_h), ‖θ̇‖ ≤ 1."""
     if rows is None:
         raise ValueError("rows must name the task rows drawn (e.g. rows=('vx', 'vy')) when hold is given, got None")
@@ -421,12 +534,21 @@ def _held_ellipsoid(J: Any, rows: Any, hold: Any):
         )
     if symbolic:
         A, H = M.extract(list(r_idx), list(range(M.cols))), M.extract(list(h_idx), list(range(M.cols)))
-        B = H.nullspace(simplify=True)
+        try:
+            with within(seconds, "velocity_ellipsoid"):
+                B = H.nullspace(simplify=True)
+        except OutOfTime:
+            raise ExactTimeoutError(
+                f"velocity_ellipsoid: the null space of the held rows did not finish within time_budget={seconds} "
+                "s; give J at a configuration, numbers, or a larger time_budget (None: no limit)"
+            ) from None
         if not B:
             return [], sp.zeros(A.rows, 0)
         B = sp.Matrix.hstack(*B)
-        P = B * (B.T * B).inv() * B.T
-        return _exact_axes(A * P * A.T, min(A.rows, B.cols))
+        d = B.cols
+        return budgeted_axes(
+            lambda: A * (B * (B.T * B).inv() * B.T) * A.T, min(A.rows, d), seconds, "velocity_ellipsoid"
+        )
     A, H = M[list(r_idx)], M[list(h_idx)]
     _, s, Vt = np.linalg.svd(H)
     rank = int(np.sum(s > max(H.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0))) if s[0] > 0 else 0

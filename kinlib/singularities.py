@@ -28,7 +28,6 @@ the answer says it is incomplete (``SingularSet.complete``) and names the numeri
 from __future__ import annotations
 
 import itertools
-import time
 import warnings
 from collections.abc import Sequence
 from typing import Any
@@ -37,6 +36,7 @@ import numpy as np
 import sympy as sp
 
 from ._backend import as_jacobian, describe, exact_number, is_symbolic, joint_symbols
+from .budget import OutOfTime, budget_seconds, clock, within
 from .exact import column_space, evaluate_at, left_null_space, rank_at
 from .taskspace import ROW_NAMES, task_rows
 from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
@@ -239,7 +239,7 @@ _MAX_PRODUCT = 2_000_000  # term pairs in one polynomial product (about a second
 
 
 def _mul(a, b, deadline: float):
-    if time.monotonic() > deadline or len(a.terms()) * len(b.terms()) > _MAX_PRODUCT:
+    if clock() > deadline or len(a.terms()) * len(b.terms()) > _MAX_PRODUCT:
         raise _OutOfTime
     return a * b
 
@@ -297,7 +297,7 @@ def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float
     if m > n:
         rows = [list(c) for c in zip(*rows)]
         m, n = n, m
-    start = time.monotonic()
+    start = clock()
     raw_deadline = min(deadline, start + max(1.0, (deadline - start) / 8))
     try:
         return [
@@ -305,7 +305,7 @@ def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float
             for cols in itertools.combinations(range(n), m)
         ]
     except _OutOfTime:
-        if time.monotonic() > deadline:
+        if clock() > deadline:
             raise
     return _minors_reduced(rows, ring, deadline)
 
@@ -337,7 +337,7 @@ def _cheap_points(g_expr: sp.Expr, joint: sp.Symbol, revolute: bool):
 def _solve_system(qs: list, ring, ctx: dict, depth: int = 0):
     """All common zeros of the ring elements qs as a list of {joint: set of points (one period)}, each a
     conjunction; None when it cannot be done this way (a factor with several joints or awkward zeros)."""
-    if time.monotonic() > ctx["deadline"] or depth > len(ctx["thetas"]):
+    if clock() > ctx["deadline"] or depth > len(ctx["thetas"]):
         return None
     qs = [q for q in qs if q]
     if not qs:
@@ -416,7 +416,7 @@ def _factor_conditions(G, ring, ctx: dict, add) -> None:
 def _display_condition(p, ring, deadline: float) -> sp.Expr:
     """'p = 0' for display: factored in sin/cos, angle sums folded (trigsimp) when small and time allows."""
     expr = ring.to_trig(sp.factor(ring.to_expr(p, trig=False))) if len(p.terms()) < 200 else ring.to_expr(p)
-    if sp.count_ops(expr) < 150 and time.monotonic() < deadline:
+    if sp.count_ops(expr) < 150 and clock() < deadline:
         expr = sp.trigsimp(expr)
     return _normalize_expr(expr)
 
@@ -442,7 +442,8 @@ def singular_configurations(
     Conditions that cannot vanish are dropped only with a proof (:mod:`kinlib.trigsign`: a positive
     constant plus squares, positive lengths, bounds |sin|, |cos| ≤ 1); so every returned condition does
     make J drop rank, and every rank drop is covered. The answer is a :class:`SingularSet` (a list):
-    ``.complete`` is False when the closed form was out of reach within ``time_budget`` seconds (then
+    ``.complete`` is False when the closed form was out of reach within ``time_budget`` seconds (None: no
+    limit; enforced inside SymPy's own work too, see :mod:`kinlib.budget`) (then
     use :func:`kinlib.singular_search.find_singularities` on a numeric chain), ``.note`` says how.
 
     ``thetas``: the n joint symbols, one per column of J. A joint need not appear in J (a space Jacobian
@@ -457,7 +458,7 @@ def singular_configurations(
     >>> conds, conds.complete           # tool position only: stretched *and* folded at once
     ([{theta2: ImageSet(Lambda(k, pi*k), Integers), theta3: ImageSet(Lambda(k, pi*k), Integers)}], True)
     """
-    t0 = time.monotonic()
+    t0 = clock()
     if not is_symbolic(J):
         raise TypeError(f"J must be a symbolic Jacobian (a SymPy Matrix in the joint symbols), got {describe(J)}")
     J = as_jacobian(J, "J", True)
@@ -465,9 +466,8 @@ def singular_configurations(
     _check_params(J, thetas, params)
     if J.rows == 0 or J.cols == 0:
         raise ValueError(f"J must have at least one row and one column, got {describe(J)}")
-    if isinstance(time_budget, bool) or not isinstance(time_budget, (int, float)) or not time_budget >= 0:
-        raise ValueError(f"time_budget must be a number of seconds ≥ 0, got {describe(time_budget)}")
-    deadline = t0 + float(time_budget)
+    seconds = budget_seconds(time_budget)  # None: no limit
+    deadline = t0 + seconds if seconds is not None else float("inf")
     joint_set = set(thetas)
 
     def parameter_atom(a: sp.Expr) -> bool:  # √L, 1/L: allowed; anything else with a joint or a trig function: not
@@ -476,22 +476,66 @@ def singular_configurations(
     def bad_entry(e):
         return ValueError(
             "J must be polynomial in sin θ_i, cos θ_i of the revolute joints and in the "
-            f"prismatic joint values; got the entry {e}"
+            f"prismatic joint values (after expanding); got the entry {e}"
         )
 
-    try:
-        ring = TrigRing(list(J), thetas, opaque=parameter_atom)  # s_i = sin θ_i, c_i = cos θ_i, θ_j, L, ...
-    except NotTrigPolynomial:
-        for e in J:
-            try:
-                TrigRing([e], thetas, opaque=parameter_atom)
-            except NotTrigPolynomial:
-                raise bad_entry(e) from None
-        raise
+    conditions: list = []
+
+    def key(c):
+        if isinstance(c, dict):
+            return (0, tuple(sorted(thetas.index(j) for j in c)), str(c))
+        return (1 if c.free_symbols & joint_set else 2, 0, str(c))
+
+    def out_of_reach(stage: str, stacklevel: int = 3):
+        note = (
+            f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
+            "(maybe none) are singular, others may be missing. For a numeric search use "
+            "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths."
+        )
+        warnings.warn(f"singular_configurations: {note}", IncompleteResultWarning, stacklevel=stacklevel)
+        return SingularSet(sorted(conditions, key=key), complete=False, note=note)
+
+    k = min(J.shape)
+    what = "det J" if J.rows == J.cols else f"the {k}×{k} minors of J"
+    try:  # the clock is also enforced inside SymPy (kinlib.budget), not only at kinlib's own checks
+        with within(None if seconds is None else max(0.0, deadline - clock()), "singular_configurations"):
+            return _singular_set(
+                J, thetas, deadline, parameter_atom, bad_entry, conditions, key, lambda st: out_of_reach(st, 4), what
+            )
+    except OutOfTime:
+        return out_of_reach(f"computing {what}" if not conditions else "after the first conditions")
+
+
+def _trig_ring(J: sp.Matrix, thetas, parameter_atom, bad_entry):
+    """The ring of J's entries (s_i = sin θ_i, c_i = cos θ_i, prismatic θ_j, parameters) and J as given or,
+    when that is not a trigonometric polynomial (θ next to sin θ, unexpanded products), J expanded: terms
+    such as θ·(…) − θ·(…) from a screw's unexpanded entries cancel then. Refused only if both fail."""
+    for attempt, M in enumerate((J, None)):
+        if M is None:
+            M = J.applyfunc(lambda e: sp.expand(sp.cancel(e)) if e.has(*thetas) else e)
+        try:
+            ring = TrigRing(list(M), thetas, opaque=parameter_atom)
+        except NotTrigPolynomial:
+            if attempt == 0:
+                continue
+            for e in M:
+                try:
+                    TrigRing([e], thetas, opaque=parameter_atom)
+                except NotTrigPolynomial:
+                    raise bad_entry(e) from None
+            raise
+        mixed = set(ring.found) & set(ring.variables)  # θ sin θ is not a trigonometric polynomial
+        if not mixed:
+            return ring, M
+        if attempt == 1:
+            raise bad_entry(next(e for e in M if mixed & set(TrigRing([e], thetas, opaque=parameter_atom).variables)))
+    raise AssertionError  # pragma: no cover
+
+
+def _singular_set(J, thetas, deadline, parameter_atom, bad_entry, conditions, key, out_of_reach, what):
+    joint_set = set(thetas)
+    ring, J = _trig_ring(J, thetas, parameter_atom, bad_entry)
     revolute = set(ring.found)  # joints inside sin/cos; the others enter polynomially
-    mixed = revolute & set(ring.variables)  # θ sin θ is not a trigonometric polynomial
-    if mixed:
-        raise bad_entry(next(e for e in J if mixed & set(TrigRing([e], thetas, opaque=parameter_atom).variables)))
     ctx = {
         "deadline": deadline,
         "thetas": thetas,
@@ -499,28 +543,11 @@ def singular_configurations(
         "revolute": revolute,
         "kinds": generator_kinds(ring),
     }
-    conditions: list = []
 
     def add(cond):
         if cond not in conditions:
             conditions.append(cond)
 
-    def key(c):
-        if isinstance(c, dict):
-            return (0, tuple(sorted(thetas.index(j) for j in c)), str(c))
-        return (1 if c.free_symbols & joint_set else 2, 0, str(c))
-
-    def out_of_reach(stage: str):
-        note = (
-            f"closed form out of reach within time_budget={time_budget} s ({stage}); the conditions listed "
-            "(maybe none) are singular, others may be missing. For a numeric search use "
-            "kinlib.singular_search.find_singularities(chain) on a chain with numeric lengths."
-        )
-        warnings.warn(f"singular_configurations: {note}", IncompleteResultWarning, stacklevel=3)
-        return SingularSet(sorted(conditions, key=key), complete=False, note=note)
-
-    k = min(J.shape)
-    what = "det J" if J.rows == J.cols else f"the {k}×{k} minors of J"
     Jp = [ring.normal_form(e) for e in J]
     try:
         minors = _maximal_minors(Jp, J.shape, ring, deadline)
@@ -537,14 +564,14 @@ def singular_configurations(
             if G.is_ground:
                 break
             G = G.gcd(q)
-            if time.monotonic() > deadline:
+            if clock() > deadline:
                 raise _OutOfTime
     except _OutOfTime:
         return out_of_reach(f"the gcd of {what}")
     except Exception:  # noqa: BLE001  (a gcd SymPy cannot take, e.g. over an algebraic domain: no common part)
         G = ring.ring.one
     _factor_conditions(G, ring, ctx, add)
-    if time.monotonic() > deadline:
+    if clock() > deadline:
         return out_of_reach(f"factoring {what}")
     note = f"from the factors of {'det J' if J.rows == J.cols else 'the gcd of ' + what}"
     qs = []
@@ -571,7 +598,7 @@ def singular_configurations(
                         }
                     )
                 note += "; where all of them vanish together: solved joint by joint"
-            elif time.monotonic() > deadline:
+            elif clock() > deadline:
                 return out_of_reach("the common zeros of the minors")
             elif total <= 2000:
                 add(sp.Add(*[_display_condition(q, ring, deadline) ** 2 for q in qs]))

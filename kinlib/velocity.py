@@ -38,7 +38,9 @@ from ._backend import (
     numeric_jacobian,
     numeric_vectors,
 )
+from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
 from .display import readable, readable_ratio
+from .exact import TIME_BUDGET
 from .exactfield import decide_zero
 from .manipulability import velocity_ellipsoid
 from .taskspace import task_rows
@@ -265,7 +267,22 @@ def _pinv_formula(A, r: int, m: int, n: int, inv, BC=None):
     return T(C) * inv(C * T(C)) * inv(T(B) * B) * T(B), r
 
 
-def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
+def _timeout(what: str, seconds, advice: str):
+    return ExactTimeoutError(
+        f"{what}: the exact computation did not finish within time_budget={seconds} s; {advice}, or give a larger "
+        "time_budget (None: no limit)"
+    )
+
+
+def _budgeted_pinv(M: sp.Matrix, seconds, what: str):
+    try:
+        with within(seconds, what):
+            return _exact_pinv(M)
+    except OutOfTime:
+        raise _timeout(what, seconds, "use float numbers for J (the SVD backend)") from None
+
+
+def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False, *, time_budget=TIME_BUDGET):
     """The Moore–Penrose pseudoinverse J⁺ (n×m) of a Jacobian J (m×n).
 
     J⁺ = Jᵀ(J Jᵀ)⁻¹ for full row rank, (Jᵀ J)⁻¹Jᵀ for full column rank, and in general
@@ -280,6 +297,8 @@ def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
     exact field K(t), t = tan(g/2) (g the angles' common measure, :mod:`kinlib.exactfield`), and come back
     written with sin g and cos g (e.g. −2 sin 10/5); a UR5 at integer angles
     takes ≲ 10 s. (SymPy's own ``Matrix.pinv`` is not used: its zero tests can silently fail on such entries.)
+    The exact path gets ``time_budget`` seconds (default 60; None: no limit; :mod:`kinlib.budget`); past it
+    :class:`~kinlib.budget.ExactTimeoutError` (a ValueError) is raised.
 
     >>> import sympy as sp
     >>> pseudoinverse(sp.Matrix([[1, 0], [0, 2], [0, 0]]))
@@ -297,10 +316,11 @@ def pseudoinverse(J: Any, rtol: Any = None, full_output: bool = False):
     (array([[0.25, 0.25],
            [0.25, 0.25]]), 1)
     """
+    seconds = budget_seconds(time_budget)
     if is_symbolic(J):
         if rtol is not None:
             raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
-        P, r = _exact_pinv(exact_jacobian(J))
+        P, r = _budgeted_pinv(exact_jacobian(J), seconds, "pseudoinverse")
         return (P, PinvReport(r, None, None)) if full_output else P
     A = numeric_jacobian(J)
     rtol = _rtol(rtol)
@@ -321,13 +341,14 @@ def _rtol(rtol: Any):
     return r
 
 
-def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False):
+def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False, *, time_budget=TIME_BUDGET):
     """Inverse velocity kinematics θ̇ = J⁺ V: the joint rates of least norm that best achieve the twist V.
 
     J⁺ as in :func:`pseudoinverse` (Jᵀ(J Jᵀ)⁻¹ for full row rank: J θ̇ = V exactly; (Jᵀ J)⁻¹Jᵀ for full column
     rank: the least-squares θ̇). Numbers: the SVD with tol = rtol·σ_max (default rtol = max(m, n)·ε), a
     :class:`SingularityWarning` at or near a singularity, ``full_output=True`` → (θ̇, PinvReport). Batches: J
-    (N, m, n) and/or V (N, m). SymPy: exact, J constant (V may hold symbols).
+    (N, m, n) and/or V (N, m). SymPy: exact, J constant (V may hold symbols), within ``time_budget`` seconds
+    as :func:`pseudoinverse`.
 
     >>> import sympy as sp
     >>> inverse_velocity(sp.Matrix([[0, 1], [1, 1]]), [1, 2]).T      # planar 2R at θ = (0, π/2), L = 1: ṗ = (1, 2)
@@ -338,7 +359,7 @@ def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False
             raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
         M = exact_jacobian(J)
         v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
-        P, r = _exact_pinv(M)
+        P, r = _budgeted_pinv(M, budget_seconds(time_budget), "inverse_velocity")
         out = (P * v).applyfunc(sp.radsimp)
         return (out, PinvReport(r, None, None)) if full_output else out
     A = numeric_jacobian(J)
@@ -355,7 +376,7 @@ def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False
 # ----------------------------------------------------------------------------------------------
 # damped least squares
 # ----------------------------------------------------------------------------------------------
-def damped_least_squares(J: Any, V: Any, damping: Any):
+def damped_least_squares(J: Any, V: Any, damping: Any, *, time_budget=TIME_BUDGET):
     """Damped least squares θ̇ = Jᵀ(J Jᵀ + λ²I)⁻¹ V = (Jᵀ J + λ²I)⁻¹ Jᵀ V = Σ σ_i/(σ_i² + λ²) v_i u_iᵀ V.
 
     The θ̇ minimising ‖J θ̇ − V‖² + λ²‖θ̇‖²: bounded by ‖V‖/(2λ) at every configuration (no blow-up at a
@@ -364,31 +385,30 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
 
     Numbers: the SVD form (stable), J (m, n) or (N, m, n), V (m,) or (N, m). SymPy: exact; with λ > 0 the
     matrix J Jᵀ + λ²I is positive definite, so the result holds for every configuration and J may keep its
-    symbols (small arms: the closed form grows fast); λ = 0 needs a constant J.
+    symbols (small arms: the closed form grows fast); λ = 0 needs a constant J. The exact path gets
+    ``time_budget`` seconds (default 60; None: no limit; :mod:`kinlib.budget`); past it
+    :class:`~kinlib.budget.ExactTimeoutError` (a ValueError) says what would work.
 
     >>> import sympy as sp
     >>> damped_least_squares(sp.Matrix([[1, 0], [0, 0]]), [1, 1], 1).T    # singular J: the 2nd direction is dropped
     Matrix([[1/2, 0]])
     """
+    seconds = budget_seconds(time_budget)
     if is_symbolic(J, V, damping):
         lam = _damping(damping)
         M = exact_jacobian(J)
         v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
         if lam == 0:
-            return inverse_velocity(M, v)
-        m, n = M.shape
-        const = not (M.free_symbols or lam.free_symbols)
-        fast = _field_dls(M, lam, v) if const else None
-        if fast is not None:
-            return fast if not v.free_symbols else (fast * v).applyfunc(sp.radsimp)
-        kw = {"iszerofunc": lambda e: decide_zero(e, "a pivot")} if const else {}
-        if m <= n:
-            out = M.T * (M * M.T + lam**2 * sp.eye(m)).LUsolve(v, **kw)
-        else:
-            out = (M.T * M + lam**2 * sp.eye(n)).LUsolve(M.T * v, **kw)
-        return out.applyfunc(
-            lambda e: sp.radsimp(sp.simplify(e)) if const and not e.has(sp.sin, sp.cos) else sp.cancel(e)
-        )
+            return inverse_velocity(M, v, time_budget=time_budget)
+        try:
+            with within(seconds, "damped_least_squares"):
+                return _exact_dls(M, lam, v)
+        except OutOfTime:
+            raise _timeout(
+                "damped_least_squares",
+                seconds,
+                "the closed form in the joint symbols grows fast: give J at a configuration (exact values) or floats",
+            ) from None
     lam = float(_damping(damping))
     A = numeric_jacobian(J)
     v = numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
@@ -398,6 +418,28 @@ def damped_least_squares(J: Any, V: Any, damping: Any):
     g = s / (s * s + lam * lam)
     P = np.swapaxes(Vt, -1, -2) @ (g[..., :, None] * np.swapaxes(U, -1, -2))
     return _apply(P, v, "V")
+
+
+def _exact_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
+    m, n = M.shape
+    const = not (M.free_symbols or lam.free_symbols)
+    fast = _field_dls(M, lam, v) if const else None
+    if fast is not None:
+        return fast if not v.free_symbols else (fast * v).applyfunc(sp.radsimp)
+    if not const:  # in the joint symbols: G = J Jᵀ + λ²I is positive definite, G⁻¹ = adj G / det G, each
+        # simplified modulo sin² + cos² = 1 (LUsolve + cancel on the raw entries took > 900 s for the 2R arm)
+        from .singularities import trig_simplify
+
+        G = trig_simplify(M * M.T if m <= n else M.T * M) + lam**2 * sp.eye(min(m, n))
+        det = trig_simplify(G.det(method="berkowitz"))
+        num = M.T * (G.adjugate(method="berkowitz") * v) if m <= n else G.adjugate(method="berkowitz") * (M.T * v)
+        return num.applyfunc(lambda e: trig_simplify(e) / det)
+    kw = {"iszerofunc": lambda e: decide_zero(e, "a pivot")}
+    if m <= n:
+        out = M.T * (M * M.T + lam**2 * sp.eye(m)).LUsolve(v, **kw)
+    else:
+        out = (M.T * M + lam**2 * sp.eye(n)).LUsolve(M.T * v, **kw)
+    return out.applyfunc(lambda e: sp.radsimp(sp.simplify(e)) if const and not e.has(sp.sin, sp.cos) else sp.cancel(e))
 
 
 def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
@@ -469,7 +511,7 @@ def joint_torques(J: Any, F: Any):
     return _apply(np.swapaxes(A, -1, -2), f, "F")
 
 
-def force_ellipsoid(J: Any, rows: Any = None):
+def force_ellipsoid(J: Any, rows: Any = None, *, time_budget=TIME_BUDGET):
     """The force ellipsoid {F : ‖Jᵀ F‖ ≤ 1}: (semi-axis lengths 1/σ_i, unit directions u_i as columns).
 
     Dual to the velocity ellipsoid {J θ̇ : ‖θ̇‖ ≤ 1} (:func:`kinlib.manipulability.velocity_ellipsoid`, lengths
@@ -480,7 +522,9 @@ def force_ellipsoid(J: Any, rows: Any = None):
     max(m, n)·ε·σ_max counts as 0) or ``sp.oo`` (exact): the structure resists that force with no torque.
     When m > n the ellipsoid is also unbounded along the m − n directions of the left null space of J (not
     among the k returned, as the velocity ellipsoid's flat directions are not).
-    Numbers: lengths (k,) and directions (m, k); a batch (N, m, n) gives (N, k), (N, m, k). SymPy: exact.
+    Numbers: lengths (k,) and directions (m, k); a batch (N, m, n) gives (N, k), (N, m, k). SymPy: exact, with
+    velocity_ellipsoid's ``time_budget`` and fallback (60-digit Floats with a NumericFallbackWarning for a
+    constant J; a ValueError for a J with free symbols).
 
     >>> import sympy as sp
     >>> force_ellipsoid(sp.Matrix([[2, 0], [0, 0]]))
@@ -489,7 +533,7 @@ def force_ellipsoid(J: Any, rows: Any = None):
     [0, 1]]))
     """
     if is_symbolic(J):
-        lengths, U = velocity_ellipsoid(J, rows)
+        lengths, U = velocity_ellipsoid(J, rows, time_budget=time_budget)
         out = []
         for s in lengths:
             try:
@@ -498,7 +542,7 @@ def force_ellipsoid(J: Any, rows: Any = None):
                 if not s.free_symbols:
                     raise
                 zero = False  # not identically zero: 1/s is exact wherever s ≠ 0
-            out.append(sp.oo if zero else sp.radsimp(1 / s))
+            out.append(sp.oo if zero else (1 / s if s.has(sp.CRootOf) or s.is_Float else sp.radsimp(1 / s)))
         return out, U
     A = numeric_jacobian(J)
     if rows is None and A.shape[-2] == 6:

@@ -1,0 +1,212 @@
+"""Time budgets for exact computations: every exact call answers, falls back or refuses within a stated time.
+
+An exact computation (a rank proof, a closed-form eigen-decomposition, a determinant of symbolic minors) can
+grow far beyond what its input suggests. Each public function of the exact engine takes ``time_budget``
+(seconds) and runs its exact part inside :func:`within`; when the budget runs out the function returns its
+documented fallback (a 60-digit numeric answer flagged as such) or raises :class:`ExactTimeoutError`, a
+``ValueError`` that says what would work.
+
+What is counted: **seconds of computation**, the CPU time of the thread doing the work (``time.thread_time``),
+so a budget gives the same answer on an idle laptop and on a loaded CI machine (where the wall time is longer by
+the load factor); on an idle machine it is the wall time. Where a thread's CPU clock cannot be read from another
+thread (macOS, Windows), the watchdog counts wall time instead.
+
+How the budget is enforced (both mechanisms, whichever stops the work first):
+
+* **a watchdog thread** (one per process, started on first use) raises an exception *into the working thread*
+  when its deadline passes (CPython's ``PyThreadState_SetAsyncExc``). This works in any thread (the main thread
+  of a script, a Jupyter kernel's executing thread, a grader's worker thread), needs no signal handler (unlike
+  ``SIGALRM``, main thread only), and stops pure-Python work inside SymPy too. The exception derives from
+  ``BaseException``, so library code that catches ``Exception`` cannot swallow it, and it is raised again every
+  50 ms until the budgeted block has ended. One C call (a huge integer product) finishes before it lands.
+  Where threads are not available (Pyodide, i.e. JupyterLite in the browser) only the next mechanism applies.
+* **cooperative checks**: kinlib's own loops call :func:`check`, which raises the same exception when the
+  deadline has passed.
+
+After an interrupted computation SymPy's caches are cleared (an interrupted assumption query could otherwise
+stay "unknown" on a cached expression; kinlib never decides a zero from assumptions, so answers are unaffected).
+
+>>> import time
+>>> try:
+...     with within(0.05, "a slow loop"):
+...         while True:
+...             check()
+... except OutOfTime as err:
+...     print(err.what, err.seconds)
+a slow loop 0.05
+"""
+
+from __future__ import annotations
+
+import ctypes
+import sys
+import threading
+import time
+from typing import Any
+
+__all__ = ["within", "check", "remaining", "clock", "OutOfTime", "ExactTimeoutError", "budget_seconds", "THREADED"]
+
+#: True where the watchdog thread can interrupt SymPy itself (CPython with threads); False in Pyodide
+THREADED = sys.implementation.name == "cpython" and sys.platform not in ("emscripten", "wasi")
+_REARM = 0.05  # seconds between repeated interrupts if the first one was swallowed
+
+
+class OutOfTime(Exception):
+    """A budgeted block ran out of time (raised by :func:`within` when the block ends; ``what``, ``seconds``)."""
+
+    def __init__(self, what: str, seconds: float):
+        super().__init__(f"{what}: out of time after {seconds} s")
+        self.what, self.seconds = what, seconds
+
+
+class ExactTimeoutError(ValueError):
+    """An exact computation did not finish within its ``time_budget`` and has no numeric fallback here (the
+    message says what would work: numbers for the parameters, a configuration, a larger budget)."""
+
+
+class _Expired(BaseException):
+    """Raised inside the budgeted block (a BaseException: ``except Exception`` in library code lets it pass)."""
+
+
+def clock() -> float:
+    """This thread's CPU time in seconds: the clock budgets count (kinlib's cooperative deadlines use it too)."""
+    try:
+        return time.thread_time()
+    except (AttributeError, OSError):  # pragma: no cover - platforms without a thread clock
+        return time.monotonic()
+
+
+def _thread_clock(tid: int):
+    """A function reading thread ``tid``'s CPU time from any thread, or None where that is not possible."""
+    try:
+        cid = time.pthread_getcpuclockid(tid)
+        time.clock_gettime(cid)
+    except (AttributeError, OSError, ValueError, OverflowError):
+        return None
+    return lambda: time.clock_gettime(cid)
+
+
+_local = threading.local()
+_cond = threading.Condition()
+_armed: dict = {}  # token -> [deadline on the thread's clock, thread id, exception class, that clock]
+_watchdog: threading.Thread | None = None
+
+
+def _stack() -> list:
+    if not hasattr(_local, "stack"):
+        _local.stack = []
+    return _local.stack
+
+
+def _async_raise(tid: int, exc) -> None:
+    ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), ctypes.py_object(exc) if exc else None)
+
+
+def _watch() -> None:
+    with _cond:
+        while True:
+            wait = None
+            for entry in _armed.values():
+                left = entry[0] - entry[3]()
+                if left <= 0:
+                    _async_raise(entry[1], entry[2])
+                    entry[0] = entry[3]() + _REARM
+                    left = _REARM
+                # CPU time runs no faster than wall time: waiting `left` wall seconds never overshoots
+                wait = left if wait is None else min(wait, left)
+            _cond.wait(None if wait is None else max(0.001, wait))
+
+
+def _start_watchdog() -> bool:
+    global _watchdog
+    if not THREADED:
+        return False
+    if _watchdog is None or not _watchdog.is_alive():
+        try:
+            _watchdog = threading.Thread(target=_watch, name="kinlib-budget-watchdog", daemon=True)
+            _watchdog.start()
+        except RuntimeError:  # no threads here after all
+            _watchdog = None
+            return False
+    return True
+
+
+class within:
+    """``with within(seconds, what):`` run the block with a deadline; :class:`OutOfTime` when it runs out.
+
+    Nested budgets each keep their own deadline (an outer one that expires ends the inner block too). ``seconds``
+    None means no limit (the block runs to its end)."""
+
+    def __init__(self, seconds: float | None, what: str):
+        self.seconds, self.what = seconds, what
+
+    def __enter__(self):
+        self.exc = type("_Expired", (_Expired,), {})  # a class of its own: nested budgets tell theirs apart
+        self.deadline = float("inf") if self.seconds is None else clock() + float(self.seconds)
+        self.token, self.tid = object(), threading.get_ident()
+        _stack().append(self)
+        if self.seconds is not None and _start_watchdog():
+            read = _thread_clock(self.tid)
+            deadline = self.deadline
+            if read is None:  # no cross-thread CPU clock here: the watchdog counts wall time
+                read, deadline = time.monotonic, time.monotonic() + float(self.seconds)
+            with _cond:
+                _armed[self.token] = [deadline, self.tid, self.exc, read]
+                _cond.notify()
+        return self
+
+    def _disarm(self) -> bool:
+        """Stop the watchdog for this block; True when an interrupt landed during this bookkeeping."""
+        landed = False
+        while True:
+            try:
+                with _cond:
+                    if _armed.pop(self.token, None) is not None:
+                        _async_raise(self.tid, None)  # clear an interrupt set but not yet delivered
+                break
+            except self.exc:
+                landed = True
+        return landed
+
+    def __exit__(self, et, ev, tb):
+        landed = self._disarm()
+        stack = _stack()
+        if self in stack:
+            stack.remove(self)
+        if (et is not None and issubclass(et, self.exc)) or landed:
+            from sympy.core.cache import clear_cache
+
+            clear_cache()
+            raise OutOfTime(self.what, self.seconds) from None
+        return False
+
+
+def check() -> None:
+    """Raise the current thread's budget expiry if a deadline has passed (kinlib's loops call this)."""
+    stack = getattr(_local, "stack", None)
+    if stack:
+        now = clock()
+        for b in stack:  # the outermost expired budget wins (it ends every block inside it)
+            if now > b.deadline:
+                raise b.exc
+
+
+def remaining() -> float:
+    """Seconds left in the innermost budget of this thread (inf without one)."""
+    stack = getattr(_local, "stack", None)
+    if not stack:
+        return float("inf")
+    return max(0.0, min(b.deadline for b in stack) - clock())
+
+
+def budget_seconds(time_budget: Any, name: str = "time_budget") -> float | None:
+    """``time_budget`` checked: a number of seconds ≥ 0, or None (no limit)."""
+    if time_budget is None:
+        return None
+    if isinstance(time_budget, bool) or not isinstance(time_budget, (int, float)) or not time_budget >= 0:
+        from ._backend import describe
+
+        raise ValueError(f"{name} must be a number of seconds ≥ 0 (or None: no limit), got {describe(time_budget)}")
+    if time_budget == float("inf"):
+        return None
+    return float(time_budget)
