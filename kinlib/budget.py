@@ -52,7 +52,11 @@ _REARM = 0.05  # seconds between repeated interrupts if the first one was swallo
 
 
 class OutOfTime(Exception):
-    """A budgeted block ran out of time (raised by :func:`within` when the block ends; ``what``, ``seconds``)."""
+    """A budgeted block ran out of time (raised by :func:`within` when the block ends; ``what``, ``seconds``).
+
+    >>> str(OutOfTime("rank_at", 60.0))
+    'rank_at: out of time after 60.0 s'
+    """
 
     def __init__(self, what: str, seconds: float):
         super().__init__(f"{what}: out of time after {seconds} s")
@@ -61,7 +65,11 @@ class OutOfTime(Exception):
 
 class ExactTimeoutError(ValueError):
     """An exact computation did not finish within its ``time_budget`` and has no numeric fallback here (the
-    message says what would work: numbers for the parameters, a configuration, a larger budget)."""
+    message says what would work: numbers for the parameters, a configuration, a larger budget).
+
+    >>> issubclass(ExactTimeoutError, ValueError)   # a refusal: callers that catch ValueError see it
+    True
+    """
 
 
 class _Expired(BaseException):
@@ -69,7 +77,11 @@ class _Expired(BaseException):
 
 
 def clock() -> float:
-    """This thread's CPU time in seconds: the clock budgets count (kinlib's cooperative deadlines use it too)."""
+    """This thread's CPU time in seconds: the clock budgets count (kinlib's cooperative deadlines use it too).
+
+    >>> t0 = clock(); _ = sum(range(10**5)); clock() >= t0
+    True
+    """
     try:
         return time.thread_time()
     except (AttributeError, OSError):  # pragma: no cover - platforms without a thread clock
@@ -135,7 +147,12 @@ class within:
     """``with within(seconds, what):`` run the block with a deadline; :class:`OutOfTime` when it runs out.
 
     Nested budgets each keep their own deadline (an outer one that expires ends the inner block too). ``seconds``
-    None means no limit (the block runs to its end)."""
+    None means no limit (the block runs to its end).
+
+    >>> with within(None, "no limit"):
+    ...     remaining()
+    inf
+    """
 
     def __init__(self, seconds: float | None, what: str):
         self.seconds, self.what = seconds, what
@@ -182,7 +199,10 @@ class within:
 
 
 def check() -> None:
-    """Raise the current thread's budget expiry if a deadline has passed (kinlib's loops call this)."""
+    """Raise the current thread's budget expiry if a deadline has passed (kinlib's loops call this).
+
+    >>> check()   # no budget in force: nothing happens
+    """
     stack = getattr(_local, "stack", None)
     if stack:
         now = clock()
@@ -192,7 +212,12 @@ def check() -> None:
 
 
 def remaining() -> float:
-    """Seconds left in the innermost budget of this thread (inf without one)."""
+    """Seconds left in the innermost budget of this thread (inf without one).
+
+    >>> with within(30, "a rank proof"):
+    ...     0 < remaining() <= 30
+    True
+    """
     stack = getattr(_local, "stack", None)
     if not stack:
         return float("inf")
@@ -200,7 +225,15 @@ def remaining() -> float:
 
 
 def budget_seconds(time_budget: Any, name: str = "time_budget") -> float | None:
-    """``time_budget`` checked: a number of seconds ≥ 0, or None (no limit)."""
+    """``time_budget`` checked: a number of seconds ≥ 0, or None (no limit).
+
+    >>> budget_seconds(5), budget_seconds(None), budget_seconds(float("inf"))
+    (5.0, None, None)
+    >>> budget_seconds(-1)
+    Traceback (most recent call last):
+        ...
+    ValueError: time_budget must be a number of seconds ≥ 0 (or None: no limit), got int -1
+    """
     if time_budget is None:
         return None
     if isinstance(time_budget, bool) or not isinstance(time_budget, (int, float)) or not time_budget >= 0:

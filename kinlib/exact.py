@@ -51,6 +51,7 @@ from .exactfield import (
     exact_is_zero,
     mp_matrix,
 )
+from .fallback import NumericFallbackWarning, fallback_rank, fallback_rref, fallback_warning
 from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = [
@@ -91,26 +92,9 @@ def exact_det(M: sp.Matrix) -> sp.Expr:
         return sp.expand(M.det(method="bareiss"))
 
 
-#: the relative size (10^-40 σ_max) below which the numeric fallback counts a singular value as zero
-FALLBACK_ZERO_DIGITS = 40
 #: exact elimination only while (largest multiple n of the common angle measure g) × min(m, n) ≤ this
 #: (a 6×6 J: multiples up to 16, a few seconds; beyond, the 60-digit fallback answers, and says so)
 EXACT_BUDGET = 100
-
-
-class NumericFallbackWarning(UserWarning):
-    """A result was computed numerically (mpmath, 60 digits) because an exact decision was out of reach.
-
-    >>> import warnings, sympy as sp
-    >>> from kinlib.robots import planar_2r
-    >>> r = planar_2r(1, 2)
-    >>> J = r.jacobian_geometric()[[3, 4], :]   # rows ṗ_x, ṗ_y
-    >>> with warnings.catch_warnings(record=True) as caught:
-    ...     warnings.simplefilter("always")
-    ...     B = column_space(J, [sp.sqrt(2), 0], r.thetas)   # θ2 = 0: a rank drop; θ1 = √2: no exact field
-    >>> [w.category.__name__ for w in caught], B.shape
-    (['NumericFallbackWarning'], (2, 1))
-    """
 
 
 class ConditionalResultWarning(UserWarning):
@@ -466,66 +450,6 @@ def _conditions(A: sp.Matrix, an: _Analysis) -> tuple:
 
 
 # ----------------------------------------------------------------------------------------------
-# the numeric fallback (stated precision)
-# ----------------------------------------------------------------------------------------------
-def _fallback_rank(A: sp.Matrix) -> tuple:
-    import mpmath
-
-    X = mp_matrix(A)
-    with mpmath.workdps(FALLBACK_DIGITS):
-        s = mpmath.svd_r(X, compute_uv=False)
-        sv = sorted((abs(x) for x in s), reverse=True)
-        top = sv[0] if sv else mpmath.mpf(0)
-        tol = top * mpmath.mpf(10) ** (-FALLBACK_ZERO_DIGITS)
-        r = sum(1 for x in sv if x > tol)
-    return r, sv
-
-
-def _fallback_rref(A: sp.Matrix) -> sp.Matrix:
-    """Nonzero rows of rref(A) as ``FALLBACK_DIGITS``-digit Floats: the rank from the 60-digit SVD, the elimination
-    (partial pivoting) with 20 guard digits, so each entry carries the 60 digits it shows (entries of A to ~100)."""
-    import mpmath
-
-    X = mp_matrix(A)
-    r, sv = _fallback_rank(A)
-    with mpmath.workdps(FALLBACK_DIGITS + 20):
-        m, n = X.rows, X.cols
-        X = X.copy()
-        tol = (sv[0] if sv else 0) * mpmath.mpf(10) ** (-FALLBACK_ZERO_DIGITS)
-        row, piv = 0, []
-        for j in range(n):
-            if row == m:
-                break
-            k = max(range(row, m), key=lambda i: abs(X[i, j]))
-            if abs(X[k, j]) <= tol:
-                continue
-            X[row, :], X[k, :] = X[k, :], X[row, :]
-            X[row, :] = X[row, :] / X[row, j]
-            for i in range(m):
-                if i != row and X[i, j] != 0:
-                    X[i, :] = X[i, :] - X[i, j] * X[row, :]
-            piv.append(j)
-            row += 1
-        rows = [
-            [
-                sp.Float(mpmath.nstr(X[i, j], FALLBACK_DIGITS), FALLBACK_DIGITS) if abs(X[i, j]) > tol else sp.S.Zero
-                for j in range(n)
-            ]
-            for i in range(row)
-        ]
-    return sp.Matrix(rows) if rows else sp.zeros(0, n)
-
-
-def _fallback_warning(what: str, why: str):
-    warnings.warn(
-        f"{what}: no exact decision here ({why}); computed with {FALLBACK_DIGITS}-digit numerics "
-        f"(singular values below 1e-{FALLBACK_ZERO_DIGITS}·σ_max counted as zero, not proven)",
-        NumericFallbackWarning,
-        stacklevel=3,
-    )
-
-
-# ----------------------------------------------------------------------------------------------
 # public functions
 # ----------------------------------------------------------------------------------------------
 def _numeric_J(J: Any, name: str = "J") -> np.ndarray:
@@ -647,7 +571,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None,
                 return Rank(an.rank, unless=unless, note="exact elimination in K(tan(g/2), parameters)")
     except OutOfTime:
         why = _late(seconds)
-    r, _ = _fallback_rank(_numbers_only(M, "rank_at", why, seconds))
+    r, _ = fallback_rank(_numbers_only(M, "rank_at", why, seconds))
     return Rank(r, exact=False, note=f"{FALLBACK_DIGITS}-digit SVD ({why})")
 
 
@@ -695,8 +619,8 @@ def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = 
     except OutOfTime:
         why = _late(seconds)
     A = _numbers_only(A, "column_space", why, seconds)
-    _fallback_warning("column_space", why)
-    return _fallback_rref(A).T
+    fallback_warning("column_space", why)
+    return fallback_rref(A).T
 
 
 def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None, *, time_budget=TIME_BUDGET):
@@ -737,8 +661,8 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
     except OutOfTime:
         why = _late(seconds)
     A = _numbers_only(A, "left_null_space", why, seconds)
-    _fallback_warning("left_null_space", why)
-    return _null_from_rref(_fallback_rref(A), m, fallback=True)
+    fallback_warning("left_null_space", why)
+    return _null_from_rref(fallback_rref(A), m, fallback=True)
 
 
 def _null_from_rref(R: sp.Matrix, m: int, fallback: bool = False) -> sp.Matrix:

@@ -1,7 +1,7 @@
 """Notebook 07 (exercises beyond the problem set) is graded and self-checked like the others (issue 21, item 7).
 
 For every answer of 7.1–7.5 the workbook self-check (:mod:`kinlib.course.workbook.selfcheck`: a fingerprint of the
-reference, the student's value checked against it) and the grader (:func:`kinlib.course.grader.in_kernel.probe.describe` then
+reference, the student's value checked against it) and the grader (:func:`kinlib.course.answers.describe.describe` of the value exported from the kernel, then
 :func:`kinlib.course.answers.compare.compare`, both sides through a JSON round trip as across the kernel boundary) are
 fed the right answer, other valid forms of it, and wrong answers (the mistakes a student makes).
 
@@ -21,7 +21,9 @@ import sympy as sp
 
 from kinlib.course import schema
 from kinlib.course.answers import compare as C
-from kinlib.course.grader.in_kernel import probe
+from kinlib.course.answers import describe as probe
+from kinlib.course.answers import wire
+from kinlib.course.grader.in_kernel.export import export
 from kinlib.course.workbook.selfcheck import fingerprint
 from kinlib.course.workbook.selfcheck import verdict as sc_verdict
 
@@ -184,9 +186,14 @@ CASES = {
 }
 
 
+def _crossed(value):
+    """The value as the grader sees it: exported in the kernel, sent as JSON, read by the whitelist parser."""
+    return wire.load(json.loads(json.dumps(export(value))))
+
+
 def _grader(kind, student, reference, name):
-    stu = json.loads(json.dumps(probe.describe(kind, student, POINTS, 0)))
-    ref = json.loads(json.dumps(probe.describe(kind, reference, POINTS, 0)))
+    stu = json.loads(json.dumps(probe.describe(kind, _crossed(student), POINTS, 0)))
+    ref = json.loads(json.dumps(probe.describe(kind, _crossed(reference), POINTS, 0)))
     return C.compare(kind, stu, ref, name)
 
 

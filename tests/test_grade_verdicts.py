@@ -27,6 +27,8 @@ from kinlib import robots
 from kinlib.course import schema
 from kinlib.course.answers import compare as C
 from kinlib.course.answers import describe as probe
+from kinlib.course.answers import wire
+from kinlib.course.grader.in_kernel.export import export
 from kinlib.singularities import task_rows
 
 pi = sp.pi
@@ -344,6 +346,9 @@ def test_5_5_the_students_own_robot_is_judged_by_its_property():
         ok, msg = verdict(PROP, chain, robots.planar_rpp(), "redesign")
         assert ok, (label, msg)
         assert "R-P-P" not in msg and "= 1" not in msg
+        # as the grader receives it: exported in the student's kernel, read by the whitelist parser
+        crossed = wire.load(json.loads(json.dumps(export(chain))))
+        assert verdict(PROP, crossed, robots.planar_rpp(), "redesign")[0], label
     ok, msg = verdict(PROP, Jr, robots.planar_rpp(), "redesign")  # its task Jacobian J
     assert ok, msg
     c1, s1 = sp.cos(TH[0]), sp.sin(TH[0])
