@@ -324,13 +324,14 @@ def _handouts(args) -> int:
 
 
 def _grade(args) -> int:
-    from .grade import SandboxUnavailable, find_submissions, grade_batch
+    from .grade import SandboxUnavailable, grade_batch
+    from .intake import find_submissions
     from .report import summary_table
 
     if not args.submissions:
         return _rewrite_class_files(args)
     try:
-        subs = find_submissions(args.submissions)
+        subs = find_submissions(args.submissions)  # usage errors now; grade_batch finds them again (ids: their roots)
     except FileNotFoundError as exc:
         args.parser.error(str(exc))
     if args.notebooks is not None and not args.notebooks.is_dir():
@@ -353,7 +354,7 @@ def _grade(args) -> int:
         return 2
     try:
         summary = grade_batch(
-            subs,
+            args.submissions,
             args.out,
             jobs=args.jobs,
             timeout=args.timeout,
