@@ -55,11 +55,11 @@ class _Worker:
     last_beat: float = field(default_factory=time.monotonic)
 
 
-def _set_subreaper() -> bool:
-    """Make this process adopt orphans of its descendants (Linux PR_SET_CHILD_SUBREAPER); False elsewhere."""
+def _set_subreaper(on: bool = True) -> bool:
+    """Make this process adopt (or stop adopting) orphans of its descendants (Linux PR_SET_CHILD_SUBREAPER)."""
     try:
         libc = ctypes.CDLL(None, use_errno=True)
-        return libc.prctl(36, 1, 0, 0, 0) == 0
+        return libc.prctl(36, int(on), 0, 0, 0) == 0
     except (OSError, AttributeError):
         return False
 
@@ -289,6 +289,9 @@ class Supervisor:
                 except subprocess.TimeoutExpired:
                     pass
                 self._kill(w)
+            if subreaper:
+                self._reap_orphans()
+                _set_subreaper(False)
         return results
 
     def _set(self, results, i, res) -> None:

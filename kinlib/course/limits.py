@@ -343,11 +343,11 @@ class Enclosure:
     def rlimits(self) -> dict:
         """The kernel's rlimits: per-process address space (a backstop; the cgroup limits the sum), file size,
         and, without a cgroup, the number of processes."""
-        out = {"as": max(self.limits.memory_bytes, 3 * 2**30), "fsize": self.limits.disk_bytes}
-        if not self.cgroups:
-            out["as"] = self.limits.memory_bytes
-            out["nproc"] = self.limits.processes
-        return out
+        if self.cgroups:  # the cgroup stops the sum first; this only stops one runaway mapping
+            return {"as": self.limits.memory_bytes + 2 * 2**30, "fsize": self.limits.disk_bytes}
+        # without one: per process only (an IPython kernel with NumPy and SymPy maps ~1 GiB before any answer)
+        as_ = max(self.limits.memory_bytes, 3 * 2**30)
+        return {"as": as_, "fsize": self.limits.disk_bytes, "nproc": self.limits.processes}
 
     def describe(self) -> str:
         """Which limits are in force, in words."""

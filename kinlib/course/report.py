@@ -320,8 +320,11 @@ def csv_text(rows: list) -> str:
     """
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
+    quoted = csv.writer(buf, lineterminator="\n", quoting=csv.QUOTE_ALL)
     for r in rows:
-        w.writerow([csv_cell(v) for v in r])
+        cells = [csv_cell(v) for v in r]
+        # the csv module quotes a cell with "\n" but not one with a lone "\r", which readers take as a line end
+        (quoted if any("\r" in c for c in cells) else w).writerow(cells)
     return buf.getvalue()
 
 
