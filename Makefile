@@ -46,7 +46,7 @@ poppler:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq poppler-utils >/dev/null; }
 
-# Debian's bubblewrap: the sandbox every student kernel runs in (kinlib.course.sandbox); `kinlib grade`
+# Debian's bubblewrap: the sandbox every student kernel runs in (kinlib.course.grader.isolation.sandbox); `kinlib grade`
 # refuses to grade without it unless given --no-sandbox.
 bubblewrap:
 	@command -v bwrap >/dev/null 2>&1 || { \
@@ -90,7 +90,7 @@ handouts: $(STAMP) chromium
 PORT ?= 8000
 site: $(STAMP)
 	@test -f build/handouts/index.html -a -f build/handouts/lite/jupyter-lite.json || $(MAKE) handouts
-	$(VENV)/bin/python -c "from kinlib.course.lite import serve; serve('build/handouts', $(PORT))"
+	$(VENV)/bin/python -c "from kinlib.course.publish.lite import serve; serve('build/handouts', $(PORT))"
 
 # Grade a class: make grade SUBMISSIONS=path/to/folder [JOBS=2] [OUT=build/grades]
 SUBMISSIONS ?= submissions

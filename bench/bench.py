@@ -816,7 +816,7 @@ def explorer_section(args, targets: Targets) -> list[str]:
 
 _GRADE_RUN = """
 import json, os, sys, time
-from kinlib.course.grade import grade_batch
+from kinlib.course.grader.grade import grade_batch
 subs, notebooks, cache, out = sys.argv[1:5]
 t0, c0 = time.monotonic(), time.process_time()
 s = grade_batch([subs], out, jobs=2, notebooks=notebooks, cache=cache, log=None)
@@ -916,8 +916,8 @@ def lite_section(args, targets: Targets) -> list[str]:
     labdriver, missing = _browser_driver()
     try:
         import test_lite
-        from kinlib.course import handouts, lite
-        from kinlib.course.pages import build_assets
+        from kinlib.course.publish import handouts, lite
+        from kinlib.course.publish.pages import build_assets
     except ImportError as exc:
         missing = missing or str(exc)
     if missing:
@@ -958,8 +958,8 @@ def grader_section(args, targets: Targets) -> list[str]:
     lines = ["## Instructor checker (`kinlib grade`, sandboxed)", ""]
     if args.quick:
         return lines + ["skipped (--quick)"]
-    if not (ROOT / "kinlib" / "course" / "grade.py").exists():
-        return lines + [f"{NA} (kinlib.course.grade missing)"]
+    if not (ROOT / "kinlib" / "course" / "grader" / "grade.py").exists():
+        return lines + [f"{NA} (kinlib.course.grader.grade missing)"]
     sols = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
     if not sols:
         return lines + [f"{NA} (no solution notebook to grade)"]

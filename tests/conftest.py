@@ -12,7 +12,7 @@ collect_ignore = ["fixtures"]
 
 @pytest.fixture(autouse=True, scope="session")
 def _grader_secret(tmp_path_factory):
-    """The grader's secret (kinlib.course.secret) for the whole run: a temporary file, never the tester's
+    """The grader's secret (kinlib.course.grader.secret) for the whole run: a temporary file, never the tester's
     ~/.config/kinlib/grader-secret (subprocesses inherit it through the environment)."""
     import os
 

@@ -75,7 +75,7 @@ def sites(tmp_path_factory):
     ``KINLIB_HANDOUTS_DIR=build/handouts`` tests an existing build of the real notebooks instead (a quick
     loop after ``make handouts``). A failing real notebook fails its pages' tests, not the fixture's.
     """
-    from kinlib.course import handouts
+    from kinlib.course.publish import handouts
 
     base = tmp_path_factory.mktemp("browser")
     out = {}

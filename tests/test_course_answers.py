@@ -1,4 +1,4 @@
-"""kinlib.course.answers: the one answer normaliser of the self-checks and of the instructor checker.
+"""kinlib.course.answers.normalise: the one answer normaliser of the self-checks and of the instructor checker.
 
 It replaced two (the self-check's coercions and the checker probe's); it accepts the union of the
 forms either accepted, and both consumers now accept each of them. The last tests check that: the same
@@ -16,9 +16,18 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from kinlib.course import compare, probe
-from kinlib.course.answers import choice_value, is_bool, is_unanswered, looks_like_set, set_conditions, to_set, to_sympy
-from kinlib.course.selfcheck import fingerprint, verdict
+from kinlib.course.answers import compare
+from kinlib.course.answers.normalise import (
+    choice_value,
+    is_bool,
+    is_unanswered,
+    looks_like_set,
+    set_conditions,
+    to_set,
+    to_sympy,
+)
+from kinlib.course.grader.in_kernel import probe
+from kinlib.course.workbook.selfcheck import fingerprint, verdict
 
 x, th1, th2 = sp.symbols("x theta1 theta2")
 COLS = [sp.Matrix([1, 2, 3]), sp.Matrix([4, 5, 6])]

@@ -127,7 +127,10 @@ def test_handouts_on_a_folder(capsys, tmp_path):
     ):
         assert (out / rel).is_file(), rel
     workbook = (out / "workbooks" / "01_fixture_jacobians.ipynb").read_text()
-    assert "from kinlib.course.selfcheck import check" in workbook and "%load_ext kinlib.course.selfcheck" in workbook
+    assert (
+        "from kinlib.course.workbook.selfcheck import check" in workbook
+        and "%load_ext kinlib.course.workbook.selfcheck" in workbook
+    )
     assert "kinlib handouts: wrote" in capsys.readouterr().out
 
 
@@ -187,12 +190,14 @@ def test_without_the_course_extra_the_command_says_what_to_install(command, caps
 
     def no_nbformat(name, *args, **kwargs):
         if name.split(".")[0] in ("nbformat", "nbclient", "nbconvert", "jupyter_client") or (
-            name in ("handouts", "grade") and args and (args[0] or {}).get("__package__") == "kinlib.course"
+            name in ("publish.handouts", "grader.grade")
+            and args
+            and (args[0] or {}).get("__package__") == "kinlib.course"
         ):
             raise ModuleNotFoundError(f"No module named {name!r}", name="nbformat")
         return real_import(name, *args, **kwargs)
 
-    for mod in ("kinlib.course.handouts", "kinlib.course.grade"):
+    for mod in ("kinlib.course.publish.handouts", "kinlib.course.grader.grade"):
         monkeypatch.delitem(sys.modules, mod, raising=False)
     monkeypatch.setattr(builtins, "__import__", no_nbformat)
     assert main(command) == 2

@@ -1,4 +1,4 @@
-"""kinlib.course.guard: what a notebook replaced is put back and reported; what the libraries change by
+"""kinlib.course.grader.in_kernel.guard: what a notebook replaced is put back and reported; what the libraries change by
 themselves (SymPy's RealField builds mpmath contexts, which re-wrap MPContext's class functions) is put back
 silently, so an honest notebook is never told it tampered with anything."""
 
@@ -9,7 +9,7 @@ import sympy
 from mpmath.ctx_mp import MPContext
 from sympy.polys.domains import RealField
 
-from kinlib.course import guard
+from kinlib.course.grader.in_kernel import guard
 
 
 def test_library_side_effects_are_not_reported():

@@ -1,4 +1,4 @@
-"""The instructor checker (``kinlib grade``, kinlib.course.grade) on a fixture notebook and, when present, notebook 02.
+"""The instructor checker (``kinlib grade``, kinlib.course.grader.grade) on a fixture notebook and, when present, notebook 02.
 
 One batch of submissions made from ``tests/fixtures/grade`` (the solution notebook, its workbook
 filled in right, filled in with mistakes, left untouched, and hostile ones) is graded once, two at a
@@ -15,10 +15,11 @@ from pathlib import Path
 
 import pytest
 
-from kinlib.course import compare as C
-from kinlib.course import grade, schema
+from kinlib.course import schema
+from kinlib.course.answers import compare as C
 from kinlib.course.cli import main
-from kinlib.course.secret import load_secret
+from kinlib.course.grader import grade
+from kinlib.course.grader.secret import load_secret
 
 FIX = Path(__file__).parent / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
@@ -89,8 +90,8 @@ MISTAKES_B = {
 }
 CHEAT = (
     "import builtins, kinlib, sympy\n"
-    "import kinlib.course.selfcheck\n"
-    "kinlib.course.selfcheck.check = lambda *a, **k: print('pass')\n"
+    "import kinlib.course.workbook.selfcheck\n"
+    "kinlib.course.workbook.selfcheck.check = lambda *a, **k: print('pass')\n"
     "sympy.simplify = lambda *a, **k: sympy.S.Zero\n"
     "sympy.Expr.evalf = lambda self, *a, **k: sympy.Float(0)\n"
     "sympy.MatrixBase.__eq__ = lambda a, b: True\n"

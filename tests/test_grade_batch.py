@@ -19,8 +19,9 @@ from pathlib import Path
 import mistune
 import pytest
 
-from kinlib.course import batch, grade, intake, limits, report
-from kinlib.course.lms import canvas_csv
+from kinlib.course.grader import batch, grade, intake, report
+from kinlib.course.grader.isolation import limits
+from kinlib.course.lms.bundles import canvas_csv
 
 FIX = Path(__file__).parent / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
@@ -378,6 +379,7 @@ def test_a_stopped_worker_is_noticed_by_its_heartbeat(tmp_path):
             os.kill(pid, signal.SIGSTOP)
 
     init = {"refs": {k: grade.asdict(v) for k, v in refs.items()}, "timeout": 60, "cell_timeout": 30}
+    init["handler"] = "kinlib.course.grader.grade:worker_handler"
     init.update(sandbox=grade.Sandbox(), secret=b"k" * 32, limits=None)
     tasks = [{"i": 0, "path": str(subs[0].path), "name": "victim", "relpath": "victim.ipynb", "root": str(d)}]
     events = []

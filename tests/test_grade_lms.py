@@ -1,4 +1,4 @@
-"""Gradescope, PrairieLearn and Canvas outputs (kinlib.course.lms), checked against the platforms' documented fields.
+"""Gradescope, PrairieLearn and Canvas outputs (kinlib.course.lms.bundles), checked against the platforms' documented fields.
 
 The validators below are written from the platforms' documentation, not from kinlib's output:
 
@@ -33,7 +33,8 @@ from pathlib import Path
 import pytest
 
 import workflow_fixture as wf
-from kinlib.course import credit, lms, report
+from kinlib.course.grader import credit, report
+from kinlib.course.lms import bundles as lms
 
 GS_VIS = {"visible", "hidden", "after_due_date", "after_published"}
 GS_TOP = {
@@ -301,7 +302,7 @@ def fixture_notebooks(tmp_path_factory):
 
 def _sandbox_ok() -> bool:
     try:
-        from kinlib.course import sandbox
+        from kinlib.course.grader.isolation import sandbox
 
         sandbox.check()
         return True
@@ -318,7 +319,7 @@ def test_gradescope_autograder_zip_in_a_simulated_container(tmp_path, fixture_no
     )  # fmt: skip
     names = zipfile.ZipFile(zpath).namelist()
     assert {"setup.sh", "run_autograder", "config.json", "references.json", "grader-secret"} <= set(names)
-    assert "kinlib-src/kinlib/course/grade.py" in names and not any("__pycache__" in n for n in names)
+    assert "kinlib-src/kinlib/course/grader/grade.py" in names and not any("__pycache__" in n for n in names)
     assert (tmp_path / "secret").read_bytes().strip() not in zipfile.ZipFile(zpath).read("grader-secret")
     scratch = tmp_path / "ag"
     zipfile.ZipFile(zpath).extractall(scratch / "source")

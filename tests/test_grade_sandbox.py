@@ -1,4 +1,4 @@
-"""The grader's sandbox and key (kinlib.course.sandbox, secret, refdata, srepr): each attack of issue 14 kept.
+"""The grader's sandbox and key (kinlib.course.grader.isolation.sandbox, secret, refdata, srepr): each attack of issue 14 kept.
 
 A batch of hostile submissions (an unanswered workbook plus one attack cell from tests/fixtures/grade/attacks)
 is graded once, sandboxed, two at a time. Each attack must gain nothing (every part still fails, and the
@@ -23,12 +23,13 @@ from pathlib import Path
 
 import pytest
 
-from kinlib.course import grade, sandbox
 from kinlib.course.cli import main
-from kinlib.course.kernel import Kernel
-from kinlib.course.refdata import reference_description
-from kinlib.course.secret import evaluation_seed, load_secret, sign
-from kinlib.course.srepr import parse_srepr
+from kinlib.course.grader import grade
+from kinlib.course.grader.in_kernel.srepr import parse_srepr
+from kinlib.course.grader.isolation import sandbox
+from kinlib.course.grader.isolation.kernel import Kernel
+from kinlib.course.grader.refdata import reference_description
+from kinlib.course.grader.secret import evaluation_seed, load_secret, sign
 
 FIX = Path(__file__).parent / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
@@ -253,7 +254,7 @@ def _points_attack(symbols: dict) -> str:
     """Part 1.2 answered wrong everywhere but at the points a public seed (the file's SHA-256) would give."""
     return (
         _right_detj_source()
-        + "\nimport hashlib, pathlib\nfrom kinlib.course.grade import make_points\n"
+        + "\nimport hashlib, pathlib\nfrom kinlib.course.grader.grade import make_points\n"
         + "data = next(pathlib.Path.cwd().glob('*.ipynb')).read_bytes()\n"
         + "pts = make_points("
         + repr(symbols)

@@ -1,8 +1,8 @@
 """Right verdicts from the grader's comparisons (issue 14, item 3), with messages that never give the key away.
 
 Every false pass and false fail reported in the issue is a test here, with the verdict it must get. The answers
-are described exactly as the grader describes them (:func:`kinlib.course.probe.describe`, the code a student
-kernel runs; the reference side uses the same function) and compared by :func:`kinlib.course.compare.compare`.
+are described exactly as the grader describes them (:func:`kinlib.course.grader.in_kernel.probe.describe`, the code a student
+kernel runs; the reference side uses the same function) and compared by :func:`kinlib.course.answers.compare.compare`.
 Oracles are independent of the comparison: the subspaces are built from known bases and mixings (numpy), the
 angle sets from known rational multiples of π, the redesigns' det(J Jᵀ) from hand-derived formulas.
 """
@@ -24,8 +24,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from kinlib import robots
-from kinlib.course import compare as C
-from kinlib.course import probe, schema
+from kinlib.course import schema
+from kinlib.course.answers import compare as C
+from kinlib.course.grader.in_kernel import probe
 from kinlib.singularities import task_rows
 
 pi = sp.pi
@@ -414,7 +415,7 @@ def _workbook(overrides: dict) -> dict:
 
 @pytest.mark.slow
 def test_end_to_end_verdicts_and_a_notebook_without_metadata(tmp_path):
-    from kinlib.course import grade
+    from kinlib.course.grader import grade
 
     subs = tmp_path / "subs"
     subs.mkdir()

@@ -16,8 +16,9 @@ from pathlib import Path
 import pytest
 
 import workflow_fixture as wf
-from kinlib.course import credit, intake, report, schema
+from kinlib.course import schema
 from kinlib.course.cli import main
+from kinlib.course.grader import credit, intake, report
 
 ROOT = Path(__file__).resolve().parent.parent
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
@@ -338,7 +339,7 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path, monkeypatc
     def boom(*a):
         raise OSError("disk full")
 
-    monkeypatch.setattr("kinlib.course.report.os.replace", boom)
+    monkeypatch.setattr("kinlib.course.grader.report.os.replace", boom)
     with pytest.raises(OSError):
         report.atomic_write(f, "new\n")
     assert f.read_text() == "old\n" and [p.name for p in tmp_path.iterdir()] == ["grades.csv"]
@@ -349,7 +350,7 @@ def test_atomic_write_keeps_the_old_file_when_writing_fails(tmp_path, monkeypatc
 
 @pytest.mark.slow
 def test_end_to_end_partial_manual_override_and_single_regrade(tmp_path):
-    from kinlib.course import grade
+    from kinlib.course.grader import grade
 
     nbs = tmp_path / "notebooks"
     wf.write_solution(nbs)

@@ -1,4 +1,4 @@
-"""``kinlib handouts`` (kinlib.course.handouts) and the workbook self-checks (kinlib.course.selfcheck).
+"""``kinlib handouts`` (kinlib.course.publish.handouts) and the workbook self-checks (kinlib.course.workbook.selfcheck).
 
 The end-to-end tests build the fixture notebook ``tests/fixtures/handouts/01_fixture_jacobians.ipynb``
 (every answer kind, a solution markdown cell, check cells, a figure, a widget, an animation, a cell that
@@ -19,10 +19,12 @@ import sympy as sp
 from IPython.core.inputtransformer2 import TransformerManager
 
 from kinlib import robots
-from kinlib.course import handouts, schema, selfcheck
-from kinlib.course.analysis import cell_names
+from kinlib.course import schema
 from kinlib.course.cli import main
-from kinlib.course.selfcheck import fingerprint, verdict
+from kinlib.course.publish import handouts
+from kinlib.course.publish.analysis import cell_names
+from kinlib.course.workbook import selfcheck
+from kinlib.course.workbook.selfcheck import fingerprint, verdict
 
 ROOT = Path(__file__).resolve().parents[1]
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"

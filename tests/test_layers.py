@@ -374,6 +374,56 @@ def test_layers():
     )
 
 
+#: kinlib.course laid out by where its code runs: each folder a package whose docstring says where
+COURSE_PACKAGES = {
+    "kinlib.course": "the schema and the `kinlib` command",
+    "kinlib.course.publish": "the instructor's machine: handouts, pages, PDFs, the in-browser site",
+    "kinlib.course.workbook": "the student's own notebook: self-checks",
+    "kinlib.course.answers": "what an answer is, when two are the same (self-check and grader)",
+    "kinlib.course.grader": "the trusted host",
+    "kinlib.course.grader.in_kernel": "sent as text into the untrusted student kernel",
+    "kinlib.course.grader.isolation": "the student kernel and its sandbox",
+    "kinlib.course.lms": "the LMS bundles",
+}
+#: the code kinlib.course.grader.isolation.kernel sends as source text into a student kernel
+SHIPPED_TO_KERNEL = {
+    "kinlib.course.grader.in_kernel.probe",
+    "kinlib.course.grader.in_kernel.guard",
+    "kinlib.course.grader.in_kernel.srepr",
+    "kinlib.course.answers.normalise",
+}
+
+
+def test_course_is_laid_out_by_where_its_code_runs():
+    """The course layer's packages are exactly the folders above; each says in its docstring what runs there
+    and imports nothing."""
+    packages = {m for m, p in MODULES.items() if layer(m) == "course" and p.name == "__init__.py"}
+    assert packages == set(COURSE_PACKAGES)
+    for m in packages:
+        tree = ast.parse(MODULES[m].read_text())
+        assert ast.get_docstring(tree), f"{_rel(MODULES[m])} has no docstring"
+        assert not [n for n in tree.body if isinstance(n, (ast.Import, ast.ImportFrom))], f"{m} imports"
+
+
+def test_code_sent_into_the_kernel_imports_only_what_the_kernel_has():
+    """What the grader ships as text into a student kernel is all of grader/in_kernel (plus the answer
+    normaliser), and imports only the standard library, SymPy, NumPy, mpmath and itself: in the kernel there is
+    no kinlib to import from."""
+    in_kernel = {m for m in MODULES if m.startswith("kinlib.course.grader.in_kernel.")}
+    assert in_kernel | {"kinlib.course.answers.normalise"} == SHIPPED_TO_KERNEL
+    kernel_src = MODULES["kinlib.course.grader.isolation.kernel"].read_text()
+    for m in SHIPPED_TO_KERNEL:
+        assert f'"{MODULES[m].name}"' in kernel_src, f"{m} is not read by kernel.py"
+    scan = _scan()
+    allowed = set(sys.stdlib_module_names) | set(CORE_DEPS) | {"__future__"}
+    bad = [f"{_rel(MODULES[m])}:{line}: {top}" for m, top, line in scan.external if m in SHIPPED_TO_KERNEL]
+    bad = [b for b in bad if b.rpartition(": ")[2] not in allowed]
+    bad += [
+        f"{e.where()}: {e.dst}" for e in scan.edges if e.src in SHIPPED_TO_KERNEL and e.dst not in SHIPPED_TO_KERNEL
+    ]
+    assert not bad, "code sent into the kernel imports beyond itself and its libraries:\n  " + "\n  ".join(bad)
+
+
 def test_core_needs_only_numpy_and_sympy():
     """Core modules import the standard library, numpy, sympy and mpmath only, at import time or later."""
     allowed = set(sys.stdlib_module_names) | set(CORE_DEPS) | {"__future__"}

@@ -1,4 +1,4 @@
-"""The JupyterLite site (kinlib/course/lite.py): pinned sources, sha256 verification that fails closed, links,
+"""The JupyterLite site (kinlib/course/publish/lite.py): pinned sources, sha256 verification that fails closed, links,
 serving; and (marked ``browser``, ``slow``) the site built as ``make handouts`` builds it, opened in Debian's
 chromium with every request that is not to the loopback server blocked: workbook 05 runs, a self-check answers,
 an explorer's picture follows its slider.
@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from kinlib.course import lite
+from kinlib.course.publish import lite
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -349,8 +349,8 @@ def labdriver_explorer_text() -> str:
 def handouts_site(tmp_path_factory):
     """Handouts of notebook 05 with the site, built as ``make handouts`` builds them (a download the first
     time, into the cache; offline after), with the app reachable from the test."""
-    from kinlib.course import handouts
-    from kinlib.course.pages import build_assets
+    from kinlib.course.publish import handouts
+    from kinlib.course.publish.pages import build_assets
 
     out = tmp_path_factory.mktemp("lite") / "handouts"
     t0 = time.perf_counter()

@@ -30,7 +30,7 @@ from pathlib import Path
 import pytest
 
 import labdriver
-from kinlib.course import handouts, pages, printing
+from kinlib.course.publish import handouts, pages, printing
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"

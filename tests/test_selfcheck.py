@@ -1,9 +1,9 @@
-"""The workbook self-check names the kind of mistake (kinlib.course.mistakes), never the answer.
+"""The workbook self-check names the kind of mistake (kinlib.course.answers.mistakes), never the answer.
 
 Each mistake is made here *forward*, independently of kinlib (a transpose is ``.T``, [v; ω] order is the
 two halves of the rows stacked the other way, degrees are the radians times 180/π), on random right
 answers (hypothesis), and the self-check's message for the wrong answer must name it; the instructor
-checker (kinlib.course.compare) must name the same mistake from the same answer. A wrong answer that is
+checker (kinlib.course.answers.compare) must name the same mistake from the same answer. A wrong answer that is
 no known mistake gets the neutral message, and no message holds a number of the right answer. The
 picture cell after a wrong answer says "fix the answer above first" (a small workbook run in a kernel).
 """
@@ -19,8 +19,9 @@ import sympy as sp
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from kinlib.course import compare, needs
-from kinlib.course.selfcheck import fingerprint, verdict
+from kinlib.course.answers import compare
+from kinlib.course.workbook import needs
+from kinlib.course.workbook.selfcheck import fingerprint, verdict
 
 SALT = "9.1:ans"
 th1, th2 = sp.symbols("theta1 theta2", real=True)
@@ -271,9 +272,9 @@ def test_a_picture_cell_after_a_wrong_answer_says_fix_the_answer(tmp_path):
     spec = fingerprint(sp.Matrix([[1, 2], [3, 4]]), salt="1.1:J")
     code = nbformat.v4.new_code_cell
     cells = [
-        code("%load_ext kinlib.course.selfcheck\nimport sympy as sp\nimport numpy as np"),
+        code("%load_ext kinlib.course.workbook.selfcheck\nimport sympy as sp\nimport numpy as np"),
         code("J = sp.Matrix([1, 2])  # a wrong shape"),
-        code(f'from kinlib.course.selfcheck import check\ncheck("1.1", J="{spec}")'),
+        code(f'from kinlib.course.workbook.selfcheck import check\ncheck("1.1", J="{spec}")'),
         code("%%needs J\nnp.array(J.tolist(), dtype=float)[1, 1]  # a 'picture' that indexes the answer"),
         code("%tb"),
         code("np.zeros(2)[5]  # a cell that does not use answers: its error shows as usual"),
@@ -295,7 +296,7 @@ def test_a_picture_cell_after_a_wrong_answer_says_fix_the_answer(tmp_path):
 
 def test_every_mistake_message_is_free_of_numbers_of_a_key():
     """The fixed words of every named mistake hold no digit but column/row numbers and 45° (the example)."""
-    from kinlib.course import mistakes
+    from kinlib.course.answers import mistakes
 
     for m in mistakes.MATRIX_MISTAKES + mistakes.SUBSPACE_MISTAKES + mistakes.SET_MISTAKES:
         words = m.message("")

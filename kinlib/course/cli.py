@@ -9,7 +9,7 @@
     kinlib grade prairielearn --out build/prairielearn [--only 05]
     kinlib grade canvas build/grades --assignment "Problem Set 4" --out canvas.csv [--roster export.csv]
 
-(``gradescope``, ``prairielearn`` and ``canvas`` right after ``grade`` are platforms, :mod:`kinlib.course.lms`;
+(``gradescope``, ``prairielearn`` and ``canvas`` right after ``grade`` are platforms, :mod:`kinlib.course.lms.bundles`;
 a submissions folder with one of those names is given as ``./gradescope``.)
 
 The console script (``kinlib = "kinlib.course.cli:main"``); ``python -m kinlib.course`` is the same.
@@ -57,7 +57,7 @@ def _positive_float(text: str) -> float:
 
 
 def _size(text: str) -> int:
-    from .limits import parse_size
+    from .grader.isolation.limits import parse_size
 
     try:
         return parse_size(text)
@@ -217,7 +217,7 @@ _LMS = ("gradescope", "prairielearn", "canvas")
 
 
 def build_lms_parser() -> argparse.ArgumentParser:
-    """The parser of ``kinlib grade gradescope|prairielearn|canvas`` (:mod:`kinlib.course.lms`).
+    """The parser of ``kinlib grade gradescope|prairielearn|canvas`` (:mod:`kinlib.course.lms.bundles`).
 
     >>> a = build_lms_parser().parse_args(["gradescope", "--out", "ag.zip", "--only", "05"])
     >>> a.platform, a.only, a.visibility
@@ -225,7 +225,7 @@ def build_lms_parser() -> argparse.ArgumentParser:
     >>> build_lms_parser().parse_args(["canvas", "build/grades", "--assignment", "PS4", "--out", "c.csv"]).id_column
     'ID'
     """
-    from .lms import VISIBILITIES
+    from .lms.bundles import VISIBILITIES
 
     ap = _Parser(prog=f"{PROG} grade", description="Grading on the platforms a class already uses.")
     sub = ap.add_subparsers(dest="platform", metavar="PLATFORM", required=True)
@@ -268,7 +268,7 @@ def build_lms_parser() -> argparse.ArgumentParser:
 
 
 def _lms_bundle(args) -> int:
-    from . import lms
+    from .lms import bundles as lms
 
     kw = dict(
         notebooks=args.notebooks,
@@ -293,7 +293,7 @@ def _lms_bundle(args) -> int:
 
 
 def _lms_canvas(args) -> int:
-    from .lms import canvas_csv
+    from .lms.bundles import canvas_csv
 
     try:
         warnings = canvas_csv(
@@ -316,7 +316,7 @@ def _lms_canvas(args) -> int:
 
 
 def _execute(args) -> int:
-    from .execute import execute_all
+    from .publish.execute import execute_all
 
     try:
         failures = execute_all(args.paths, timeout=args.timeout, log=lambda s: print(s, flush=True))
@@ -328,7 +328,7 @@ def _execute(args) -> int:
 
 
 def _handouts(args) -> int:
-    from .handouts import NotebookFailed, build
+    from .publish.handouts import NotebookFailed, build
 
     try:
         build(
@@ -350,17 +350,17 @@ def _handouts(args) -> int:
         print(f"{PROG} handouts: error: {_one_line(e)}", file=sys.stderr)
         return 2
     if args.serve:  # a local look at the site: loopback only; any static web host serves the folder as well
-        from .lite import serve
+        from .publish.lite import serve
 
         serve(args.out, args.port)
     return 0
 
 
 def _grade(args) -> int:
-    from .grade import SandboxUnavailable, grade_batch
-    from .intake import find_submissions
-    from .limits import Limits
-    from .report import summary_table
+    from .grader.grade import SandboxUnavailable, grade_batch
+    from .grader.intake import find_submissions
+    from .grader.isolation.limits import Limits
+    from .grader.report import summary_table
 
     if not args.submissions:
         return _rewrite_class_files(args)
@@ -373,7 +373,7 @@ def _grade(args) -> int:
     if not subs:
         print(f"{PROG} grade: no .ipynb submissions found", file=sys.stderr)
     log = (lambda s: None) if args.quiet else (lambda s: print(s, flush=True))
-    from . import credit, report
+    from .grader import credit, report
 
     if args.id_pattern is not None:
         try:
@@ -424,7 +424,7 @@ def _grade(args) -> int:
 def _rewrite_class_files(args) -> int:
     """``kinlib grade --out OUT`` without submissions: grades.csv, totals.csv and feedback again from the
     results kept in OUT, with the overrides as they are now."""
-    from . import report
+    from .grader import report
 
     if not report.load_results(args.out):
         args.parser.error(f"no submissions given, and no graded results kept in {args.out / 'results'}")

@@ -1,7 +1,7 @@
 """The notebook schema: the one place that reads cell tags, ``kinlib`` metadata and points.
 
 The solution notebooks in ``notebooks/`` follow one structure, read here for both the handouts
-(:mod:`kinlib.course.handouts`) and the checker (:mod:`kinlib.course.grade`):
+(:mod:`kinlib.course.publish.handouts`) and the checker (:mod:`kinlib.course.grader.grade`):
 
 * **notebook metadata** ``metadata.kinlib``: ``notebook`` (the id a submission is recognised by, students
   rename files), ``title``, ``sections``;
@@ -15,7 +15,7 @@ The solution notebooks in ``notebooks/`` follow one structure, read here for bot
   ``describe`` ({name: words for the workbook's stub}), ``points`` (overrides the
   question's points for that part), ``answer_points`` ({name: points} of answers within the part, for
   partial credit; answers not listed share the rest evenly) and ``manual`` ({label: points} of work graded
-  by hand, e.g. {"drawing": 5}; also allowed on ``solution`` markdown cells). See :mod:`kinlib.course.credit`.
+  by hand, e.g. {"drawing": 5}; also allowed on ``solution`` markdown cells). See :mod:`kinlib.course.grader.credit`.
 
 Cells may be nbformat ``NotebookNode`` objects or the plain dicts of ``json.load``; anything malformed
 (tags that are not a list, metadata that is not a dict) reads as absent rather than raising.
@@ -61,9 +61,9 @@ __all__ = [
 QUESTION, SOLUTION, CHECK, SELFCHECK = "question", "solution", "check", "selfcheck"
 ANSWER_TAGS = frozenset({SOLUTION, CHECK})
 KINDS = ("default", "expr", "choice", "set", "subspace")
-# the module a workbook's self-check cells import ``check`` from: today's, and the one of workbooks
-# handed out before the course tooling moved into kinlib.course
-SELFCHECK_MODULES = ("kinlib.course.selfcheck", "kinlib.selfcheck")
+# the module a workbook's self-check cells import ``check`` from: today's, and those of workbooks handed out
+# before kinlib.course was laid out in folders (kinlib.course.selfcheck) or existed (kinlib.selfcheck)
+SELFCHECK_MODULES = ("kinlib.course.workbook.selfcheck", "kinlib.course.selfcheck", "kinlib.selfcheck")
 _POINTS_RE = [re.compile(r"\((\d+(?:\.\d+)?)\s*points?\)", re.I), re.compile(r"(\d+(?:\.\d+)?)\s*points?\b", re.I)]
 
 
@@ -412,10 +412,10 @@ def stash_points(nb) -> dict:
 
 def is_plain_selfcheck(cell) -> bool:
     """A workbook self-check cell as ``kinlib handouts`` writes it: tagged ``selfcheck``, holding only
-    ``from kinlib.course.selfcheck import check`` (or the pre-``kinlib.course`` ``kinlib.selfcheck``) and
+    ``from kinlib.course.workbook.selfcheck import check`` (or an older workbook's ``kinlib.course.selfcheck`` or ``kinlib.selfcheck``) and
     ``check(...)`` calls with constant arguments. It cannot change an answer.
 
-    >>> src = 'from kinlib.course.selfcheck import check\\ncheck("1.1", J="matrix|6x3|0123456789abcdef")'
+    >>> src = 'from kinlib.course.workbook.selfcheck import check\\ncheck("1.1", J="matrix|6x3|0123456789abcdef")'
     >>> is_plain_selfcheck({"metadata": {"tags": ["selfcheck"]}, "source": src})
     True
     >>> is_plain_selfcheck({"metadata": {"tags": ["selfcheck"]}, "source": src + "\\nJ = 0"})

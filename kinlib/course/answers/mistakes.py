@@ -1,0 +1,352 @@
+"""Named mistakes: the known ways a right answer goes wrong, each with the transform that undoes it.
+
+Shared by the instructor checker (:func:`kinlib.course.answers.compare.compare_expr`, which compares numbers) and
+the workbook self-check (:mod:`kinlib.course.workbook.selfcheck`, which compares salted fingerprints): both take
+the student's answer, undo one known mistake (or two of the simple ones) and ask "is *this* the right
+answer?". The first yes names the mistake. Each :class:`Mistake` has
+
+- ``name``: a short id (``"negated"``, ``"transposed"``, ``"vw-order"``, ``"columns"``, ``"rows"``,
+  ``"degrees"``, ``"complement"``, ``"zero-based"``);
+- ``says``: the student-facing words that complete "<answer> ...", e.g. "is transposed (rows and columns
+  swapped)"; they name the mistake and never show a value of the answer;
+- ``candidates(A)``: the candidate right answers, as ``(detail, array)`` pairs, for the student's values
+  ``A`` (an array whose last two axes are rows and columns; NumPy numbers or SymPy numbers in an object
+  array: the transforms only move, negate and scale entries).
+
+Angle sets (:data:`SET_MISTAKES`) undo a mistake point by point (:func:`map_set`), choices
+(:data:`CHOICE_MISTAKES`) value by value; :func:`trig_degrees` rewrites degrees written inside sin/cos.
+
+*What it tells the student.* A self-check that says "your matrix is the transpose of the answer" tells
+only that the transpose of what they typed is right; the student could have typed the transpose and
+asked the plain self-check the same question. So the named mistakes add no information beyond saving
+tries, and the messages hold no numbers of the answer (tests/test_selfcheck.py checks this).
+
+>>> import numpy as np
+>>> R = np.arange(6.0).reshape(1, 2, 3)       # one sample point, a 2×3 matrix
+>>> found = search(-R, lambda X: X.shape == R.shape and np.allclose(X, R))
+>>> found.name, found.says
+('negated', 'has the wrong sign (every entry is negated)')
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+
+import numpy as np
+import sympy as sp
+
+__all__ = [
+    "Mistake",
+    "Found",
+    "MATRIX_MISTAKES",
+    "SUBSPACE_MISTAKES",
+    "SET_MISTAKES",
+    "CHOICE_MISTAKES",
+    "search",
+    "map_set",
+    "trig_degrees",
+    "shape_says",
+    "DEGREE_CONSTANTS",
+]
+
+DEGREE_CONSTANTS = frozenset(
+    {15, 30, 45, 60, 75, 90, 105, 120, 135, 150, 165, 180, 210, 225, 240, 270, 300, 315, 330, 360}
+)
+
+
+@dataclass(frozen=True)
+class Mistake:
+    """A known mistake: its id, what to tell the student, and the candidate right answers it suggests.
+
+    >>> MATRIX_MISTAKES[1].name, MATRIX_MISTAKES[1].message()
+    ('transposed', 'is transposed (rows and columns swapped)')
+    """
+
+    name: str
+    says: str
+    candidates: Callable[..., Iterator]
+    simple: bool = True  # may be combined with another simple mistake
+
+    def message(self, detail: str = "") -> str:
+        """The student-facing words, with the detail (e.g. which columns moved) when there is one."""
+        return self.says.format(detail=detail) if "{detail}" in self.says else self.says
+
+
+@dataclass(frozen=True)
+class Found:
+    """The mistake(s) found: ``name`` ("transposed" or "transposed+negated") and ``says``.
+
+    >>> Found("negated", "has the wrong sign (every entry is negated)").name
+    'negated'
+    """
+
+    name: str
+    says: str
+
+
+# ----------------------------------------------------------------------------- matrices and expressions
+
+
+def _rows(A, order):
+    return A[..., list(order), :]
+
+
+def _cols(A, order):
+    return A[..., :, list(order)]
+
+
+def _scale(A, exact, approx):
+    """A times a constant: SymPy's 30-digit value for object arrays (self-check), a float otherwise."""
+    return A * (sp.Float(exact.evalf(40), 40) if A.dtype == object else approx)
+
+
+def _negated(A):
+    yield ("" if A.shape[-2:] == (1, 1) else " (every entry is negated)"), -A
+
+
+def _transposed(A):
+    if A.shape[-1] > 1 or A.shape[-2] > 1:
+        yield "", np.swapaxes(A, -1, -2)
+
+
+def _vw_order(A):
+    r = A.shape[-2]
+    if r == 6:  # [v; ω] -> [ω; v]
+        yield "6", _rows(A, (3, 4, 5, 0, 1, 2))
+    elif r == 3:  # planar task rows (v_x, v_y, ω_z) -> (ω_z, v_x, v_y)
+        yield "3", _rows(A, (2, 0, 1))
+
+
+def _permutations(n: int, exhaustive: bool):
+    """Non-identity permutations of n items, fewest moved first (all of them for small n)."""
+    if n < 2:
+        return []
+    if n <= (6 if exhaustive else 4):
+        perms = [p for p in itertools.permutations(range(n)) if list(p) != list(range(n))]
+    else:  # two items swapped
+        perms = []
+        for i, j in itertools.combinations(range(n), 2):
+            p = list(range(n))
+            p[i], p[j] = j, i
+            perms.append(tuple(p))
+    return sorted(perms, key=lambda p: (sum(i != j for i, j in enumerate(p)), p))
+
+
+def _moved(perm, what):
+    return ", ".join(f"your {what} {i + 1} is {what} {j + 1}" for i, j in enumerate(perm) if i != j)
+
+
+def _columns(A, exhaustive=False):
+    for p in _permutations(A.shape[-1], exhaustive):  # student column i is the answer's column p[i]
+        yield _moved(p, "column"), _cols(A, np.argsort(p))
+
+
+def _rows_perm(A, exhaustive=False):
+    for p in _permutations(A.shape[-2], exhaustive):
+        yield _moved(p, "row"), _rows(A, np.argsort(p))
+
+
+def _degrees(A):
+    yield "", _scale(A, sp.pi / 180, math.pi / 180)
+
+
+_VW_SAYS = {
+    "6": "has the rows in [v; ω] order: the textbook stacks angular first, [ω; v] (rows 1–3 angular, rows 4–6 linear)",
+    "3": "has the rows in (v_x, v_y, ω_z) order: the planar task rows are (ω_z, v_x, v_y), angular first",
+}
+
+
+class _VwMistake(Mistake):
+    def message(self, detail: str = "") -> str:
+        return _VW_SAYS.get(detail, _VW_SAYS["6"])
+
+
+MATRIX_MISTAKES = (
+    Mistake("negated", "has the wrong sign{detail}", _negated),
+    Mistake("transposed", "is transposed (rows and columns swapped)", _transposed),
+    _VwMistake("vw-order", "", _vw_order),
+    Mistake("columns", "has its columns swapped: {detail} (column i belongs to joint i)", _columns, simple=False),
+    Mistake("rows", "has its rows swapped: {detail}", _rows_perm, simple=False),
+    Mistake("degrees", "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)", _degrees),
+)
+
+
+def search(A, matches: Callable, mistakes=MATRIX_MISTAKES, pairs: bool = True, exhaustive: bool = False):
+    """The first mistake whose undoing makes ``A`` right (``matches(candidate)`` is True), or None.
+
+    Single mistakes first, in the order of ``mistakes``; then, with ``pairs``, two simple ones (e.g.
+    transposed and negated). ``exhaustive`` tries every permutation of up to 6 rows or columns (the
+    checker compares numbers: cheap), else up to 4 and then only two swapped (the self-check hashes).
+
+    >>> R = np.array([[[1.0, 2.0], [3.0, 4.0]]])
+    >>> search(-R.transpose(0, 2, 1), lambda X: np.allclose(X, R)).name
+    'negated+transposed'
+    >>> search(R + 1, lambda X: np.allclose(X, R)) is None
+    True
+    """
+
+    def cands(m, X):
+        if m.name in ("columns", "rows"):
+            return m.candidates(X, exhaustive=exhaustive)
+        return m.candidates(X)
+
+    for m in mistakes:
+        for detail, C in cands(m, A):
+            if matches(C):
+                return Found(m.name, m.message(detail))
+    if not pairs:
+        return None
+    simple = [m for m in mistakes if m.simple]
+    for a, b in itertools.combinations(simple, 2):
+        for da, X in cands(a, A):
+            for db, C in cands(b, X):
+                if matches(C):
+                    return Found(f"{a.name}+{b.name}", f"{a.message(da)}, and {b.message(db)}")
+    return None
+
+
+def shape_says(yours: tuple, expected: tuple) -> str:
+    """Words for a wrong shape (the "wrong shape" mistake), naming a transposed shape as such.
+
+    >>> shape_says((3, 6), (6, 3))
+    'is transposed: yours is 3×6, expected 6×3 (one column per joint)'
+    >>> shape_says((4, 1), (2, 2))
+    'has the wrong shape: yours is 4×1, expected 2×2'
+    """
+
+    def words(s):
+        return "a scalar" if not s else "×".join(map(str, s))
+
+    if len(yours) == 2 and tuple(yours)[::-1] == tuple(expected):
+        tail = " (one column per joint)" if expected[0] == 6 else ""
+        return f"is transposed: yours is {words(yours)}, expected {words(expected)}{tail}"
+    return f"has the wrong shape: yours is {words(yours)}, expected {words(expected)}"
+
+
+def trig_degrees(expr):
+    """``expr`` with degree constants inside sin/cos/tan (``sin(θ + 45)``) turned into radians, or None
+    when it has none (the "degrees inside trig" mistake, for SymPy answers).
+
+    >>> t = sp.Symbol("theta")
+    >>> trig_degrees(sp.sin(t + 45))
+    sin(theta + pi/4)
+    >>> trig_degrees(sp.sin(t + sp.pi / 4)) is None
+    True
+    """
+    trig = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+    if not hasattr(expr, "atoms"):
+        return None
+    changed = False
+
+    def fix(arg):
+        nonlocal changed
+        reps = {}
+        for n in arg.atoms(sp.Number):
+            try:
+                if abs(n) in DEGREE_CONSTANTS:
+                    reps[n] = n * sp.pi / 180
+            except TypeError:
+                pass
+        if reps:
+            changed = True
+            return arg.xreplace(reps)
+        return arg
+
+    out = expr.replace(lambda e: isinstance(e, trig), lambda e: e.func(fix(e.args[0])))
+    return out if changed else None
+
+
+# ----------------------------------------------------------------------------- subspaces (numeric bases)
+
+
+def _complement(A):
+    """Orthonormal bases of the orthogonal complements of the spans of A[k] (float arrays (P, m, n))."""
+    out = []
+    for B in A:
+        m = B.shape[0]
+        if B.size == 0 or np.abs(B).max() < 1e-12:
+            out.append(np.eye(m))
+            continue
+        U, s, _ = np.linalg.svd(B)
+        r = int((s > 1e-9 * max(1.0, s[0])).sum())
+        out.append(U[:, r:] if r < m else np.zeros((m, 1)))
+    return out
+
+
+def _sub_complement(A):
+    yield "", _complement(A)
+
+
+def _sub_rows_as_vectors(A):
+    yield "", np.swapaxes(A, -1, -2)
+
+
+SUBSPACE_MISTAKES = (
+    Mistake("vectors-as-rows", "gives the vectors as rows: put one vector per column", _sub_rows_as_vectors),
+    _VwMistake("vw-order", "", _vw_order),
+    Mistake(
+        "complement",
+        "spans the orthogonal complement of the asked subspace (the directions asked for and the others swapped?)",
+        _sub_complement,
+    ),
+)
+
+
+# ----------------------------------------------------------------------------- sets of angles and choices
+
+
+def map_set(s, f):
+    """The set ``{f(x) : x in s}`` for a SymPy set of angles (finite, intervals, image sets, unions).
+
+    >>> map_set(sp.FiniteSet(45, 135), lambda x: x * sp.pi / 180)
+    {pi/4, 3*pi/4}
+    >>> n = sp.Symbol("n", integer=True)
+    >>> map_set(sp.ImageSet(sp.Lambda(n, 180 * n + 135), sp.Integers), lambda x: x * sp.pi / 180)
+    ImageSet(Lambda(n, pi*n + 3*pi/4), Integers)
+    """
+    if s is sp.S.EmptySet:
+        return s
+    if isinstance(s, sp.FiniteSet):
+        return sp.FiniteSet(*[sp.Tuple(*map(f, p)) if isinstance(p, (sp.Tuple, tuple)) else f(p) for p in s])
+    if isinstance(s, sp.Union):
+        return sp.Union(*[map_set(a, f) for a in s.args])
+    if isinstance(s, sp.Interval):
+        a, b = sorted([f(s.start), f(s.end)], key=lambda x: float(x) if x.is_number else 0.0)
+        return sp.Interval(a, b)
+    if isinstance(s, sp.ImageSet):
+        lam = s.lamda
+        return sp.ImageSet(sp.Lambda(lam.variables, sp.expand(f(lam.expr))), *s.base_sets)
+    x = sp.Dummy("x")
+    return sp.imageset(sp.Lambda(x, f(x)), s)
+
+
+SET_MISTAKES = (
+    Mistake(
+        "degrees",
+        "looks like degrees: angles are radians (45° = sp.pi/4)",
+        lambda s: iter([("", map_set(s, lambda x: x * sp.pi / 180))]),
+    ),
+    Mistake(
+        "negated",
+        "has the wrong sign: each value is minus a right one",
+        lambda s: iter([("", map_set(s, lambda x: -x))]),
+    ),
+)
+
+
+def _plus_one(x):
+    if isinstance(x, list):
+        return [_plus_one(e) for e in x]
+    return x + 1 if isinstance(x, int) and not isinstance(x, bool) else x
+
+
+CHOICE_MISTAKES = (
+    Mistake(
+        "zero-based",
+        "counts joints from 0: joints are numbered from 1 (the first joint is 1)",
+        lambda c: iter([("", _plus_one(c))]),
+    ),
+)

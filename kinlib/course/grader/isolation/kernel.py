@@ -1,0 +1,548 @@
+"""One isolated IPython kernel per submission, driven through jupyter_client, with time and size limits.
+
+The kernel is a fresh ``python -P -B -c ... ipykernel`` process (no working directory on sys.path) in its
+own session (process group), with the scratch directory as its working directory, a unix-socket (ipc) connection, no history database,
+``MPLBACKEND=Agg`` and resource limits (address space, file size, no core dumps). With a
+:class:`kinlib.course.grader.isolation.sandbox.Sandbox` it runs under bubblewrap (own PID/network/user namespaces, read-only
+system, only its own folder writable); stopping it kills its whole PID namespace, daemons included.
+Start-up and liveness are judged by the process itself (``poll()``), never by heartbeats: a start is
+retried up to :data:`START_ATTEMPTS` times with a generous time limit, and a kernel that still cannot
+start raises :class:`KernelStartError` (an infrastructure failure, not the submission's fault). Each cell runs with
+a per-cell time limit; past it the kernel gets SIGINT, and if it does not come back within a grace
+period the whole process group is killed. Outputs are never stored: only their size is counted (so a
+submission printing megabytes costs nothing but the time it spends printing), and errors are kept as
+(ename, evalue, cell index), truncated.
+
+:class:`NotebookRun` runs a whole notebook's code cells in such kernels (restarting past a cell that
+kills one), with the checker's probe (:mod:`kinlib.course.grader.in_kernel.probe` and :mod:`kinlib.course.answers.normalise`, sent
+as source text) loaded in a private module first.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+import queue
+import signal
+import stat
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from jupyter_client import BlockingKernelClient
+from jupyter_client.connect import write_connection_file
+
+from ...schema import cell_source, is_plain_selfcheck
+
+__all__ = [
+    "CellResult",
+    "Kernel",
+    "NotebookRun",
+    "PROBE_SOURCE",
+    "ANSWERS_SOURCE",
+    "GUARD_SOURCE",
+    "SREPR_SOURCE",
+    "MAX_RESTARTS",
+    "MAX_RESULT_BYTES",
+    "START_ATTEMPTS",
+    "KernelStartError",
+]
+
+# the checker's code for the kernel, sent as text (see kinlib.course.grader.in_kernel.probe)
+_IN_KERNEL = Path(__file__).parents[1] / "in_kernel"  # kinlib/course/grader/in_kernel
+PROBE_SOURCE = (_IN_KERNEL / "probe.py").read_text()
+ANSWERS_SOURCE = (Path(__file__).parents[2] / "answers" / "normalise.py").read_text()
+GUARD_SOURCE = (_IN_KERNEL / "guard.py").read_text()
+SREPR_SOURCE = (_IN_KERNEL / "srepr.py").read_text()
+MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
+MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
+START_ATTEMPTS = 3  # tries to start a kernel before it is an infrastructure failure
+
+
+class KernelStartError(RuntimeError):
+    """The kernel (or the checker's probe in it) could not be started: an infrastructure failure.
+
+    >>> str(KernelStartError("no answer in 120 s"))
+    'no answer in 120 s'
+    """
+
+
+_LAUNCH = (
+    "import resource, sys\n"
+    "def _lim(r, v):\n"
+    "    try:\n"
+    "        resource.setrlimit(r, (v, v))\n"
+    "    except (ValueError, OSError):\n"
+    "        pass\n"
+    "_lim(resource.RLIMIT_AS, {mem})\n"
+    "_lim(resource.RLIMIT_FSIZE, {fsize})\n"
+    "_lim(resource.RLIMIT_CORE, 0)\n"
+    "if {nproc}:\n"
+    "    _lim(resource.RLIMIT_NPROC, {nproc})\n"
+    "sys.path[:] = [p for p in sys.path if p not in ('', '.')]\n"
+    "from ipykernel import kernelapp as app\n"
+    "app.launch_new_instance()\n"
+)
+
+
+def _cpu_seconds(pid) -> float:
+    """utime + stime + cutime + cstime of process ``pid`` in seconds (0 if it cannot be read)."""
+    try:
+        with open(f"/proc/{int(pid)}/stat") as f:
+            fields = f.read().rsplit(")", 1)[-1].split()
+        return sum(int(x) for x in fields[11:15]) / os.sysconf("SC_CLK_TCK")
+    except (OSError, ValueError, TypeError, IndexError):
+        return 0.0
+
+
+@dataclass
+class CellResult:
+    """What happened when one cell ran: status ok | error | timeout | died | skipped.
+
+    >>> CellResult(0, "ok")
+    CellResult(index=0, status='ok', ename='', evalue='', seconds=0.0, output_bytes=0, note='')
+    >>> CellResult(4, "timeout", note="stopped after the 60 s limit for one cell").summary()
+    'stopped after the 60 s limit for one cell'
+    """
+
+    index: int
+    status: str
+    ename: str = ""
+    evalue: str = ""
+    seconds: float = 0.0
+    output_bytes: int = 0
+    note: str = ""
+
+    def summary(self) -> str:
+        """One line for a person: "ran", "raised E: v", or the note.
+
+        >>> CellResult(3, "error", ename="NameError", evalue="name 'J' is not defined").summary()
+        "raised NameError: name 'J' is not defined"
+        """
+        if self.status == "ok":
+            return "ran"
+        if self.status == "error":
+            return f"raised {self.ename}: {self.evalue}".strip()
+        return self.note or self.status
+
+
+@dataclass
+class Kernel:
+    """A kernel process plus a blocking client; ``run(code)`` executes with limits.
+
+    Until :meth:`start` there is no process, and ``run`` says so instead of raising:
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     k = Kernel(cwd=d, conn_dir=d)
+    ...     k.alive(), k.run("1 + 1", timeout=5).summary()
+    (False, 'the kernel was not running')
+
+    ``start`` launches an IPython kernel (seconds; tests/test_grade.py exercises it), hence not run here:
+
+    >>> k = Kernel(cwd=".", conn_dir="/tmp")  # doctest: +SKIP
+    >>> k.start()  # doctest: +SKIP
+    >>> k.run("x = 1 / 0", timeout=10, index=0).summary()  # doctest: +SKIP
+    'raised ZeroDivisionError: division by zero'
+    >>> k.kill()  # doctest: +SKIP
+    """
+
+    cwd: str
+    conn_dir: str
+    mem_bytes: int = 3 * 2**30
+    fsize_bytes: int = 200 * 2**20
+    startup_timeout: float = 120.0
+    grace: float = 3.0
+    sandbox: object | None = None  # a kinlib.course.grader.isolation.sandbox.Sandbox, or None (a plain subprocess)
+    enclosure: object | None = None  # a kinlib.course.grader.isolation.limits.Enclosure: cgroup and tmpfs
+    proc: subprocess.Popen | None = None
+    kc: BlockingKernelClient | None = None
+    dead_reason: str = ""
+    info: dict | None = None  # bwrap's --info-fd (child-pid, pid-namespace) when sandboxed
+    record: list | None = None  # sandbox.sandbox_record: [pid namespace, init PID, its start time]
+    start_failures: int = 0
+    cpu_seconds: float = 0.0  # CPU time the kernel process (and what it waited for) used, read when it is killed
+
+    def start(self) -> None:
+        """Launch the kernel and wait until it answers, retrying (:data:`START_ATTEMPTS` tries); raise
+        :class:`KernelStartError` if it never does."""
+        errors = []
+        for _ in range(START_ATTEMPTS):
+            try:
+                self._launch()
+                self._wait_ready(time.monotonic() + self.startup_timeout)
+                return
+            except KernelStartError as exc:
+                errors.append(str(exc))
+                self.start_failures += 1
+                self.kill()
+        raise KernelStartError(f"the kernel did not start ({START_ATTEMPTS} tries: {'; '.join(errors)})"[:600])
+
+    def _launch(self) -> None:
+        Kernel._counter = getattr(Kernel, "_counter", 0) + 1
+        base = os.path.join(self.conn_dir, f"k{os.getpid()}-{Kernel._counter}")
+        fn, _ = write_connection_file(fname=base + ".json", transport="ipc", ip=base)
+        extra = {"MPLBACKEND": "Agg", "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
+        mem, fsize, nproc = int(self.mem_bytes), int(self.fsize_bytes), 0
+        if self.enclosure is not None:
+            rl = self.enclosure.rlimits()
+            mem, fsize, nproc = int(rl["as"]), int(rl["fsize"]), int(rl.get("nproc", 0))
+        code = _LAUNCH.format(mem=mem, fsize=fsize, nproc=nproc)
+        argv = [sys.executable, "-P", "-B", "-c", code, "-f", fn, "--HistoryManager.enabled=False"]
+        argv += ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
+        fds: tuple = ()
+        rfd = None
+        if self.sandbox is not None:
+            rfd, wfd = os.pipe()
+            fds = (wfd,)
+            env = self.sandbox.environment(extra)
+            sb = self.sandbox
+            if self.enclosure is not None and self.enclosure.tmp_dir:
+                sb = dataclasses.replace(sb, tmp_dir=self.enclosure.tmp_dir, shm_dir=self.enclosure.shm_dir)
+            try:
+                argv = sb.command(argv, cwd=self.cwd, rw=[self.conn_dir, self.cwd], env=env, info_fd=wfd)
+            except Exception:
+                os.close(rfd)
+                os.close(wfd)
+                raise
+        else:
+            env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
+            env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+        if self.enclosure is not None:
+            argv = self.enclosure.wrap(argv)  # every process the kernel starts is in the submission's cgroup
+        try:
+            self.proc = subprocess.Popen(
+                argv,
+                cwd=self.cwd,
+                env=env,
+                stdin=subprocess.DEVNULL,
+                stdout=subprocess.DEVNULL,
+                stderr=subprocess.DEVNULL,
+                start_new_session=True,
+                pass_fds=fds,
+            )
+        except OSError as exc:
+            raise KernelStartError(f"cannot run {argv[0]}: {exc}") from None
+        finally:
+            for fd in fds:
+                os.close(fd)
+        if rfd is not None:
+            from .sandbox import read_info, sandbox_record
+
+            self.info = read_info(rfd, self.proc, self.startup_timeout)
+            self.record = sandbox_record(self.info)
+            if self.record is None:
+                raise KernelStartError(f"the sandbox did not start (bwrap exit status {self.proc.poll()})")
+        self.kc = BlockingKernelClient(connection_file=fn)
+        self.kc.load_connection_file()
+        self.kc.start_channels(hb=False)
+
+    def _wait_ready(self, deadline: float) -> None:
+        """kernel_info until it is answered and IOPub delivers; alive means ``proc.poll()`` is None."""
+        kc = self.kc
+        while True:
+            if self.proc.poll() is not None:
+                raise KernelStartError(f"the kernel process exited (status {self.proc.returncode}) before answering")
+            if time.monotonic() > deadline:
+                raise KernelStartError(f"no answer in {self.startup_timeout:g} s")
+            kc.kernel_info()
+            t_end = min(time.monotonic() + 5.0, deadline)
+            while time.monotonic() < t_end and self.proc.poll() is None:
+                try:
+                    msg = kc.get_shell_msg(timeout=0.5)
+                except queue.Empty:
+                    continue
+                if msg.get("msg_type") != "kernel_info_reply":
+                    continue
+                try:  # the reply came; IOPub must be connected too (it publishes the busy/idle status)
+                    kc.get_iopub_msg(timeout=2.0)
+                except queue.Empty:
+                    break  # ask again
+                while True:
+                    try:
+                        kc.get_iopub_msg(timeout=0.2)
+                    except queue.Empty:
+                        return
+
+    def alive(self) -> bool:
+        """Whether the kernel process is running."""
+        return self.proc is not None and self.proc.poll() is None
+
+    def kill(self) -> None:
+        """Stop the client and kill the kernel's whole process group (sandboxed: its whole PID namespace,
+        waiting until no process of it is left)."""
+        if self.kc is not None:
+            try:
+                self.kc.stop_channels()
+            except Exception:  # noqa: BLE001
+                pass
+            self.kc = None
+        if self.proc is not None:
+            if self.proc.poll() is None:
+                self.cpu_seconds += _cpu_seconds(self._kernel_pid())
+            if self.record is not None:
+                # the sandbox's init first: the kernel kills its whole namespace, init reaps it, and bwrap,
+                # seeing its child gone, exits (so CPU time is accounted up the chain to the grader)
+                from .sandbox import reap_namespaces
+
+                reap_namespaces([self.record])
+                try:
+                    self.proc.wait(timeout=2)
+                except subprocess.TimeoutExpired:
+                    pass
+            try:
+                os.killpg(self.proc.pid, signal.SIGKILL)
+            except (ProcessLookupError, PermissionError):
+                pass
+            try:
+                self.proc.wait(timeout=5)
+            except subprocess.TimeoutExpired:
+                pass
+
+    def _kernel_pid(self):
+        """The kernel's PID as the grader sees it: the sandbox's init's child, or the process itself."""
+        child = (self.info or {}).get("child-pid")
+        if not child:
+            return self.proc.pid
+        try:
+            with open(f"/proc/{int(child)}/task/{int(child)}/children") as f:
+                kids = f.read().split()
+            return int(kids[0]) if kids else None
+        except (OSError, ValueError):
+            return None
+
+    def _interrupt(self) -> None:
+        pid = self._kernel_pid()
+        try:
+            if pid:
+                os.kill(pid, signal.SIGINT)
+            elif self.kc is not None:  # ask the kernel to interrupt itself
+                self.kc.control_channel.send(self.kc.session.msg("interrupt_request", content={}))
+        except (ProcessLookupError, PermissionError):
+            pass
+
+    def run(self, code: str, timeout: float, index: int = -1, silent: bool = False) -> CellResult:
+        """Execute ``code``; never raises for anything the code does."""
+        t0 = time.monotonic()
+        res = CellResult(index, "ok")
+        if not self.alive() or self.kc is None:
+            res.status, res.note = "died", "the kernel was not running"
+            return res
+        msg_id = self.kc.execute(code, silent=silent, store_history=not silent, allow_stdin=False, stop_on_error=False)
+        deadline = t0 + timeout
+        interrupted_at = None
+        idle = replied = False
+        replied_at = None
+        while not (idle and replied):
+            now = time.monotonic()
+            if replied_at is not None and now > replied_at + 2.0:
+                break  # the reply is in; an idle status lost in an output flood must not hang us
+            if interrupted_at is None and now > deadline:
+                self._interrupt()
+                interrupted_at = now
+                res.status, res.note = "timeout", f"stopped after the {timeout:g} s limit for one cell"
+            if interrupted_at is not None and now > interrupted_at + self.grace:
+                self.kill()
+                self.dead_reason = f"killed after ignoring the {timeout:g} s limit for one cell"
+                res.status, res.note = "timeout", self.dead_reason
+                break
+            if not self.alive():
+                # the process is gone: drain nothing more, report
+                self.dead_reason = "the kernel died (the code exited Python or crashed)"
+                res.status, res.note = "died", self.dead_reason
+                break
+            msg = None
+            if not idle:
+                try:
+                    msg = self.kc.get_iopub_msg(timeout=0.1 if replied else 0.05)
+                except queue.Empty:
+                    msg = None
+            if msg is not None and msg.get("parent_header", {}).get("msg_id") == msg_id:
+                mt, c = msg["msg_type"], msg["content"]
+                if mt == "status" and c.get("execution_state") == "idle":
+                    idle = True
+                elif mt == "stream":
+                    res.output_bytes += len(c.get("text", ""))
+                elif mt in ("display_data", "execute_result", "update_display_data"):
+                    res.output_bytes += sum(len(str(v)) for v in c.get("data", {}).values())
+                elif mt == "error" and res.status == "ok":
+                    res.status, res.ename, res.evalue = (
+                        "error",
+                        str(c.get("ename", ""))[:200],
+                        str(c.get("evalue", ""))[:500],
+                    )
+            if not replied:
+                try:
+                    reply = self.kc.get_shell_msg(timeout=0.1 if idle else 0)
+                except queue.Empty:
+                    reply = None
+                if reply is not None and reply.get("parent_header", {}).get("msg_id") == msg_id:
+                    replied, replied_at = True, time.monotonic()
+                    c = reply["content"]
+                    if c.get("status") == "error" and res.status == "ok":
+                        res.status, res.ename, res.evalue = (
+                            "error",
+                            str(c.get("ename", ""))[:200],
+                            str(c.get("evalue", ""))[:500],
+                        )
+                    elif c.get("status") == "aborted" and res.status == "ok":
+                        res.status, res.note = "error", "aborted"
+        if res.status == "timeout" and interrupted_at is not None and self.alive():
+            res.ename = "TimeoutError"
+        res.seconds = time.monotonic() - t0
+        return res
+
+
+class NotebookRun:
+    """A submission (or reference) notebook executed cell by cell in a fresh kernel, with restarts.
+
+    Nothing starts until :meth:`execute`; before it, :meth:`call` answers without a kernel:
+
+    >>> NotebookRun([], cwd=".", tmp=".", cell_timeout=5, total_timeout=30).call("restore_saved(PATH)", 5)
+    (None, 'the kernel was not running')
+
+    ``execute`` starts a kernel (and a fresh one past a cell that kills it; seconds, exercised by
+    tests/test_grade.py), hence not run here:
+
+    >>> cells = [{"cell_type": "code", "source": "J = 2 * 3"},
+    ...          {"cell_type": "code", "source": "import os; os._exit(1)"}]
+    >>> run = NotebookRun(cells, cwd=".", tmp="/tmp", cell_timeout=10, total_timeout=60).execute()  # doctest: +SKIP
+    >>> [run.results[i].status for i in range(2)], run.restarts  # doctest: +SKIP
+    (['ok', 'died'], 1)
+    >>> run.call("probe_answer(globals(), 'J', 'choice', [], 0, PATH)", 10)  # doctest: +SKIP
+    ({'tag': 'choice', 'type': 'int', 'value': 6}, '')
+    >>> run.close()  # doctest: +SKIP
+    """
+
+    def __init__(
+        self,
+        cells: list,
+        cwd: str,
+        tmp: str,
+        cell_timeout: float,
+        total_timeout: float,
+        stash_after: dict | None = None,
+        snapshot: bool = True,
+        sandbox=None,
+        enclosure=None,
+    ):
+        self.cells = cells
+        self.enclosure = enclosure  # kinlib.course.grader.isolation.limits.Enclosure: the submission's limits, or None
+        self.cwd, self.tmp = cwd, tmp
+        self.cell_timeout, self.total = cell_timeout, total_timeout
+        self.stash_after = stash_after or {}
+        self.snapshot = snapshot
+        self.sandbox = sandbox
+        self.namespaces: list = []  # sandbox records of every sandboxed kernel this run started
+        self.start_failures = 0
+        self.cpu_seconds = 0.0  # of every kernel this run started (read as each is stopped)
+        self.nonce = "_kinlib_grade_" + os.urandom(8).hex()
+        self.kernel = None
+        self.results: dict = {}
+        self.restarts = 0
+        self.t0 = time.monotonic()
+
+    def _start(self):
+        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp, sandbox=self.sandbox, enclosure=self.enclosure)
+        try:
+            self.kernel.start()
+        finally:
+            self.start_failures += self.kernel.start_failures
+            if self.kernel.record is not None:
+                self.namespaces.append(self.kernel.record)
+        code = (
+            f"def __kg_setup():\n"
+            f"    import sys, types\n"
+            f"    a = types.ModuleType({self.nonce + '_answers'!r})\n"
+            f"    exec(compile({ANSWERS_SOURCE!r}, '<kinlib-grade-answers>', 'exec'), a.__dict__)\n"
+            f"    m = types.ModuleType({self.nonce!r})\n"
+            f"    g = types.ModuleType({self.nonce + '_guard'!r})\n"
+            f"    exec(compile({GUARD_SOURCE!r}, '<kinlib-grade-guard>', 'exec'), g.__dict__)\n"
+            f"    r = types.ModuleType({self.nonce + '_srepr'!r})\n"
+            f"    exec(compile({SREPR_SOURCE!r}, '<kinlib-grade-srepr>', 'exec'), r.__dict__)\n"
+            f"    m.answers, m.guard, m.srepr = a, g, r\n"
+            f"    exec(compile({PROBE_SOURCE!r}, '<kinlib-grade-probe>', 'exec'), m.__dict__)\n"
+            f"    sys.modules[{self.nonce!r}] = m\n"
+            f"    m.SNAP = g.snapshot() if {self.snapshot!r} else None\n"
+            f"__kg_setup(); del __kg_setup\n"
+        )
+        r = self.kernel.run(code, timeout=180, silent=True)
+        if r.status != "ok":
+            raise KernelStartError(f"could not start the checker's probe in the kernel: {r.summary()}")
+
+    def _m(self) -> str:
+        return f"__import__('sys').modules[{self.nonce!r}]"
+
+    def execute(self):
+        """Run all cells; returns self (results: index -> CellResult)."""
+        skip: set = set()
+        while True:
+            self._start()
+            died_at = None
+            for i, cell in enumerate(self.cells):
+                if i in skip:
+                    continue
+                left = self.total - (time.monotonic() - self.t0)
+                if left <= 0:
+                    self.results[i] = CellResult(i, "skipped", note="not run: the total time limit was reached")
+                    continue
+                src = cell_source(cell)
+                if not src.strip() or is_plain_selfcheck(cell):
+                    self.results[i] = CellResult(
+                        i, "ok", note="self-check not run by the checker" if src.strip() else ""
+                    )
+                else:
+                    r = self.kernel.run(src, timeout=min(self.cell_timeout, left), index=i)
+                    self.results[i] = r
+                    if self.enclosure is not None:
+                        self.enclosure.check_disk()  # a file written, then deleted, still reached the limit
+                    if r.status in ("died", "timeout") and not self.kernel.alive():
+                        died_at = i
+                        break
+                if i in self.stash_after and self.kernel.alive():
+                    self.kernel.run(f"{self._m()}.stash(globals(), {self.stash_after[i]!r})", timeout=10, silent=True)
+            if died_at is None:
+                return self
+            skip.add(died_at)
+            self.kernel.kill()
+            self.cpu_seconds += self.kernel.cpu_seconds
+            if self.restarts >= MAX_RESTARTS or self.total - (time.monotonic() - self.t0) <= 1:
+                for j in range(died_at + 1, len(self.cells)):
+                    self.results.setdefault(j, CellResult(j, "skipped", note="not run: the kernel had died"))
+                self.kernel = None
+                return self
+            self.restarts += 1
+            # rerun from the top in a fresh kernel without the cell(s) that killed it
+            for j in list(self.results):
+                if j not in skip:
+                    del self.results[j]
+
+    def call(self, expr: str, timeout: float) -> tuple[dict | None, str]:
+        """Run ``probe.<expr with PATH>`` in the kernel; return (JSON result, error text)."""
+        if self.kernel is None or not self.kernel.alive():
+            return None, "the kernel was not running"
+        path = os.path.join(self.tmp, "r-" + os.urandom(8).hex() + ".json")
+        r = self.kernel.run(f"{self._m()}.{expr.replace('PATH', repr(path))}", timeout=timeout, silent=True)
+        if r.status != "ok":
+            return None, r.summary()
+        try:  # the kernel can write in this folder: never follow a link it planted, read regular files only
+            fd = os.open(path, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+            with os.fdopen(fd, "rb") as f:
+                if not stat.S_ISREG(os.fstat(f.fileno()).st_mode):
+                    return None, "no readable result (not a regular file)"
+                data = f.read(MAX_RESULT_BYTES + 1)
+            if len(data) > MAX_RESULT_BYTES:
+                return None, "the answer is too large to read"
+            return json.loads(data), ""
+        except (OSError, ValueError) as exc:
+            return None, f"no readable result ({type(exc).__name__})"
+
+    def close(self):
+        """Kill the kernel, if one is running."""
+        if self.kernel is not None:
+            self.kernel.kill()
+            self.cpu_seconds += self.kernel.cpu_seconds
+            self.kernel = None

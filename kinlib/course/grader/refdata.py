@@ -1,0 +1,302 @@
+"""The grader's answer key: reference answers computed in the trusted process, kept as signed data.
+
+* **Computed by the instructor's side only.** :func:`build_reference` executes a solution notebook in a
+  kernel of the grader's own (instructor code; never a student kernel) and reads each answer as data:
+  a SymPy expression tree in ``srepr`` form, a choice's JSON value, the symbols and their assumptions.
+* **Data, never code.** The trees are read back with :func:`kinlib.course.parse_srepr`, a strict
+  parser (only SymPy class calls, singletons, numbers, lists, tuples and dicts; nothing is ``eval``-ed),
+  and evaluated at a submission's points here, in the grader (:func:`reference_description`).
+* **Signed.** The cache (``<cache>/<id>-<hash>.json``) holds the reference and an HMAC-SHA256 tag keyed
+  by the instructor's secret (:mod:`kinlib.course.grader.secret`); a file whose tag does not verify (edited,
+  planted, or made with another secret) is ignored and rebuilt. The cache folder is never visible to a
+  sandboxed student kernel (:mod:`kinlib.course.grader.isolation.sandbox`), nor is the notebooks folder.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import shutil
+import tempfile
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from ..answers import normalise as answers
+from ..schema import notebook_id, notebook_title, parse_parts, stash_points
+from .in_kernel import probe
+from .in_kernel.srepr import parse_srepr
+from .isolation.kernel import ANSWERS_SOURCE, GUARD_SOURCE, PROBE_SOURCE, SREPR_SOURCE, NotebookRun
+from .secret import sign, verify
+
+__all__ = [
+    "Reference",
+    "GRADE_VERSION",
+    "build_reference",
+    "load_references",
+    "default_notebooks",
+    "code_cells",
+    "reference_description",
+    "read_cache",
+]
+
+GRADE_VERSION = "2"
+_CACHE_PURPOSE = "kinlib-reference-cache"
+
+
+@dataclass
+class Reference:
+    """A solution notebook's graded parts and reference answers (as the reference kernel described them).
+
+    :func:`build_reference` makes them (and caches them as signed JSON, read back with ``Reference(**d)``):
+
+    >>> ref = Reference("02_planar", "Planar arms", "notebooks/02_planar.ipynb", "0" * 64,
+    ...                 parts=[{"part": "2.1", "points": 5.0, "answers": ["L"], "kinds": {"L": "expr"}}],
+    ...                 answers={"L": {"kind": "expr", "srepr": "Symbol('L', positive=True)",
+    ...                                "symbols": {"L": {"positive": True}}}})
+    >>> ref.error, [p["part"] for p in ref.parts]
+    ('', ['2.1'])
+    """
+
+    notebook: str
+    title: str
+    path: str
+    sha: str
+    parts: list  # [schema.Part as dict]
+    answers: dict  # name -> {"srepr"/"choice", "symbols"} or {"error"}
+    error: str = ""
+
+
+def default_notebooks() -> Path:
+    """The repository's ``notebooks/`` (next to the kinlib package), else ``notebooks`` in the cwd.
+
+    >>> default_notebooks().name
+    'notebooks'
+    """
+    p = Path(__file__).resolve().parents[3] / "notebooks"
+    return p if p.is_dir() else Path("notebooks")
+
+
+def code_cells(nb: dict) -> list:
+    """The code cells of notebook ``nb`` (a dict), in order.
+
+    >>> len(code_cells({"cells": [{"cell_type": "code"}, {"cell_type": "markdown"}, "junk"]}))
+    1
+    """
+    return [c for c in nb.get("cells", []) if isinstance(c, dict) and c.get("cell_type") == "code"]
+
+
+def _hash(data: bytes) -> str:
+    h = hashlib.sha256(data)
+    for s in (PROBE_SOURCE, ANSWERS_SOURCE, GUARD_SOURCE, SREPR_SOURCE, GRADE_VERSION):
+        h.update(s.encode())
+    return h.hexdigest()
+
+
+def _canonical(d: dict) -> bytes:
+    return json.dumps(d, sort_keys=True, separators=(",", ":"), ensure_ascii=True).encode()
+
+
+def read_cache(cfile: Path, secret: bytes, sha: str) -> Reference | None:
+    """The Reference in cache file ``cfile`` if its tag verifies with ``secret`` and it is for ``sha``; else None.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = (Path(d) / "x.json").write_text('{"reference": {}, "mac": "0"}')
+    ...     read_cache(Path(d) / "x.json", b"k" * 32, "0" * 64) is None
+    True
+    """
+    try:
+        with open(cfile, "rb") as f:
+            d = json.loads(f.read(50 * 2**20))
+        ref = d["reference"]
+        if not verify(secret, _CACHE_PURPOSE, _canonical(ref), d.get("mac")) or ref.get("sha") != sha:
+            return None
+        return Reference(**ref)
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        return None
+
+
+def _write_cache(cfile: Path, secret: bytes, ref: Reference) -> None:
+    d = asdict(ref)
+    cfile.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+    tmp = cfile.with_name(cfile.name + f".{time.monotonic_ns()}.tmp")
+    tmp.write_text(json.dumps({"reference": d, "mac": sign(secret, _CACHE_PURPOSE, _canonical(d))}))
+    tmp.replace(cfile)
+
+
+def build_reference(
+    path: Path, cache: Path | None = None, timeout: float = 300.0, log=None, secret: bytes | None = None
+) -> Reference:
+    """Execute the solution notebook ``path`` and read its answers (cached by content hash when ``cache`` and
+    ``secret`` are given; a cache file whose HMAC tag does not verify is rebuilt, never used).
+
+    It runs the notebook in a Jupyter kernel (seconds; tests/test_grade.py exercises it), hence not run here:
+
+    >>> ref = build_reference(Path("notebooks/02_planar_robot_jacobian.ipynb"), cache=None)  # doctest: +SKIP
+    >>> ref.notebook, ref.error  # doctest: +SKIP
+    ('02_planar_robot_jacobian', '')
+    """
+    path = Path(path)
+    data = path.read_bytes()
+    sha = _hash(data)
+    nb = json.loads(data)
+    nid = notebook_id(nb) or path.stem
+    cfile = Path(cache) / f"{nid}-{sha[:16]}.json" if cache is not None and secret else None
+    if cfile is not None and cfile.exists():
+        ref = read_cache(cfile, secret, sha)
+        if ref is not None:
+            return ref
+        if log:
+            log(f"  reference cache {cfile.name}: signature does not verify; ignored and rebuilt")
+    t0 = time.monotonic()
+    parts = parse_parts(nb)
+    title = notebook_title(nb, nid)
+    kinds = {n: k for p in parts for n, k in p.kinds.items()}
+    tmp = tempfile.mkdtemp(prefix="kinlib-grade-ref-")
+    err = ""
+    ans: dict = {}
+    run = NotebookRun(
+        code_cells(nb),
+        str(path.parent.resolve()),
+        tmp,
+        cell_timeout=timeout,
+        total_timeout=timeout * 4,
+        stash_after=stash_points(nb),
+        snapshot=False,
+    )
+    try:
+        run.execute()
+        bad = [r for r in run.results.values() if r.status != "ok"]
+        if bad:
+            err = f"code cell {bad[0].index + 1} of the solution notebook: {bad[0].summary()}"
+        got, e = run.call(f"probe_reference(globals(), {kinds!r}, PATH)", timeout=120)
+        if got is None:
+            err = err or f"could not read the reference answers: {e}"
+        else:
+            ans = got
+    except RuntimeError as exc:
+        err = str(exc)
+    finally:
+        run.close()
+        shutil.rmtree(tmp, ignore_errors=True)
+    missing = [f"{n}: {a['error']}" for n, a in ans.items() if "error" in a]
+    if missing and not err:
+        err = "; ".join(missing)[:1000]
+    for n, a in ans.items():  # the key must read back as data now, not fail later at grading time
+        if "srepr" in a and not err:
+            try:
+                parse_srepr(a["srepr"])
+            except ValueError as exc:
+                err = f"{n}: {exc}"
+    ref = Reference(nid, title, str(path), sha, [asdict(p) for p in parts], ans, err)
+    if log:
+        log(
+            f"  reference {nid}: {len(parts)} parts, {len(kinds)} answers "
+            f"({time.monotonic() - t0:.1f} s){' ERROR: ' + err if err else ''}"
+        )
+    if cfile is not None and not err:
+        _write_cache(cfile, secret, ref)
+    return ref
+
+
+def load_references(
+    notebooks: Path, cache: Path | None, ids: set | None = None, log=None, jobs: int = 1, secret: bytes | None = None
+) -> dict:
+    """{notebook id: Reference} for the solution notebooks in ``notebooks`` (only ``ids`` if given).
+
+    Each one is a :func:`build_reference` (a kernel run, or a verified cache file); notebooks without a
+    ``kinlib.notebook`` id are not references:
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = (Path(d) / "scratch.ipynb").write_text('{"cells": [], "metadata": {}}')
+    ...     load_references(Path(d), cache=None)
+    {}
+    >>> refs = load_references(default_notebooks(), cache=None, ids={"02_planar_robot_jacobian"})  # doctest: +SKIP
+    >>> list(refs)  # doctest: +SKIP
+    ['02_planar_robot_jacobian']
+    """
+    todo = {}
+    for p in sorted(Path(notebooks).glob("*.ipynb")):
+        try:
+            nid = notebook_id(json.loads(p.read_bytes()))
+        except (OSError, ValueError):
+            continue
+        if nid is None or (ids is not None and nid not in ids):
+            continue
+        todo[nid] = p
+    if jobs <= 1 or len(todo) <= 1:
+        return {nid: build_reference(p, cache, log=log, secret=secret) for nid, p in todo.items()}
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        futures = {nid: pool.submit(build_reference, p, cache, log=log, secret=secret) for nid, p in todo.items()}
+        return {nid: f.result() for nid, f in futures.items()}
+
+
+# ----------------------------------------------------------------------------------------- evaluation
+
+_PARSED: dict = {}
+
+
+def _fast_expr(obj):
+    """(template description, f) with f(point) -> values for a reference Matrix/expression, or None."""
+    import numpy as np
+    import sympy as sp
+
+    tmpl = probe.describe_expr(obj, [], 0)
+    syms = sorted((s for s in obj.free_symbols if isinstance(s, sp.Symbol)), key=lambda s: s.name)
+    entries = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
+    try:
+        f = sp.lambdify(syms, entries, modules="numpy", cse=True)
+    except Exception:  # noqa: BLE001
+        return None
+
+    def values(point):
+        with np.errstate(all="ignore"):
+            out = f(*[np.complex128(point[s.name]) for s in syms])
+        row = [[float(np.real(v)), float(np.imag(v))] for v in (complex(x) for x in out)]
+        if not all(math.isfinite(x) for v in row for x in v):
+            raise ValueError("not finite")
+        return row
+
+    return tmpl, values
+
+
+def reference_description(ref: Reference, name: str, kind: str, points: list, seed: int) -> dict:
+    """The reference answer ``name`` described like a student's, at ``points`` (same code path as the
+    kernel's probe; the parsed tree and its lambdified form are cached per process).
+
+    >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
+    ...                                                      "symbols": {"x": {}}}})
+    >>> reference_description(ref, "x2", "expr", [{"x": 3.0}], 0)["values"]
+    [[[9.0, 0.0]]]
+    """
+    a = ref.answers[name]
+    if "choice" in a:
+        return a["choice"]
+    key = (name, a["srepr"])  # by the text itself: a different text is never served from this cache
+    if key not in _PARSED:
+        obj = parse_srepr(a["srepr"])
+        fast = (
+            _fast_expr(obj)
+            if kind in ("expr", "subspace") and obj is not None and answers.to_sympy(obj)[0] in ("matrix", "scalar")
+            else None
+        )
+        _PARSED[key] = (obj, fast)
+    obj, fast = _PARSED[key]
+    if fast is not None:
+        try:
+            tmpl, values = fast
+            out = dict(tmpl, values=[values(p) for p in points])
+            if kind == "subspace" and not tmpl.get("symbols") and not tmpl.get("has_float"):
+                try:  # a constant exact span: compared exactly (compare.compare_subspace)
+                    out["tree"] = answers.expr_tree(answers.to_sympy(obj, vectors=True)[1], max_nodes=600)
+                except Exception:  # noqa: BLE001
+                    pass
+            return out
+        except Exception:  # noqa: BLE001  fall back to SymPy's evaluation
+            pass
+    return probe.describe(kind, obj, points, seed)

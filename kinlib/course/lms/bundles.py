@@ -1,0 +1,577 @@
+"""The platforms a class already uses, when it outgrows one machine: Gradescope, PrairieLearn, Canvas.
+
+Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.grade_submission`, scored by
+:mod:`kinlib.course.grader.credit`): only the packaging around it and the results' format differ.
+
+* ``kinlib grade gradescope --out autograder.zip`` writes a Gradescope autograder (Autograder
+  Specifications, https://gradescope-autograders.readthedocs.io/en/latest/specs/): ``setup.sh`` and
+  ``run_autograder`` at the root of the zip, plus the bundle: a copy of the ``kinlib`` package
+  (``kinlib-src/``), its pins (``constraints.txt``, the repository's ``environment.txt``), the reference
+  answers as data (``references.json``, computed here by the instructor's grader), a grader secret derived
+  for this zip (never the instructor's own) and ``config.json``. Gradescope runs each submission in its own
+  container: ``/autograder/submission/`` (the student's files), ``/autograder/source/`` (the zip),
+  ``/autograder/results/results.json`` (written by ``run_autograder``: ``score``, ``output``,
+  ``execution_time``, ``stdout_visibility`` and ``tests`` [{``name``, ``number``, ``score``, ``max_score``,
+  ``status``, ``output``, ``visibility``}], one test per automatically graded part; visibility is one of
+  ``visible``, ``hidden``, ``after_due_date``, ``after_published``). Use a Gradescope base image with
+  Python ≥ 3.11 (Ubuntu 24.04).
+* ``kinlib grade prairielearn --out DIR`` writes ``DIR/serverFilesCourse/kinlib_grader/`` (the same bundle
+  and ``run.sh``) and ``DIR/info-externalGradingOptions.json`` (External Grading,
+  https://prairielearn.readthedocs.io/en/latest/externalGrading/): the student's files are in
+  ``/grade/student/``, the results go to ``/grade/results/results.json`` (created by ``run.sh``):
+  ``gradable``, ``score`` in [0, 1], ``message``, ``output``, ``tests`` [{``name``, ``description``,
+  ``points``, ``max_points``, ``message``, ``output``}]; a file that is not a notebook is ``gradable:
+  false`` with ``format_errors``.
+* ``kinlib grade canvas OUT --assignment NAME --out canvas.csv`` writes a Canvas gradebook import file from a
+  class folder (``kinlib grade ... --out OUT``): columns ``Student, ID, SIS User ID, SIS Login ID, Section``
+  then the assignment, a ``Points Possible`` row first (Canvas: Grades → Import). The student id goes to
+  ``--id-column`` (default ``ID``: the Canvas user id, which Canvas's submission downloads carry in their
+  file names, ``doejane_12345_678_ps4.ipynb``; grade them with
+  ``--id-pattern '[^/_]+_(?:LATE_|late_)?(?P<id>\\d+)_\\d+_[^/]*$'``) or is looked up in ``--roster`` (a
+  Canvas gradebook export). Students with manual parts still pending are left blank (ungraded in Canvas)
+  unless ``--include-pending``.
+
+Work graded by hand (``manual`` items, e.g. 5.2's drawing) is not part of the platforms' automatic score:
+the results' output lists it; grade it with the platform's own manual grading. Within the container the
+student's kernel runs in the sandbox when bubblewrap can run there; a zip built with ``--no-sandbox`` says
+so in every result. For testing, the roots are ``--root`` (or ``KINLIB_AUTOGRADER_ROOT`` /
+``KINLIB_GRADE_ROOT``), default ``/autograder`` and ``/grade``.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import shutil
+import stat
+import sys
+import tempfile
+import time
+import zipfile
+from dataclasses import asdict
+from pathlib import Path
+
+from ..grader import credit, report
+
+__all__ = [
+    "VISIBILITIES",
+    "build_bundle",
+    "gradescope_zip",
+    "prairielearn_dir",
+    "gradescope_results",
+    "prairielearn_results",
+    "run_platform",
+    "canvas_csv",
+    "main",
+]
+
+VISIBILITIES = ("visible", "hidden", "after_due_date", "after_published")
+_ROOTS = {"gradescope": ("KINLIB_AUTOGRADER_ROOT", "/autograder"), "prairielearn": ("KINLIB_GRADE_ROOT", "/grade")}
+
+SETUP_SH = """#!/usr/bin/env bash
+# Gradescope runs this once, as root, when it builds the autograder image.
+set -euo pipefail
+export DEBIAN_FRONTEND=noninteractive
+apt-get update -qq
+apt-get install -y -qq python3 python3-venv python3-pip bubblewrap
+python3 -c 'import sys; sys.exit(sys.version_info < (3, 11))' || {
+  echo "kinlib needs Python >= 3.11: choose a Gradescope base image with Ubuntu 24.04" >&2; exit 1; }
+python3 -m venv /autograder/venv
+/autograder/venv/bin/pip install -q -c /autograder/source/constraints.txt "/autograder/source/kinlib-src[course]"
+"""
+
+RUN_AUTOGRADER = """#!/usr/bin/env bash
+# Gradescope runs this for every submission: /autograder/submission -> /autograder/results/results.json
+ROOT="${KINLIB_AUTOGRADER_ROOT:-/autograder}"
+PY="${KINLIB_PYTHON:-$ROOT/venv/bin/python}"
+[ -x "$PY" ] || PY=python3
+export PYTHONPATH="$ROOT/source/kinlib-src${PYTHONPATH:+:$PYTHONPATH}"
+cd "$ROOT"
+exec "$PY" -m kinlib.course.lms.bundles run gradescope --root "$ROOT" --bundle "$ROOT/source"
+"""
+
+RUN_PL = """#!/usr/bin/env bash
+# PrairieLearn's entrypoint: /grade/student -> /grade/results/results.json
+ROOT="${KINLIB_GRADE_ROOT:-/grade}"
+HERE="$ROOT/serverFilesCourse/kinlib_grader"
+PY="${KINLIB_PYTHON:-python3}"
+export PYTHONPATH="$HERE/kinlib-src${PYTHONPATH:+:$PYTHONPATH}"
+mkdir -p "$ROOT/results"
+exec "$PY" -m kinlib.course.lms.bundles run prairielearn --root "$ROOT" --bundle "$HERE"
+"""
+
+
+# ----------------------------------------------------------------------------------------- the bundle
+
+
+def _copy_package(dest: Path) -> None:
+    import kinlib
+
+    pkg = Path(kinlib.__file__).resolve().parent
+    shutil.copytree(pkg, dest / "kinlib", ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+    repo = pkg.parent
+    for name in ("pyproject.toml", "README.md"):
+        if (repo / name).is_file():
+            shutil.copy(repo / name, dest / name)
+
+
+def build_bundle(
+    dest,
+    notebooks=None,
+    only=None,
+    cache="default",
+    secret=None,
+    sandbox: bool = True,
+    visibility: str = "visible",
+    timeout: float = 300.0,
+    cell_timeout: float = 60.0,
+    log=None,
+) -> dict:
+    """Write the grader bundle into the folder ``dest``; returns its ``config.json`` as a dict.
+
+    The references are computed here (the solution notebooks run in the instructor's grader) and kept as
+    data; the bundle's secret is HMAC(instructor secret, "platform", random nonce), so the platform never
+    holds the instructor's own secret. Runs the solution notebooks (seconds), hence not run here:
+
+    >>> cfg = build_bundle("/tmp/bundle", only=["05"])  # doctest: +SKIP
+    >>> sorted(cfg)  # doctest: +SKIP
+    ['cell_timeout', 'notebooks', 'points', 'sandbox', 'timeout', 'visibility']
+    """
+    from ..grader import grade
+    from ..grader import secret as secret_mod
+
+    if visibility not in VISIBILITIES:
+        raise ValueError(f"visibility must be one of {', '.join(VISIBILITIES)}, got {visibility!r}")
+    log = log or (lambda s: None)
+    dest = Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+    notebooks = Path(notebooks) if notebooks else grade.default_notebooks()
+    ids = None
+    if only:
+        ids = {p.stem for p in notebooks.glob("*.ipynb") if any(p.name.startswith(o) for o in only)}
+        if not ids:
+            raise ValueError(f"no notebook in {notebooks} starts with {', '.join(only)}")
+    if cache == "default":
+        cache = notebooks.resolve().parent / "build" / "grade-cache"
+    master = secret_mod.load_secret(secret)
+    refs = grade.load_references(notebooks, Path(cache) if cache else None, ids, log=log, secret=master)
+    broken = {k: r.error for k, r in refs.items() if r.error}
+    if broken:
+        raise RuntimeError("broken references: " + "; ".join(f"{k}: {e}" for k, e in broken.items()))
+    if not refs:
+        raise ValueError(f"no solution notebooks (with a kinlib.notebook id) in {notebooks}")
+    (dest / "references.json").write_text(json.dumps({k: asdict(v) for k, v in sorted(refs.items())}))
+    derived = secret_mod.sign(master, "platform", os.urandom(16).hex().encode())
+    key = dest / "grader-secret"
+    key.write_text(derived + "\n")
+    key.chmod(0o600)
+    _copy_package(dest / "kinlib-src")
+    env = Path(grade.__file__).resolve().parents[3] / "environment.txt"
+    if env.is_file():
+        shutil.copy(env, dest / "constraints.txt")
+    else:
+        (dest / "constraints.txt").write_text("")
+    points = {}
+    for k, r in refs.items():
+        auto = sum(sum(credit.answer_max(p).values()) for p in r.parts)
+        manual = sum(sum(credit.manual_items(p).values()) for p in r.parts)
+        points[k] = {"auto": float(auto), "manual": float(manual)}
+    cfg = {
+        "notebooks": sorted(refs),
+        "points": points,
+        "sandbox": bool(sandbox),
+        "visibility": visibility,
+        "timeout": float(timeout),
+        "cell_timeout": float(cell_timeout),
+    }
+    (dest / "config.json").write_text(json.dumps(cfg, indent=1, sort_keys=True) + "\n")
+    log(f"bundle: {len(refs)} notebook(s): {', '.join(sorted(refs))}")
+    return cfg
+
+
+def _exe(path: Path, text: str) -> None:
+    path.write_text(text)
+    path.chmod(path.stat().st_mode | stat.S_IXUSR | stat.S_IXGRP | stat.S_IXOTH)
+
+
+def gradescope_zip(out, **kw) -> Path:
+    """Write Gradescope's ``autograder.zip``: ``setup.sh``, ``run_autograder`` and the bundle at its root.
+
+    >>> gradescope_zip("build/autograder.zip", only=["05"])  # runs the solution notebooks  # doctest: +SKIP
+    """
+    out = Path(out)
+    with tempfile.TemporaryDirectory(prefix="kinlib-gs-") as d:
+        root = Path(d)
+        build_bundle(root, **kw)
+        _exe(root / "setup.sh", SETUP_SH)
+        _exe(root / "run_autograder", RUN_AUTOGRADER)
+        out.parent.mkdir(parents=True, exist_ok=True)
+        tmp = out.with_name(out.name + ".part")
+        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as z:
+            for p in sorted(root.rglob("*")):
+                if p.is_file():
+                    info = zipfile.ZipInfo.from_file(p, p.relative_to(root).as_posix())
+                    with open(p, "rb") as f:
+                        z.writestr(info, f.read(), zipfile.ZIP_DEFLATED)
+        os.replace(tmp, out)
+    return out
+
+
+def prairielearn_dir(out, **kw) -> Path:
+    """Write ``out/serverFilesCourse/kinlib_grader/`` (bundle + ``run.sh``) and the ``externalGradingOptions``
+    to put in each question's ``info.json`` (``out/info-externalGradingOptions.json``).
+
+    >>> prairielearn_dir("build/prairielearn", only=["05"])  # runs the solution notebooks  # doctest: +SKIP
+    """
+    out = Path(out)
+    here = out / "serverFilesCourse" / "kinlib_grader"
+    if here.exists():
+        shutil.rmtree(here)
+    cfg = build_bundle(here, **kw)
+    _exe(here / "run.sh", RUN_PL)
+    opts = {
+        "externalGradingOptions": {
+            "enabled": True,
+            "image": "prairielearn/grader-python",
+            "serverFilesCourse": ["kinlib_grader/"],
+            "entrypoint": "/grade/serverFilesCourse/kinlib_grader/run.sh",
+            "timeout": int(min(600, cfg["timeout"] + 60)),
+        }
+    }
+    (out / "info-externalGradingOptions.json").write_text(json.dumps(opts, indent=2) + "\n")
+    return out
+
+
+# ----------------------------------------------------------------------------------------- results formats
+
+
+def _row_output(r: dict) -> str:
+    lines = [r.get("message", "")] if r.get("message") else []
+    for a in r.get("answers") or []:
+        mark = "✓" if a["status"] == "pass" else "✗"
+        lines.append(f"{mark} {a['answer']}: {a['points']:g} / {a['max_points']:g}")
+    return "\n".join(lines)
+
+
+def _manual_note(results: list) -> str:
+    items = [
+        f"{r['part']} {r.get('answer', '')}".strip() + f" ({r['max_points']:g} points)"
+        for res in results
+        for r in res["rows"]
+        if r.get("kind") == "manual"
+    ]
+    return ("Graded by hand, not included in this score: " + ", ".join(items) + ".") if items else ""
+
+
+def _auto_rows(results: list):
+    multi = len({res.get("notebook") for res in results}) > 1
+    for res in results:
+        for r in res["rows"]:
+            if r.get("kind") != "manual":
+                name = f"{res.get('notebook')} {r['part']}" if multi and res.get("notebook") else str(r["part"])
+                yield res, r, name
+
+
+def _summary(results: list, sandbox: bool) -> str:
+    lines = []
+    for res in results:
+        t = credit.result_totals([r for r in res["rows"] if r.get("kind") != "manual"])
+        lines.append(
+            f"{res.get('title') or res.get('notebook') or res['submission']}: "
+            f"{t['points']:g} / {t['max_points']:g} points (automatic)"
+        )
+    note = _manual_note(results)
+    if note:
+        lines.append(note)
+    if not sandbox:
+        lines.append("Graded without the sandbox (--no-sandbox).")
+    return "\n".join(lines)
+
+
+def gradescope_results(results: list, visibility: str = "visible", sandbox: bool = True, seconds: float = 0.0) -> dict:
+    """Gradescope's ``results.json`` for graded results (one test per automatically graded part).
+
+    >>> res = {"submission": "ann.ipynb", "notebook": "05", "rows": [
+    ...     {"part": "5.1", "status": "fail", "points": 2.0, "max_points": 5.0, "message": "s: wrong", "kind": "auto"},
+    ...     {"part": "5.2", "answer": "drawing", "kind": "manual", "status": "pending", "points": 0.0,
+    ...      "max_points": 5.0, "message": ""}]}
+    >>> g = gradescope_results([res])
+    >>> g["score"], [(t["name"], t["score"], t["max_score"], t["status"]) for t in g["tests"]]
+    (2.0, [('5.1', 2.0, 5.0, 'failed')])
+    """
+    if visibility not in VISIBILITIES:
+        raise ValueError(f"visibility must be one of {', '.join(VISIBILITIES)}, got {visibility!r}")
+    tests = []
+    for _, r, name in _auto_rows(results):
+        tests.append(
+            {
+                "name": name,
+                "number": str(r["part"]),
+                "score": float(r.get("points") or 0),
+                "max_score": float(r.get("max_points") or 0),
+                "status": "passed" if r["status"] == "pass" else "failed",
+                "output": _row_output(r),
+                "visibility": visibility,
+            }
+        )
+    if not results:
+        out = "No .ipynb notebook was found in your submission: upload your completed workbook."
+    else:
+        out = _summary(results, sandbox)
+    return {
+        "score": round(sum(t["score"] for t in tests), 6),
+        "execution_time": int(round(seconds)),
+        "output": out,
+        "stdout_visibility": "hidden",
+        "tests": tests,
+    }
+
+
+def prairielearn_results(results: list, sandbox: bool = True) -> dict:
+    """PrairieLearn's ``results.json``: ``score`` = automatic points / their maximum, in [0, 1].
+
+    >>> res = {"submission": "ann.ipynb", "notebook": "05", "rows": [
+    ...     {"part": "5.1", "status": "fail", "points": 2.0, "max_points": 5.0, "message": "s: wrong", "kind": "auto"}]}
+    >>> p = prairielearn_results([res])
+    >>> p["gradable"], p["score"], p["tests"][0]["points"], p["tests"][0]["max_points"]
+    (True, 0.4, 2.0, 5.0)
+    >>> prairielearn_results([])["gradable"]
+    False
+    """
+    bad = [r["message"] for res in results for r in res["rows"] if r["part"] == "-"]
+    if not results or (bad and len(bad) == sum(len(res["rows"]) for res in results)):
+        errs = bad or ["No .ipynb notebook was found in your submission: upload your completed workbook."]
+        return {"gradable": False, "format_errors": errs, "message": errs[0], "tests": []}
+    tests = []
+    for _, r, name in _auto_rows(results):
+        tests.append(
+            {
+                "name": name,
+                "description": f"part {r['part']}",
+                "points": float(r.get("points") or 0),
+                "max_points": float(r.get("max_points") or 0),
+                "message": r.get("message", ""),
+                "output": _row_output(r),
+            }
+        )
+    mx = sum(t["max_points"] for t in tests)
+    score = sum(t["points"] for t in tests) / mx if mx else 0.0
+    return {
+        "gradable": True,
+        "score": min(1.0, max(0.0, round(score, 6))),
+        "message": _summary(results, sandbox),
+        "output": _summary(results, sandbox),
+        "tests": tests,
+    }
+
+
+# ----------------------------------------------------------------------------------------- inside the platform
+
+
+def _load_refs(bundle: Path) -> dict:
+    from ..grader.grade import Reference
+
+    data = json.loads((bundle / "references.json").read_text())
+    return {k: Reference(**v) for k, v in data.items()}
+
+
+def _grade(path: Path, refs: dict, cfg: dict, bundle: Path) -> dict:
+    import inspect
+
+    from ..grader import grade
+
+    kw = {
+        "cell_timeout": cfg.get("cell_timeout", 60.0),
+        "total_timeout": cfg.get("timeout", 300.0),
+        "display_name": path.name,
+    }
+    params = inspect.signature(grade.grade_submission).parameters
+    if "secret" in params:
+        kw["secret"] = (bundle / "grader-secret").read_bytes().strip()
+    if "sandbox" in params:
+        kw["sandbox"] = bool(cfg.get("sandbox", True))
+    res = grade.grade_submission(path, refs, **kw)
+    ref = refs.get(res.get("notebook"))
+    if ref is not None and res.get("credit") != "scored":
+        credit.score_parts(res, ref.parts)
+    res.setdefault("sandbox", bool(cfg.get("sandbox", True)))
+    return res
+
+
+def run_platform(platform: str, root=None, bundle=None) -> dict:
+    """Grade the submission in the platform's layout and write its results file; returns the results dict.
+
+    ``platform`` is "gradescope" (``ROOT/submission`` → ``ROOT/results/results.json``, ROOT default
+    ``/autograder``) or "prairielearn" (``ROOT/student`` → ``ROOT/results/results.json``, ROOT ``/grade``).
+    tests/test_grade_lms.py runs it in a simulated container (bubblewrap); a platform it does not know:
+
+    >>> run_platform("moodle")
+    Traceback (most recent call last):
+    ...
+    ValueError: platform must be gradescope or prairielearn, got 'moodle'
+    """
+    from ..grader.grade import find_submissions
+
+    if platform not in _ROOTS:
+        raise ValueError(f"platform must be gradescope or prairielearn, got {platform!r}")
+    env, default = _ROOTS[platform]
+    root = Path(root or os.environ.get(env) or default)
+    bundle = (
+        Path(bundle)
+        if bundle
+        else (root / "source" if platform == "gradescope" else root / "serverFilesCourse" / "kinlib_grader")
+    )
+    t0 = time.monotonic()
+    import kinlib
+
+    cfg = json.loads((bundle / "config.json").read_text())
+    print(f"kinlib {kinlib.__version__} from {Path(kinlib.__file__).parent}", flush=True)  # the instructor's log
+    refs = _load_refs(bundle)
+    subdir = root / ("submission" if platform == "gradescope" else "student")
+    subs = find_submissions([subdir]) if subdir.is_dir() else []
+    results = [_grade(p, refs, cfg, bundle) for p in subs]
+    broken = [res["infrastructure"] for res in results if res.get("infrastructure")]
+    if broken:  # the platform's machine, not the student: report a failed run, never a grade of 0
+        raise RuntimeError(broken[0])
+    for res in results:
+        print(report.summary_table([res], res.get("seconds", 0.0), 0.0, 1), flush=True)
+    if platform == "gradescope":
+        out = gradescope_results(
+            results, cfg.get("visibility", "visible"), cfg.get("sandbox", True), time.monotonic() - t0
+        )
+    else:
+        out = prairielearn_results(results, cfg.get("sandbox", True))
+    dest = root / "results" / "results.json"
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    report.atomic_write(dest, json.dumps(out, indent=1, ensure_ascii=False) + "\n")
+    return out
+
+
+# ----------------------------------------------------------------------------------------- Canvas
+
+
+CANVAS_IDENTITY = ["Student", "ID", "SIS User ID", "SIS Login ID", "Section"]
+
+
+def canvas_csv(
+    grades,
+    assignment: str,
+    out,
+    id_column: str = "ID",
+    roster=None,
+    include_pending: bool = False,
+    overrides=None,
+    points_possible=None,
+) -> list[str]:
+    """Write a Canvas gradebook import CSV from the class folder ``grades`` (``kinlib grade --out``);
+    returns warnings (students pending, students not in the roster).
+
+    One assignment column: each student's total over their notebooks (overrides applied); the
+    ``Points Possible`` row is the sum over the class's notebooks of each notebook's maximum (or
+    ``points_possible``).
+
+    >>> import tempfile
+    >>> res = {"student_id": "12345", "submission": "a.ipynb", "notebook": "05", "rows": [
+    ...     {"part": "5.1", "status": "pass", "points": 5.0, "max_points": 5.0, "message": ""}]}
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = report.write_outputs(Path(d), [dict(res, path="/x/12345.ipynb")])
+    ...     _ = canvas_csv(Path(d), "Problem Set 4", Path(d) / "canvas.csv")
+    ...     print((Path(d) / "canvas.csv").read_text(), end="")
+    Student,ID,SIS User ID,SIS Login ID,Section,Problem Set 4
+    Points Possible,,,,,5
+    ,12345,,,,5
+    """
+    if id_column not in CANVAS_IDENTITY[:4]:
+        raise ValueError(f"id_column must be one of {', '.join(CANVAS_IDENTITY[:4])}, got {id_column!r}")
+    grades = Path(grades)
+    results = report.load_results(grades)
+    if not results:
+        raise FileNotFoundError(f"no graded results in {grades / 'results'} (run kinlib grade --out {grades} first)")
+    if overrides is None:
+        overrides = report.default_overrides(grades)
+    if overrides is not None and not isinstance(overrides, list):
+        overrides = credit.load_overrides(overrides)
+    warnings = credit.apply_overrides(results, overrides or [])
+    totals = report.student_totals(results)
+    per_nb: dict = {}
+    for res in results:
+        if res.get("notebook"):
+            mx = sum(r.get("max_points", 0) for r in res["rows"])
+            per_nb[res["notebook"]] = max(per_nb.get(res["notebook"], 0), mx)
+    possible = float(points_possible) if points_possible is not None else sum(per_nb.values())
+    ident: dict = {}
+    if roster is not None:
+        with open(roster, newline="", encoding="utf-8-sig") as f:
+            for row in csv.DictReader(f):
+                for col in CANVAS_IDENTITY[:4]:
+                    v = (row.get(col) or "").strip()
+                    if v and v != "Points Possible":
+                        ident.setdefault(v, {c: (row.get(c) or "").strip() for c in CANVAS_IDENTITY})
+    rows = [CANVAS_IDENTITY + [assignment], ["Points Possible", "", "", "", ""] + [possible]]
+    for sid in sorted(totals):
+        t = totals[sid]
+        who = ident.get(sid)
+        if roster is not None and who is None:
+            warnings.append(f"{sid}: not in the roster {roster}; left out")
+            continue
+        who = who or dict.fromkeys(CANVAS_IDENTITY, "") | {id_column: sid}
+        score = t["points"]  # a number: report.csv_text keeps it one
+        if t["pending"] and not include_pending:
+            warnings.append(f"{sid}: pending {' '.join(t['pending'])}: left blank (ungraded in Canvas)")
+            score = ""
+        rows.append([who[c] for c in CANVAS_IDENTITY] + [score])
+    report.atomic_write(Path(out), report.csv_text(rows))  # text cells neutralised (OWASP's rule)
+    return warnings
+
+
+# ----------------------------------------------------------------------------------------- entry point
+
+
+def main(argv=None) -> int:
+    """``python -m kinlib.course.lms.bundles run gradescope|prairielearn [--root R] [--bundle B]`` (inside the platform).
+
+    Always writes a results file: a failure of the grader becomes an error result (and exit status 1).
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:  # no grader bundle there
+    ...     main(["run", "prairielearn", "--root", d])
+    ...     json.loads((Path(d) / "results" / "results.json").read_text())["gradable"]
+    1
+    False
+    """
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python -m kinlib.course.lms.bundles")
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("platform", choices=sorted(_ROOTS))
+    r.add_argument("--root", type=Path, default=None)
+    r.add_argument("--bundle", type=Path, default=None)
+    args = ap.parse_args(argv)
+    try:
+        run_platform(args.platform, args.root, args.bundle)
+    except Exception as exc:  # noqa: BLE001  the platform must get a results file whatever happens
+        env, default = _ROOTS[args.platform]
+        root = Path(args.root or os.environ.get(env) or default)
+        msg = f"the autograder failed: {type(exc).__name__}: {exc}"
+        if "bwrap" in msg or "sandbox" in msg:
+            msg += (
+                " (the platform's container cannot run bubblewrap: build the bundle again with --no-sandbox; "
+                "each submission already runs in a container of its own)"
+            )
+        print(msg, file=sys.stderr)
+        out = (
+            {"score": 0.0, "output": msg, "tests": [], "stdout_visibility": "hidden"}
+            if args.platform == "gradescope"
+            else {"gradable": False, "format_errors": [msg], "message": msg, "tests": []}
+        )
+        dest = root / "results" / "results.json"
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        dest.write_text(json.dumps(out, indent=1) + "\n")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,391 @@
+"""The HTML side of the handouts: pages exported with nbconvert, the index, and the offline assets.
+
+MathJax 2 is copied from the installed ``jupyter-server-mathjax``; require.js, font-awesome and the
+``@jupyter-widgets/html-manager`` embed bundle are ``npm pack``-ed from the npm registry into a vendor
+folder once, then reused, so every page renders offline.
+"""
+
+from __future__ import annotations
+
+import copy
+import html
+import re
+import shutil
+import time
+from pathlib import Path
+
+from .lite import lite_link
+from .npm import npm_pack
+
+__all__ = [
+    "build_assets",
+    "npm_pack",
+    "export_html",
+    "write_index",
+    "LINKS",
+    "print_header",
+    "contrast_ratio",
+    "COURSE",
+    "HTML_MANAGER",
+    "REQUIREJS",
+    "FONT_AWESOME",
+    "MATHJAX_CONFIG",
+]
+
+HTML_MANAGER = ("@jupyter-widgets/html-manager", "1.0.15")  # the embedder for ipywidgets 8.1 (controls 5)
+REQUIREJS = ("requirejs", "2.3.8")
+FONT_AWESOME = ("font-awesome", "4.7.0")  # the play buttons of matplotlib's to_jshtml() animations
+_FA_CDN = re.compile(
+    r"https?://(?:maxcdn|stackpath)\.bootstrapcdn\.com/font-awesome/[0-9.]+/css/font-awesome(?:\.min)?\.css"
+)
+_FA_LOCAL = "../assets/font-awesome/css/font-awesome.min.css"
+_REQUIRE_TAG = '<script src="../assets/require.js"></script>'
+# The widget bundle finds its icon fonts relative to its AMD module ids: point those at assets/widgets/.
+_WIDGET_PATHS = """<script>
+window.__jupyter_widgets_assets_path__ = "../assets/widgets/";
+if (window.requirejs) {
+  requirejs.config({paths: {
+    "@jupyter-widgets/html-manager/dist": "../assets/widgets",
+    "@jupyter-widgets/base": "../assets/widgets/base", "@jupyter-widgets/controls": "../assets/widgets/controls",
+    "@jupyter-widgets/output": "../assets/widgets/output", "@jupyter-widgets/html-manager": "../assets/widgets/hm"}});
+}
+</script>"""
+MATHJAX_CONFIG = "TeX-AMS-MML_HTMLorMML-full,Safe,kinlib"
+_MATHJAX_LOCAL_CONFIG = """\
+/* kinlib: MathJax 2 from jupyter-server-mathjax ships only the STIX-Web fonts: use them, no image fonts. */
+/* No URL that is not there: MathJax_Blank (a font-loading probe) and the TeX web fonts of the hidden
+   (assistive) MathML point at local() names instead of about:blank and the missing TeX otf files. */
+(function () {
+  var none = "local('kinlib-no-such-font')", mml = {};
+  for (var i = 1; i <= 6; i++) { mml["@font-face /*" + i + "*/"] = {src: none}; }
+  MathJax.Hub.Config({
+    "HTML-CSS": {availableFonts: [], preferredFont: null, webFont: "STIX-Web", imageFont: null,
+                 styles: {"@font-face": {"font-family": "MathJax_Blank", src: none}}},
+    NativeMML: {styles: mml},
+    SVG: {font: "STIX-Web"},
+    MathMenu: {showLocale: false}
+  });
+})();
+MathJax.Ajax.loadComplete("[MathJax]/config/kinlib.js");
+"""
+
+
+_npm_pack = npm_pack  # the old private name, used below
+
+
+LINKS = ("pdf", "lite")  # the other forms a handout links to when they are built (PDF, the in-browser site)
+
+
+def build_assets(assets: Path, vendor: Path) -> dict:
+    """Copy MathJax, require.js and the widget embedder into ``assets``; return their relative URLs
+    (the keyword arguments of nbconvert's HTMLExporter used by :func:`export_html`).
+
+    It copies MathJax and may run ``npm pack`` (a download, the first time), hence not run here;
+    tests/test_handouts.py exercises it:
+
+    >>> urls = build_assets(Path("build/handouts/assets"), Path("build/vendor"))  # doctest: +SKIP
+    >>> urls["require_js_url"]  # doctest: +SKIP
+    '../assets/require.js'
+    """
+    import jupyter_server_mathjax
+
+    assets.mkdir(parents=True, exist_ok=True)
+    mj_src = Path(jupyter_server_mathjax.__file__).parent / "static"
+    mj = assets / "mathjax"
+    if not (mj / "MathJax.js").exists():
+        shutil.copytree(mj_src, mj, dirs_exist_ok=True)
+    (mj / "config" / "kinlib.js").write_text(_MATHJAX_LOCAL_CONFIG)
+
+    hm = _npm_pack(*HTML_MANAGER, vendor)
+    wdst = assets / "widgets"
+    wdst.mkdir(exist_ok=True)
+    for f in (hm / "dist").iterdir():
+        if f.name == "embed-amd.js" or f.suffix in (".woff", ".woff2", ".ttf", ".eot", ".svg"):
+            shutil.copy2(f, wdst / f.name)
+    rq = _npm_pack(*REQUIREJS, vendor)
+    shutil.copy2(rq / "require.js", assets / "require.js")
+    fa = _npm_pack(*FONT_AWESOME, vendor)
+    for sub in ("css", "fonts"):
+        shutil.copytree(fa / sub, assets / "font-awesome" / sub, dirs_exist_ok=True)
+    return {
+        "mathjax_url": f"../assets/mathjax/MathJax.js?config={MATHJAX_CONFIG}",
+        "require_js_url": "../assets/require.js",
+        "widget_renderer_url": "../assets/widgets/embed-amd.js",
+    }
+
+
+def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool, links=LINKS) -> None:
+    """Write ``nb`` as a page ``dest`` using the offline assets ``urls``; ``problems`` drops prompt numbers.
+    ``links``: which of the other forms the page links to, of ``("pdf", "lite")`` (those that are built).
+
+    The assets need not be there to write the page (``urls`` are only links):
+
+    >>> import nbformat, tempfile
+    >>> nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell("# Planar arms")])
+    >>> urls = {"require_js_url": "../assets/require.js", "mathjax_url": "../assets/mathjax/MathJax.js"}
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     export_html(nb, Path(d) / "problems" / "02_x.html", urls, title="Planar arms", problems=True)
+    ...     page = (Path(d) / "problems" / "02_x.html").read_text()
+    >>> "<title>Planar arms</title>" in page, 'src="../assets/require.js"' in page
+    (True, True)
+    """
+    from nbconvert import HTMLExporter
+
+    nb = copy.deepcopy(nb)
+    for c in nb.cells:  # matplotlib's to_jshtml() links font-awesome on a CDN
+        for o in c.get("outputs", []):
+            h = o.get("data", {}).get("text/html")
+            if h:
+                h = _FA_CDN.sub(_FA_LOCAL, h if isinstance(h, str) else "".join(h))
+                h = h.replace('<input id="_anim_slider', '<input aria-label="animation frame" id="_anim_slider')
+                if "_anim_img" in h and _FA_LOCAL not in h:  # an animation whose CDN link was dropped
+                    h = f'<link rel="stylesheet" href="{_FA_LOCAL}">\n' + h
+                o["data"]["text/html"] = h
+    exporter = HTMLExporter(
+        template_name="lab", embed_images=True, exclude_input_prompt=problems, exclude_output_prompt=problems, **urls
+    )
+    body, _ = exporter.from_notebook_node(nb, resources={"metadata": {"name": title}})
+    if _REQUIRE_TAG not in body:
+        raise RuntimeError(f"nbconvert's lab template changed: no {_REQUIRE_TAG} in {dest.name}")
+    body = body.replace(_REQUIRE_TAG, _REQUIRE_TAG + "\n" + _WIDGET_PATHS, 1)
+    body = _print_and_links(body, nb, dest, title=title, problems=problems, links=links)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    dest.write_text(body, encoding="utf-8")
+
+
+# ---------------------------------------------------------------------------------------------------
+# What export_html adds to nbconvert's page: the print stylesheet and header (kinlib.course.publish.printing), a bar
+# of links (index, PDF, workbook, "open in the browser"), and a text alternative for every figure.
+
+COURSE = "Problem Set 4"  # the course name in the PDF page headers
+_NO_ALT = 'alt="No description has been provided for this image"'  # what nbconvert puts on every figure
+_LINKS_CSS = """<style>/* kinlib: the links bar, and contrast (WCAG AA) for the prompts */
+.kinlib-links { font: 14px/1.5 system-ui, sans-serif; margin: 0 0 1rem; padding: .5rem 0; border-bottom: 1px solid #ccc; }
+.kinlib-links a { color: #0b4fa8; margin-right: 1.2rem; }
+.jp-InputPrompt, .jp-OutputPrompt { opacity: 1 !important; }
+.jp-InputPrompt { color: #245e91 !important; } .jp-OutputPrompt { color: #9c3f22 !important; }
+</style>
+"""
+
+
+def _luminance(hexcolor: str) -> float:
+    h = hexcolor.lstrip("#")
+    if len(h) == 3:
+        h = "".join(c * 2 for c in h)
+    channels = [int(h[i : i + 2], 16) / 255 for i in (0, 2, 4)]
+    lin = [c / 12.92 if c <= 0.04045 else ((c + 0.055) / 1.055) ** 2.4 for c in channels]
+    return 0.2126 * lin[0] + 0.7152 * lin[1] + 0.0722 * lin[2]
+
+
+def contrast_ratio(fg: str, bg: str) -> float:
+    """WCAG 2 contrast ratio (L1 + 0.05) / (L2 + 0.05) of two ``#rgb``/``#rrggbb`` colours.
+
+    >>> round(contrast_ratio("#408080", "#f5f5f5"), 2), round(contrast_ratio("#000", "#fff"), 1)
+    (4.17, 21.0)
+    """
+    a, b = sorted((_luminance(fg), _luminance(bg)), reverse=True)
+    return (a + 0.05) / (b + 0.05)
+
+
+def _code_colours(body: str, background: str = "#f5f5f5", target: float = 4.6) -> str:
+    """CSS overriding the syntax colours of JupyterLab's light theme (``--jp-mirror-editor-*-color``) that
+    have less than WCAG AA contrast on the code background: each is darkened until it has ``target``."""
+    fixes = {}
+    for name, colour in re.findall(r"(--jp-mirror-editor-[\w-]+-color):\s*(#[0-9a-fA-F]{3}(?:[0-9a-fA-F]{3})?);", body):
+        h = colour.lstrip("#")
+        rgb = [int((h[i] * 2) if len(h) == 3 else h[2 * i : 2 * i + 2], 16) for i in range(3)]
+        new = colour
+        while contrast_ratio(new, background) < target:
+            rgb = [int(c * 0.92) for c in rgb]
+            new = "#" + "".join(f"{c:02x}" for c in rgb)
+        if new != colour:
+            fixes.setdefault(name, new)
+    if not fixes:
+        return ""
+    return (
+        "<style>/* kinlib: syntax colours with WCAG AA contrast */ :root { "
+        + " ".join(f"{k}: {v};" for k, v in fixes.items())
+        + " }</style>\n"
+    )
+
+
+def print_header(stem: str, title: str, problems: bool) -> str:
+    """The header of each printed page of a handout: course, section number, title and which handout.
+
+    >>> print_header("05_singularities_planar", "Singularities: the planar robot (solutions)", False)
+    'Problem Set 4 · 5 Singularities: the planar robot — solutions'
+    """
+    kind = "problems" if problems else "solutions"
+    base = re.sub(r"\s*\((?:problems|solutions)\)\s*$", "", title)
+    number = f"{int(stem[:2])} " if stem[:2].isdigit() else ""
+    return f"{COURSE} · {number}{base} — {kind}"
+
+
+def _plain(text: str) -> str:
+    """Markdown/TeX to a short plain sentence for alt text."""
+    text = re.sub(r"!\[[^\]]*\]\([^)]*\)|<[^>]+>", "", text)
+    text = re.sub(r"\[([^\]]*)\]\([^)]*\)", r"\1", text)
+    text = re.sub(r"\\(?:bigl|bigr|Bigl|Bigr|left|right|,|;|!)", "", text)
+    greek = {"theta": "θ", "pi": "π", "omega": "ω", "sigma": "σ", "mu": "μ", "lambda": "λ", "phi": "φ", "alpha": "α"}
+    text = re.sub(r"\\(theta|pi|omega|sigma|mu|lambda|phi|alpha)(?![A-Za-z])", lambda m: greek[m.group(1)], text)
+    text = re.sub(r"[*_`#${}]|\\(?:mathrm|text|operatorname|boldsymbol|mathbf)|\\", "", text)
+    return " ".join(text.split())
+
+
+def _figure_alts(nb, section_default: str) -> dict:
+    """{cell id: alt text} for the code cells with figures: "Figure k of <section>: <caption>", the caption
+    being the figure's ``title="…"`` in the cell's code, else the first sentence of the markdown just above; a
+    cell's ``metadata.kinlib.alt`` (a string) wins."""
+    alts, heading, k, prev_md = {}, section_default, 0, ""
+    for c in nb.cells:
+        if c.cell_type == "markdown":
+            m = re.search(r"^#{1,3}\s+(.+)$", c.source, re.M)
+            if m:
+                heading, k = _plain(m.group(1)), 0
+            prev_md = _plain(re.sub(r"^#{1,6}\s+.*$", "", c.source, flags=re.M))
+            continue
+        n_img = sum(
+            1
+            for o in c.get("outputs", [])
+            if {"image/png", "image/jpeg"} & set(o.get("data", {})) or "_anim_img" in str(o.get("data", {}))
+        )
+        if n_img and c.get("id"):
+            k += 1
+            given = c.get("metadata", {}).get("kinlib", {}).get("alt")
+            title = re.search(r"""\btitle\s*=\s*f?(["'])(.+?)\1""", c.source)
+            sentence = re.sub(r"^\d+(?:\.\d+)*\s*\(\d+ points?\)\.?\s*", "", prev_md).split(". ")[0]
+            if title and "{" not in title.group(2):  # the figure's own title (an f-string's varies: not that)
+                caption = _plain(title.group(2))
+            else:
+                caption = sentence[:160] if len(sentence) >= 20 else ""
+            alts[c["id"]] = (
+                given
+                if isinstance(given, str) and given.strip()
+                else f"Figure {k} of “{heading}”" + (f": {caption}" if caption else "")
+            )
+        prev_md = ""
+    return alts
+
+
+def _print_and_links(body: str, nb, dest: Path, *, title: str, problems: bool, links=LINKS) -> str:
+    from .printing import HEADER_META, PRINT_HEAD
+
+    stem, kind = dest.stem, dest.parent.name
+    header = print_header(stem, title, problems)
+    head = f'<meta name="{HEADER_META}" content="{html.escape(header)}">\n{_LINKS_CSS}{_code_colours(body)}{PRINT_HEAD}'
+    if "</head>" not in body:
+        raise RuntimeError(f"nbconvert's lab template changed: no </head> in {dest.name}")
+    body = body.replace("</head>", head + "</head>", 1)
+    notebook = f"{'workbooks' if problems else 'solutions'}/{stem}.ipynb"
+    which = "the workbook" if problems else "this notebook"
+    bar_links = [("../index.html", "All handouts (course index)")]
+    if "pdf" in links:
+        bar_links.append((f"../pdf/{kind}/{stem}.pdf", f"PDF of this page ({kind})"))
+    if "lite" in links:
+        bar_links.append(
+            ("../" + lite_link(notebook), f"Open {which} in the browser (JupyterLite, nothing to install)")
+        )
+    if problems:
+        bar_links.append((f"../workbooks/{stem}.ipynb", "Download the workbook (.ipynb)"))
+    bar = '<nav class="kinlib-links" aria-label="This handout">' + "".join(
+        f'<a href="{html.escape(href)}">{html.escape(text)}</a>' for href, text in bar_links
+    )
+    bar += "</nav>\n"
+    m = re.search(r"<main>", body)
+    if m is None:
+        raise RuntimeError(f"nbconvert's lab template changed: no <main> in {dest.name}")
+    body = body[: m.end()] + "\n" + bar + body[m.end() :]
+    alts = _figure_alts(nb, html.unescape(header))
+    pieces = re.split(r'(id="cell-id=[^"]*")', body)
+    for i in range(1, len(pieces), 2):
+        alt = alts.get(pieces[i][len('id="cell-id=') : -1])
+        if alt:
+            pieces[i + 1] = pieces[i + 1].replace(_NO_ALT, f'alt="{html.escape(alt)}"')
+    return "".join(pieces).replace(_NO_ALT, f'alt="{html.escape("Figure in " + header)}"')
+
+
+_INDEX = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>{course} handouts: Jacobians, singularities and manipulability</title>
+<style>
+body {{ font: 16px/1.5 system-ui, sans-serif; max-width: 52rem; margin: 2rem auto; padding: 0 1rem;
+  color: #1f1f1f; background: #fff; }}
+a {{ color: #0b4fa8; }} a:visited {{ color: #5b2a86; }} a:focus {{ outline: 2px solid #0b4fa8; outline-offset: 2px; }}
+section {{ border-top: 1px solid #ccc; padding: .2rem 0 .6rem; }}
+h2 {{ font-size: 1.25rem; margin: .8rem 0 .2rem; }}
+.sections, footer {{ color: #595959; font-size: .9em; margin: 0 0 .3rem; }}
+ul.links {{ margin: .2rem 0; padding-left: 1.2rem; }} ul.links li {{ margin: .15rem 0; }}
+.sep {{ color: #595959; padding: 0 .4rem; }}
+</style></head><body>
+<header>
+<h1>{course}: Jacobians, singularities and manipulability</h1>
+<p>For each notebook of the course: the <strong>problems</strong> (questions, no answers) and the worked
+<strong>solutions</strong>, as web pages and as PDFs; the <strong>workbook</strong>, a Jupyter notebook to fill
+in with self-checks, to download or to <strong>open in the browser</strong> (JupyterLite: Python runs in the
+browser tab, nothing to install; it needs this folder served over http, for example by <code>make site</code>
+or any static web host, and its first start takes a while).</p>
+<p>These pages load nothing from the internet: every script, font and picture is in this folder.</p>
+</header>
+<main>
+{rows}
+</main>
+<footer><p>Built by <code>make handouts</code> ({when}).</p></footer>
+</body></html>
+"""
+
+
+def write_index(out: Path, entries: list, links=LINKS) -> None:
+    """Write ``out/index.html``, the course front page: for each entry (a section of the course) its
+    problems and solutions (web page and PDF), its workbook (download, and "open in the browser" with
+    JupyterLite) and its solution notebook in the browser (``links``: which of ``("pdf", "lite")`` were built; the
+    others are left out). Offline (no external URL), ``lang="en"``, one h1
+    then an h2 per section, link texts that name the section and the target.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     write_index(Path(d), [{"stem": "01_x", "title": "X", "sections": ["1.1"]}])
+    ...     page = (Path(d) / "index.html").read_text()
+    >>> 'href="problems/01_x.html"' in page, 'href="pdf/solutions/01_x.pdf"' in page, "://" in page
+    (True, True, False)
+    """
+    rows = []
+    pdf, lite = "pdf" in links, "lite" in links
+    for e in entries:
+        stem = e["stem"]
+        num = str(int(stem[:2])) if stem[:2].isdigit() else stem
+        title = html.escape(e["title"])
+        sections = ", ".join(e.get("sections") or [])
+
+        def a(href, text, extra=""):
+            return f'<a href="{html.escape(href)}"{extra}>{html.escape(text)}</a>'
+
+        sep = '<span class="sep" aria-hidden="true">·</span>'
+        rows.append(
+            f'<section aria-labelledby="s{stem}"><h2 id="s{stem}">{html.escape(num)} · {title}</h2>\n'
+            + (f'<p class="sections">Problem set sections {html.escape(sections)}</p>\n' if sections else "")
+            + '<ul class="links">\n'
+            + f"<li>{a(f'problems/{stem}.html', f'Problems {num} (web page)')}"
+            + (f"{sep}{a(f'pdf/problems/{stem}.pdf', f'Problems {num} (PDF)')}" if pdf else "")
+            + "</li>\n"
+            + f"<li>{a(f'solutions/{stem}.html', f'Solutions {num} (web page)')}"
+            + (f"{sep}{a(f'pdf/solutions/{stem}.pdf', f'Solutions {num} (PDF)')}" if pdf else "")
+            + (
+                f"{sep}{a(lite_link(f'solutions/{stem}.ipynb'), f'Solutions {num}: open the notebook in the browser')}"
+                if lite
+                else ""
+            )
+            + "</li>\n"
+            + f"<li>{a(f'workbooks/{stem}.ipynb', f'Workbook {num} (download .ipynb)', ' download')}"
+            + (
+                f"{sep}{a(lite_link(f'workbooks/{stem}.ipynb'), f'Workbook {num}: open in the browser')}"
+                if lite
+                else ""
+            )
+            + "</li>\n"
+            "</ul></section>"
+        )
+    (out / "index.html").write_text(
+        _INDEX.format(rows="\n".join(rows), when=time.strftime("%Y-%m-%d"), course=html.escape(COURSE)),
+        encoding="utf-8",
+    )
