@@ -406,6 +406,13 @@ def test_an_enclosure_leaves_no_cgroup_mount_or_folder():
     assert not any(g.exists() for g in groups)
 
 
+def test_without_cgroups_the_enclosure_falls_back_to_rlimits(monkeypatch):
+    monkeypatch.setitem(limits._SUPPORT, "res", ("", "no writable cgroup"))  # noqa: SLF001  (a machine without)
+    with limits.Enclosure(limits.Limits(processes=100), "t") as e:
+        assert e.kind == "" and e.cgroups == [] and e.wrap(["python"]) == ["python"]
+        assert e.rlimits()["nproc"] == 100 and "rlimits only" in e.describe() and e.reached() == []
+
+
 BOMBS = {
     # each names its processes MARK, so that the test can look for survivors
     "fork": (

@@ -309,8 +309,8 @@ class Enclosure:
                 self.cgroups = [where["memory"] / name, where["pids"] / name]
             for c in self.cgroups:
                 c.mkdir()
-            self.kind = kind
-            if not self._apply():
+            self.kind = kind if self.cgroups else ""
+            if self.kind and not self._apply():
                 self.kind = ""
         except OSError:
             self.kind = ""
