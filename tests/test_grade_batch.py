@@ -145,6 +145,39 @@ def test_links_fifos_and_folders_are_refused_one_by_one(tmp_path):
         assert "symbolic link" in intake.read_notebook(root / "link.ipynb")[2]
 
 
+def test_a_class_of_hostile_files_is_graded_row_by_row(tmp_path):
+    d = tmp_path / "subs"
+    d.mkdir()
+    (d / "deep.ipynb").write_text('{"metadata": ' + "[" * 100_000 + "]" * 100_000 + ', "cells": []}')
+    (d / "string.ipynb").write_text('{"nbformat": "4", "cells": []}')
+    (d / "latin1.ipynb").write_bytes(b'{"cells": [], "x": "\xe9"}')
+    with open(d / "huge.ipynb", "wb") as f:
+        f.truncate(intake.MAX_SUBMISSION_BYTES + 1)  # sparse: costs nothing to make
+    os.mkfifo(d / "fifo.ipynb")
+    (d / "env.ipynb").symlink_to(Path(sys.prefix) / "pyvenv.cfg")  # a link into the environment
+    out = tmp_path / "out"
+    with _Alarm(300):
+        summary = grade.grade_batch(
+            [d], out, jobs=2, notebooks=FIX / "notebooks", cache=tmp_path / "c", log=None
+        )  # the sandbox on: a link no longer makes the whole batch refuse
+    got = {r["relpath"]: r["rows"] for r in summary["results"]}
+    want = {
+        "deep.ipynb": "nested 100001 levels deep",
+        "string.ipynb": "nbformat is '4' (a str)",
+        "latin1.ipynb": "not JSON",
+        "huge.ipynb": "larger than 50 MB",
+        "fifo.ipynb": "a FIFO",
+        "env.ipynb": "a symbolic link",
+    }
+    assert set(got) == set(want)
+    for name, words in want.items():
+        (row,) = got[name]
+        assert row["status"] == "error" and words in row["message"], (name, row["message"])
+    assert {r[1] for r in _read(out / "grades.csv")[1:]} == set(want)
+    assert len(list((out / "feedback").iterdir())) == len(want) and summary["infrastructure_errors"] == 0
+    assert _children() == []
+
+
 # ----------------------------------------------------------------------------------------- identity
 
 

@@ -137,7 +137,7 @@ def find_submissions(paths, root=None) -> list[Submission]:
     for p in map(Path, paths):
         if not os.path.lexists(p):
             raise FileNotFoundError(f"no such file or folder: {p}")
-        if p.is_dir() and not p.is_symlink():
+        if p.is_dir():  # a folder given on the command line is the instructor's: followed (its contents are not)
             top = Path(os.path.abspath(p))
             for parts, q in _walk(top):
                 found.append(Submission(q, "/".join(parts), str(top), _refusal(q)))
