@@ -197,110 +197,125 @@ class Supervisor:
     def run(self, tasks: list) -> list:
         """One result per task, in order (graded, or the ``fail`` result of an infrastructure failure)."""
         t0 = time.monotonic()
-        subreaper = _set_subreaper()
-        results: list = [None] * len(tasks)
-        attempts = [0] * len(tasks)
-        queue = deque(range(len(tasks)))
-
-        def lost(w: _Worker, why: str):
-            i = w.task
-            self._kill(w)
-            self.cleanup(w.proc.pid)
-            if subreaper:
-                self._reap_orphans()
-            if i is None:
-                if not w.ready:
-                    self.start_failures += 1
-                    self.log.append(f"a grading worker did not start ({why})")
-                return
-            if attempts[i] < MAX_ATTEMPTS:
-                self.on_event("retry", w.proc.pid, i)
-                queue.appendleft(i)
-            else:
-                self.on_event("gave-up", w.proc.pid, i)
-                self._set(
-                    results, i, self.fail(tasks[i], f"the grading worker {why} twice while grading it; run it again")
-                )
-
+        self.tasks, self.results = tasks, [None] * len(tasks)
+        self.attempts, self.queue = [0] * len(tasks), deque(range(len(tasks)))
+        self.subreaper = _set_subreaper()
         try:
-            while queue or any(w.task is not None for w in self.workers):
-                now = time.monotonic()
-                if self.batch_timeout is not None and now - t0 > self.batch_timeout:
-                    for w in list(self.workers):
-                        lost_task = w.task
-                        self._kill(w)
-                        self.cleanup(w.proc.pid)
-                        if lost_task is not None:
-                            queue.append(lost_task)
-                    for i in queue:
-                        why = f"the batch's time limit ({self.batch_timeout:g} s) was reached before it was graded"
-                        self._set(results, i, self.fail(tasks[i], why))
-                    queue.clear()
+            while self.queue or any(w.task is not None for w in self.workers):
+                if self.batch_timeout is not None and time.monotonic() - t0 > self.batch_timeout:
+                    self._give_up_all(
+                        f"the batch's time limit ({self.batch_timeout:g} s) was reached before it was graded"
+                    )
                     break
                 busy = sum(w.task is not None for w in self.workers)
-                if len(self.workers) < min(self.jobs, len(queue) + busy) and self.start_failures < MAX_START_FAILURES:
+                if (
+                    len(self.workers) < min(self.jobs, len(self.queue) + busy)
+                    and self.start_failures < MAX_START_FAILURES
+                ):
                     self._spawn()
-                if queue and self.start_failures >= MAX_START_FAILURES and not self.workers:
-                    why = "; ".join(self.log[-MAX_START_FAILURES:])
-                    for i in queue:
-                        self._set(results, i, self.fail(tasks[i], f"no grading worker could start ({why})"[:600]))
-                    queue.clear()
+                if self.queue and self.start_failures >= MAX_START_FAILURES and not self.workers:
+                    self._give_up_all(f"no grading worker could start ({'; '.join(self.log[-MAX_START_FAILURES:])})")
                     break
-                for w in self.workers:
-                    if w.ready and w.task is None and queue:
-                        i = queue.popleft()
-                        attempts[i] += 1
-                        try:
-                            w.conn.send(("task", i, tasks[i]))
-                        except OSError:
-                            queue.appendleft(i)
-                            attempts[i] -= 1
-                            continue
-                        w.task, w.task_started, w.last_beat = i, time.monotonic(), time.monotonic()
-                        self.on_event("start", w.proc.pid, i)
-                conns = [w.conn for w in self.workers]
-                for conn in wait(conns, timeout=0.5) if conns else time.sleep(0.2) or []:
-                    w = next((x for x in self.workers if x.conn is conn), None)
-                    if w is None:
-                        continue
-                    try:
-                        while conn.poll():
-                            self._message(w, conn.recv(), results, tasks)
-                    except (EOFError, OSError, pickle.UnpicklingError):
-                        code = w.proc.poll()
-                        self.on_event("died", w.proc.pid, w.task)
-                        lost(w, f"died (exit status {code if code is not None else 'unknown'})")
-                now = time.monotonic()
-                for w in list(self.workers):
-                    code = w.proc.poll()
-                    if code is not None:
-                        self.on_event("died", w.proc.pid, w.task)
-                        lost(w, f"died (exit status {code})")
-                    elif not w.ready and now - w.started > self.start_timeout:
-                        lost(w, f"sent nothing in {self.start_timeout:g} s")
-                    elif w.task is not None and now - w.last_beat > self.beat_limit:
-                        self.on_event("stuck", w.proc.pid, w.task)
-                        lost(w, f"stopped answering (no heartbeat for {self.beat_limit:g} s)")
-                    elif w.task is not None and now - w.task_started > self.task_timeout:
-                        self.on_event("stuck", w.proc.pid, w.task)
-                        lost(w, f"went past the {self.task_timeout:g} s limit for one submission")
+                self._assign()
+                self._receive()
+                self._check()
         finally:
-            for w in list(self.workers):
+            self._stop_all()
+        return self.results
+
+    def _give_up_all(self, why: str) -> None:
+        """End every worker; every task not graded yet gets its ``fail`` result."""
+        for w in list(self.workers):
+            if w.task is not None:
+                self.queue.append(w.task)
+            self._kill(w)
+            self.cleanup(w.proc.pid)
+        for i in self.queue:
+            self._set(self.results, i, self.fail(self.tasks[i], why[:600]))
+        self.queue.clear()
+
+    def _assign(self) -> None:
+        for w in self.workers:
+            if w.ready and w.task is None and self.queue:
+                i = self.queue.popleft()
                 try:
-                    w.conn.send(("stop",))
+                    w.conn.send(("task", i, self.tasks[i]))
                 except OSError:
-                    pass
-            deadline = time.monotonic() + 5
-            for w in list(self.workers):
-                try:
-                    w.proc.wait(timeout=max(0.1, deadline - time.monotonic()))
+                    self.queue.appendleft(i)  # it died: seen by _check
+                    continue
+                self.attempts[i] += 1
+                w.task, w.task_started, w.last_beat = i, time.monotonic(), time.monotonic()
+                self.on_event("start", w.proc.pid, i)
+
+    def _receive(self) -> None:
+        conns = [w.conn for w in self.workers]
+        for conn in wait(conns, timeout=0.5) if conns else time.sleep(0.2) or []:
+            w = next((x for x in self.workers if x.conn is conn), None)
+            if w is None:
+                continue
+            try:
+                while conn.poll():
+                    self._message(w, conn.recv(), self.results, self.tasks)
+            except (EOFError, OSError, pickle.UnpicklingError):
+                try:  # its socket closed: it is exiting (or is made to)
+                    code = w.proc.wait(timeout=2)
                 except subprocess.TimeoutExpired:
-                    pass
-                self._kill(w)
-            if subreaper:
-                self._reap_orphans()
-                _set_subreaper(False)
-        return results
+                    code = None
+                self.on_event("died", w.proc.pid, w.task)
+                self._lost(w, f"died (exit status {code if code is not None else 'unknown'})")
+
+    def _check(self) -> None:
+        """Workers dead, never started, without heartbeat, or past the time limit of their task: lost."""
+        now = time.monotonic()
+        for w in list(self.workers):
+            code = w.proc.poll()
+            if code is not None:
+                self.on_event("died", w.proc.pid, w.task)
+                self._lost(w, f"died (exit status {code})")
+            elif not w.ready and now - w.started > self.start_timeout:
+                self._lost(w, f"sent nothing in {self.start_timeout:g} s")
+            elif w.task is not None and now - w.last_beat > self.beat_limit:
+                self.on_event("stuck", w.proc.pid, w.task)
+                self._lost(w, f"stopped answering (no heartbeat for {self.beat_limit:g} s)")
+            elif w.task is not None and now - w.task_started > self.task_timeout:
+                self.on_event("stuck", w.proc.pid, w.task)
+                self._lost(w, f"went past the {self.task_timeout:g} s limit for one submission")
+
+    def _lost(self, w: _Worker, why: str) -> None:
+        """A worker is gone (killed here if it was not): what it started is ended, its task retried once."""
+        i = w.task
+        self._kill(w)
+        self.cleanup(w.proc.pid)
+        if self.subreaper:
+            self._reap_orphans()
+        if i is None:
+            if not w.ready:
+                self.start_failures += 1
+                self.log.append(f"a grading worker did not start ({why})")
+        elif self.attempts[i] < MAX_ATTEMPTS:
+            self.on_event("retry", w.proc.pid, i)
+            self.queue.appendleft(i)
+        else:
+            self.on_event("gave-up", w.proc.pid, i)
+            why = f"the grading worker {why} twice while grading it; run it again"
+            self._set(self.results, i, self.fail(self.tasks[i], why))
+
+    def _stop_all(self) -> None:
+        for w in list(self.workers):
+            try:
+                w.conn.send(("stop",))
+            except OSError:
+                pass
+        deadline = time.monotonic() + 5
+        for w in list(self.workers):
+            try:
+                w.proc.wait(timeout=max(0.1, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                pass
+            self._kill(w)
+        if self.subreaper:
+            self._reap_orphans()
+            _set_subreaper(False)
 
     def _set(self, results, i, res) -> None:
         results[i] = res
