@@ -2,6 +2,8 @@
 
     kinlib grade SUBMISSION.ipynb|FOLDER ... --out DIR [--timeout S] [--cell-timeout S] [--jobs N]
                  [--notebooks notebooks] [--cache build/grade-cache] [--quiet] [--secret FILE] [--no-sandbox]
+                 [--id-pattern REGEX] [--root DIR] [--memory 2G] [--processes 256] [--disk 512M]
+                 [--batch-timeout S]
 
 (the command line is :mod:`kinlib.course.cli`; the outputs are written by :mod:`kinlib.course.grader.report`)
 
@@ -17,7 +19,13 @@ How it works
   files); one whose metadata was lost (solution cells pasted into a new notebook) by its questions
   (:func:`kinlib.course.schema.match_notebook`: the answer names it assigns, the part numbers it mentions),
   with a note in its feedback. A file that is not JSON, not a notebook, or not one of ours gets one
-  ``error`` row.
+  ``error`` row; so does a link, a FIFO, a file over 50 MB, JSON nested too deep or a notebook of the wrong
+  types (:mod:`kinlib.course.grader.intake` reads every file defensively and says what was wrong).
+* **The batch** (:func:`grade_batch`): with ``--jobs`` > 1, grading workers started and watched by the grader
+  itself (:mod:`kinlib.course.grader.batch`); a worker that dies or stops answering is replaced and its
+  submission tried once more, then reported as infrastructure; the outputs are always written for everyone
+  graded. Student ids come from each file's path relative to the submissions folder
+  (:func:`kinlib.course.grader.intake.student_id`).
 * **Reference answers** come from executing the solution notebooks in ``--notebooks`` (never from the
   installed package, which holds no answer key). For each graded part (a ``question`` markdown cell,
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
@@ -63,7 +71,10 @@ Threat model
 Each kernel runs in the sandbox: its own user, PID, network and IPC namespaces (no network, no view of
 the grader's processes; everything it starts dies with it), a read-only system and Python environment,
 the ``kinlib`` package folder but not the repository around it (no notebooks, build folder, reference
-cache, secret, output folder or home), and writable only its own scratch folder and a private /tmp.
+cache, secret, output folder or home), and writable only its own scratch folder, a private /tmp and a
+small /dev/shm (``/dev`` read-only). Each submission has limits in all (:mod:`kinlib.course.grader.isolation.limits`:
+2 GiB of memory and 256 processes in a cgroup of its own, 512 MiB written on one size-limited tmpfs that
+holds every folder it can write); a limit reached is a ``limits`` row and the other parts are graded.
 grades.csv and the feedback are written after every kernel of the batch, and every process a submission
 started, is gone (checked: :func:`kinlib.course.grader.isolation.sandbox.reap_namespaces`). Without bubblewrap the grader
 refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.

@@ -390,8 +390,10 @@ def _key_results(kept: list, new: list, pattern) -> tuple:
     groups: dict = {}
     warnings = []
     for res in [*kept, *new]:
-        rel = res.get("relpath") or Path(str(res.get("path") or res["submission"])).name
-        res["student_id"], why = student_id(rel, pattern)
+        if res.get("relpath"):
+            res["student_id"], why = student_id(res["relpath"], pattern)
+        else:  # kept by an older kinlib: its id as that version read it (the pattern searched in the whole path)
+            res["student_id"], why = _legacy_id(str(res.get("path") or res["submission"]), pattern), ""
         if why:
             warnings.append(why)
         for r in res["rows"]:
@@ -419,6 +421,21 @@ def _key_results(kept: list, new: list, pattern) -> tuple:
                 "give --id-pattern (one folder per student: '([^/]+)/[^/]+$')"
             )
     return table, warnings
+
+
+def _legacy_id(path: str, pattern) -> str:
+    """The id of a result kept without ``relpath`` (an older kinlib): ``pattern`` searched in its absolute path,
+    else the file's stem.
+
+    >>> _legacy_id("/class/ann/ps4.ipynb", r"([^/]+)/[^/]+$"), _legacy_id("/class/ann/ps4.ipynb", None)
+    ('ann', 'ps4')
+    """
+    m = re.search(pattern, path) if pattern else None
+    if m:
+        got = m.groupdict().get("id") if "id" in m.re.groupindex else (m.group(1) if m.re.groups else m.group(0))
+        if got:
+            return got
+    return Path(path).stem or path
 
 
 def remembered_root(out: Path) -> list:
