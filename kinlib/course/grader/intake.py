@@ -173,18 +173,26 @@ def json_depth(data: bytes) -> int:
     a = np.frombuffer(data, dtype=np.uint8)
     if not a.size:
         return 0
-    idx = np.arange(a.size)
-    bs = a == 92  # backslash
-    # length of the run of backslashes just before each byte: a quote after an odd run is escaped
-    last_other = np.maximum.accumulate(np.where(bs, -1, idx))
-    before = np.empty(a.size, dtype=np.int64)
-    before[0] = 0
-    before[1:] = idx[:-1] - last_other[:-1]
-    quote = (a == 34) & (before % 2 == 0)
-    inside = (np.cumsum(quote) % 2 == 1) & ~quote  # bytes within a string
-    delta = ((a == 91) | (a == 123)).astype(np.int64) - ((a == 93) | (a == 125))
-    delta[inside] = 0
-    return int(max(np.cumsum(delta).max(), 0))
+    # escaped characters: in a run of backslashes every second one escapes the next byte (valid JSON has
+    # backslashes only in strings)
+    quote = a == 34
+    bs = np.flatnonzero(a == 92)
+    if bs.size:
+        start = np.ones(bs.size, dtype=bool)
+        start[1:] = bs[1:] != bs[:-1] + 1
+        first = np.maximum.accumulate(np.where(start, np.arange(bs.size), 0))
+        escaped = bs[(np.arange(bs.size) - first) % 2 == 0] + 1  # the byte after each escaping backslash
+        quote[escaped[escaped < a.size]] = False
+    quotes = np.flatnonzero(quote)
+    opening = np.flatnonzero((a == 91) | (a == 123))
+    closing = np.flatnonzero((a == 93) | (a == 125))
+    where = np.concatenate([opening, closing])
+    step = np.concatenate([np.ones(opening.size, np.int64), -np.ones(closing.size, np.int64)])
+    outside = np.searchsorted(quotes, where) % 2 == 0  # an even number of quotes before it: not in a string
+    where, step = where[outside], step[outside]
+    if not where.size:
+        return 0
+    return int(max(np.cumsum(step[np.argsort(where, kind="stable")]).max(), 0))
 
 
 def notebook_problem(nb) -> str:
