@@ -80,8 +80,12 @@ notebooks: $(STAMP)
 	$(VENV)/bin/kinlib execute $(NB)
 
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
+# make handouts AUDIENCE=students -> build/handouts-students/: the same without any solution (page, PDF or
+# notebook), the folder to publish to students; build/handouts/ is the instructors' (it has the solutions).
+AUDIENCE ?= all
+HANDOUTS_OUT := $(if $(filter students,$(AUDIENCE)),build/handouts-students,build/handouts)
 handouts: $(STAMP) chromium
-	$(VENV)/bin/kinlib handouts notebooks --out build/handouts
+	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE)
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
 # http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.
@@ -99,10 +103,11 @@ JOBS ?= 2
 grade: $(STAMP) bubblewrap
 	$(VENV)/bin/kinlib grade $(SUBMISSIONS) --out $(OUT) --jobs $(JOBS)
 
-# Benchmark against modern-robotics (and Pinocchio, installed here as an optional extra).
+# Benchmark against modern-robotics (and Pinocchio with example-robot-data's URDFs, installed here as an optional extra).
 bench: $(STAMP) bubblewrap chromium
-	@$(PY) -c "import pinocchio" 2>/dev/null || $(PIP) install --quiet -e '.[bench]' \
-	    || echo "pin (Pinocchio) could not be installed: the table will say so"
+	@$(PY) -c "import pinocchio, importlib.metadata as m; m.distribution('example-robot-data')" 2>/dev/null \
+	    || $(PIP) install --quiet -e '.[bench]' \
+	    || echo "pin (Pinocchio) or example-robot-data could not be installed: the table will say so"
 	$(PY) bench/bench.py --out build/bench.md
 
 # Regenerate environment.txt from pyproject.toml: a clean temporary venv, pip install -e '.[dev]'

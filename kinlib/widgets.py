@@ -16,8 +16,9 @@ than rows) the manipulability (both from :mod:`kinlib.manipulability`), the conf
 
 * ``"singular"`` when the rank of J_r (the singular values above ``tol`` · σ_max, default 10⁻⁶) is below
   min(m, n): J_r loses rank,
-* ``"near"`` when w < ``near`` · w_max (default 0.1; w_max = the largest w over a fixed sample of the
-  slider ranges: a relative, unit-free threshold),
+* ``"near"`` when w < ``near`` · w_max (the course's one rule, :data:`kinlib.manipulability.NEAR_SINGULAR`
+  = 0.1, decided by :func:`kinlib.manipulability.singularity_state`; w_max = the largest w over a fixed sample
+  of the slider ranges, :func:`kinlib.manipulability.peak_manipulability`: a relative, unit-free threshold),
 * ``"regular"`` otherwise.
 
 What the picture shows agrees with the status: when the task has orientation rows besides the drawn ṗ
@@ -54,7 +55,15 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from ._backend import describe
-from .manipulability import manipulability_values, singular_values, strongest_joints
+from .manipulability import (
+    NEAR_SINGULAR,
+    SINGULAR_RTOL,
+    manipulability_values,
+    peak_manipulability,
+    singular_values,
+    singularity_state,
+    strongest_joints,
+)
 from .plotting import (
     JOINT_COLORS,
     default_ranges,
@@ -80,12 +89,15 @@ __all__ = [
 ]
 
 
-def classify(J_rows: np.ndarray, tol: float = 1e-6, near: float = 0.1, w_max: float | None = None) -> dict:
+def classify(
+    J_rows: np.ndarray, tol: float = SINGULAR_RTOL, near: float = NEAR_SINGULAR, w_max: float | None = None
+) -> dict:
     """Numbers for the readout of task rows J_r (m×n), from :mod:`kinlib.manipulability`: ``rank`` (the
     singular values above tol · σ_max), ``full_rank`` = min(m, n), ``det`` (square only), ``manipulability``
     w (√det(J Jᵀ), or √det(Jᵀ J) when n < m), ``ratio`` σ_min/σ_max, ``relative`` = w / w_max and ``state``:
     'singular' when rank < min(m, n), 'near' when w / w_max < near (w_max: the largest w over the joint
-    ranges; without it, the ratio σ_min/σ_max is compared with ``near``), else 'regular'.
+    ranges; :func:`kinlib.manipulability.singularity_state`; without w_max only 'singular' or 'regular'),
+    else 'regular'.
 
     >>> import numpy as np
     >>> info = classify(np.array([[1.0, 1.0], [0.0, 0.0]]))
@@ -101,8 +113,12 @@ def classify(J_rows: np.ndarray, tol: float = 1e-6, near: float = 0.1, w_max: fl
     rank = int(np.sum(s > tol * smax)) if smax > 0 else 0
     ratio = float(manipulability_values(J, "inverse_condition"))
     w = float(manipulability_values(J, "yoshikawa"))
-    rel = w / w_max if w_max else ratio
-    state = "singular" if rank < full else ("near" if rel < near else "regular")
+    rel = w / w_max if w_max else None
+    if rank < full:
+        state = "singular"
+    else:
+        state = singularity_state(J, w_max, near, tol) if w_max else "regular"
+        state = "regular" if state == "singular" else state  # the rank test above decides singular
     return {
         "rank": rank,
         "full_rank": full,
@@ -188,7 +204,7 @@ class Explorer(W.VBox):
     # the options grouped by what they set: configuration, task space, drawing, readout, image
     # fmt: off
     def __init__(self, chain, *, q=None, qdot=None, params=None, ranges=None, step=None, continuous_update=True,
-                 rows=None, ellipse_rows=None, tol=1e-6, near=0.1,
+                 rows=None, ellipse_rows=None, tol=SINGULAR_RTOL, near=NEAR_SINGULAR,
                  show_ellipse=True, show_velocity=True, rate_sliders=True, velocity_scale=0.5, title=None,
                  show_maximum=True, figsize=(5.2, 5.0), dpi=80, image_format="png"):
         # fmt: on
@@ -361,12 +377,7 @@ class Explorer(W.VBox):
 
     def _max_manipulability(self) -> float:
         """The largest √det(J_r J_rᵀ) over a fixed sample of the slider ranges (the reference for "near")."""
-        rng = np.random.default_rng(0)
-        lo = np.array([r[0] for r in self.ranges])
-        hi = np.array([r[1] for r in self.ranges])
-        Q = np.vstack([lo + (hi - lo) * rng.random((4000, self.chain.n)), self.q])
-        J = task_rows(self.chain.jacobian_geometric(Q), self.rows)
-        return float(np.max(manipulability_values(J, "yoshikawa")))
+        return peak_manipulability(self.chain, self.rows, self.ranges, extra=self.q)
 
     def _readout_html(self, info) -> str:
         esc = html.escape

@@ -4,7 +4,7 @@ Every false pass and false fail reported in the issue is a test here, with the v
 are described exactly as the grader describes them (:func:`kinlib.course.grader.in_kernel.probe.describe`, the code a student
 kernel runs; the reference side uses the same function) and compared by :func:`kinlib.course.answers.compare.compare`.
 Oracles are independent of the comparison: the subspaces are built from known bases and mixings (numpy), the
-angle sets from known rational multiples of π, the redesigns' det(J Jᵀ) from hand-derived formulas.
+angle sets from known rational multiples of π, the redesigns' det(J Jᵀ) from modern_robotics' Jacobian.
 """
 
 from __future__ import annotations
@@ -298,47 +298,89 @@ def test_5_5_is_declared_a_property_in_notebook_05():
     nb = json.loads((ROOT / "notebooks" / "05_singularities_planar.ipynb").read_text())
     part = next(p for p in schema.parse_parts(nb) if p.part == "5.5")
     assert [part.kinds[a] for a in part.answers] == [PROP]
-    # the self-check and handouts keep the printed design's kind (they know only its value)
-    for g in schema.answer_groups(nb):
-        for pid, _name, kind, _i in g.answers:
-            assert not kind.startswith("property") or pid != "5.5"
+    # the self-check judges the same property (schema.answer_groups gives it the grading kind)
+    kinds = {(pid, kind) for g in schema.answer_groups(nb) for pid, _name, kind, _i in g.answers if pid == "5.5"}
+    assert kinds == {("5.5", PROP)}
 
 
-def test_5_5_alternative_redesign_passes_and_the_printed_one_too():
+def _planar_robot(joints):
+    """A planar SerialChain from (kind, x, y) joints at home: 'R' about z through (x, y), 'P' along (x, y);
+    screw axes written by hand (S = (ω, −ω × q) for R, (0, v) for P), independent of kinlib's robots."""
+    from kinlib.chains import SerialChain
+
+    cols = []
+    for kind, x, y in joints:
+        cols.append([0, 0, 1, y, -x, 0] if kind == "R" else [0, 0, 0, x, y, 0])
+    return SerialChain(sp.eye(4), sp.Matrix(cols).T, name="student_design")
+
+
+def _gram_det_by_hand(chain):
+    """det(J Jᵀ) of the planar task rows from modern_robotics' JacobianSpace at random θ (numbers)."""
+    import modern_robotics as mr
+
+    S = np.array(chain.subs(L=1).screws if chain.params else chain.screws, dtype=float)
+    rng = np.random.default_rng(3)
+    out = []
+    for _ in range(200):
+        J = mr.JacobianSpace(S, rng.uniform(-np.pi, np.pi, S.shape[1]))[[2, 3, 4]]
+        out.append(np.linalg.det(J @ J.T))
+    return np.array(out)
+
+
+def test_5_5_the_students_own_robot_is_judged_by_its_property():
+    """Right: the printed R-P-P (as a robot and as its J); other valid designs pass: a P-P-R, an R-P-P with a
+    slanted slide (not orthogonal: det(J Jᵀ) = sin²α, never 0 for 0 < α < π), a 4-joint R-R-P-P. The oracle is
+    modern_robotics' Jacobian: det(J Jᵀ) on 200 random configurations stays away from 0."""
     Jr, det_rpp = _rpp_det()
     assert det_rpp == 1  # eq. (55)
+    valid = {
+        "printed R-P-P": robots.planar_rpp(),
+        "P-P-R": _planar_robot([("P", 1, 0), ("P", 0, 1), ("R", 2, 1)]),
+        "slanted slides": _planar_robot([("R", 0, 0), ("P", 1, 0), ("P", sp.Rational(3, 5), sp.Rational(4, 5))]),
+        "R-R-P-P": _planar_robot([("R", 0, 0), ("R", 1, 0), ("P", 1, 0), ("P", 0, 1)]),
+    }
+    for label, chain in valid.items():
+        assert _gram_det_by_hand(chain).min() > 1e-3, label  # the oracle agrees the design is valid
+        ok, msg = verdict(PROP, chain, robots.planar_rpp(), "redesign")
+        assert ok, (label, msg)
+        assert "R-P-P" not in msg and "= 1" not in msg
+    ok, msg = verdict(PROP, Jr, robots.planar_rpp(), "redesign")  # its task Jacobian J
+    assert ok, msg
     c1, s1 = sp.cos(TH[0]), sp.sin(TH[0])
-    # another R-P-P: the first slide's screw axis scaled by 1/√2 (a slide moving 1/√2 per unit of its joint
-    # value): columns (1, 0, 0), (0, c/√2, s/√2), (0, −s, c)
     J_alt = sp.Matrix([[1, 0, 0], [0, c1 / sp.sqrt(2), -s1], [0, s1 / sp.sqrt(2), c1]])
-    assert sp.simplify((J_alt * J_alt.T).det()) == sp.Rational(1, 2)  # by hand: (1/2)(c² + s²)·1
-    for answer in (sp.Rational(1, 2), J_alt, det_rpp, Jr, sp.Float(0.5), 2 + sp.sin(TH[0]) ** 2, TH[2] ** 2 + 1):
-        ok, msg = verdict(PROP, answer, det_rpp, "detJJt_rpp")
-        assert ok, (answer, msg)
-        assert "factor" not in msg and "times" not in msg and "0.5" not in msg
+    assert verdict(PROP, J_alt, robots.planar_rpp(), "redesign")[0]
 
 
-def test_5_5_designs_with_singularities_fail_without_showing_a_design():
+def test_5_5_a_value_with_no_robot_and_singular_designs_fail():
+    """`1` (the printed det) with no robot fails, as do 2, L**4, cos(θ1)² + 1: values, not robots. Designs with
+    singular configurations fail and the message names where *their* det(J Jᵀ) vanishes, never a design."""
     L = sp.Symbol("L", positive=True)
-    _, det_rpp = _rpp_det()
     original = robots.planar_offset_3r()
     Jt = task_rows(original.jacobian_space(), "planar")
-    det_orig = 2 * L**4 * sp.sin(original.thetas[1] + pi / 4) ** 2  # (det J)², det J = √2 L² sin(θ2 + π/4)
-    assert sp.simplify((Jt * Jt.T).det() - det_orig) == 0
-    cases = {
-        "original det": det_orig,
-        "original J": Jt,
-        "zero": sp.Integer(0),
-        "sin²": sp.sin(TH[1]) ** 2,
-        "vanishes for some L": L - sp.cos(TH[0]),
-        "negative": -sp.Integer(2),
-        "tall": sp.Matrix([[1, 0], [0, 1], [0, 0]]),
+    for value in (1, sp.Integer(1), 2, L**4, sp.cos(TH[0]) ** 2 + 1, sp.Float(0.5)):
+        ok, msg = verdict(PROP, value, robots.planar_rpp(), "redesign")
+        assert not ok and "robot" in msg, (value, msg)
+    cases = {  # answer, a configuration where the oracle (modern_robotics) finds det(J Jᵀ) = 0
+        "original robot": (original, [0.4, -np.pi / 4, 1.0]),
+        "original J": (Jt, None),
+        "two slides only (too few joints)": (_planar_robot([("P", 1, 0), ("P", 0, 1)]), None),
+        "R-P-P with parallel slides": (_planar_robot([("R", 0, 0), ("P", 1, 0), ("P", 1, 0)]), [0.3, 0.2, 0.1]),
+        "three joints on a line": (_planar_robot([("R", 0, 0), ("R", 1, 0), ("R", 2, 0)]), [0.7, 0.0, 0.0]),
+        "spatial": (robots.spatial_rppr(), None),
+        "zero": (sp.zeros(3, 3), None),
+        "tall": (sp.Matrix([[1, 0], [0, 1], [0, 0]]), None),
     }
-    for label, answer in cases.items():
-        ok, msg = verdict(PROP, answer, det_rpp, "detJJt_rpp")
+    for label, (answer, q_sing) in cases.items():
+        if q_sing is not None:
+            import modern_robotics as mr
+
+            S = np.array(answer.subs(L=1).screws if answer.params else answer.screws, dtype=float)
+            J = mr.JacobianSpace(S, q_sing)[[2, 3, 4]]
+            assert abs(np.linalg.det(J @ J.T)) < 1e-12, label
+        ok, msg = verdict(PROP, answer, robots.planar_rpp(), "redesign")
         assert not ok, label
         assert "R-P-P" not in msg and "prismatic" not in msg and "= 1" not in msg and "factor" not in msg, msg
-    ok, msg = verdict(PROP, det_orig, det_rpp, "detJJt_rpp")
+    ok, msg = verdict(PROP, original, robots.planar_rpp(), "redesign")
     assert "3*pi/4, 7*pi/4" in msg  # where *the student's* det vanishes (their own answer), θ2 = −π/4 + kπ
 
 
@@ -352,9 +394,13 @@ def test_5_5_hostile_trees_are_rejected_not_evaluated():
     for _ in range(30000):
         deep = ["add", deep, ["int", "1"]]
     ok, msg = C.compare(PROP, {"tag": "scalar", "tree": deep}, {}, "d")
+    assert not ok
+    ok, msg = C.compare(PROP, {"tag": "matrix", "tree": ["matrix", 1, 1, deep]}, {}, "d")
+    assert not ok and "could not" in msg
+    ok, msg = C.compare(PROP, {"tag": "robot", "tree": ["matrix", 6, 1, *[deep] * 6]}, {}, "d")
     assert not ok and "could not" in msg
     big = (sp.sin(TH[0]) + sp.cos(TH[1]) + sp.sin(TH[2]) + 2) ** 12
-    ok, msg = verdict(PROP, big, 1, "d")
+    ok, msg = verdict(PROP, sp.diag(big, 1, 1), 1, "d")
     assert not ok and "too large" in msg
     assert not verdict(PROP, sp.exp(TH[0]), 1, "d")[0]
 

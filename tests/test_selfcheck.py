@@ -303,3 +303,44 @@ def test_every_mistake_message_is_free_of_numbers_of_a_key():
         for tok in "".join(ch if ch.isdigit() else " " for ch in words).split():
             assert tok in {"45", "4", "1", "3", "6", "180"}, (m.name, words)
     assert math.isclose(float(sp.pi / 180), math.pi / 180)
+
+
+# ---------------------------------------------------------------------------------------------------
+# 5.5: the self-check judges the property of the student's own redesign (as the grader does)
+
+
+def _planar_chain(joints):
+    """A planar SerialChain from (kind, x, y) at home, screw axes written by hand: R about z through (x, y)
+    is (0, 0, 1, y, −x, 0), a slide along (x, y) is (0, 0, 0, x, y, 0)."""
+    from kinlib.chains import SerialChain
+
+    cols = [[0, 0, 1, y, -x, 0] if k == "R" else [0, 0, 0, x, y, 0] for k, x, y in joints]
+    return SerialChain(sp.eye(4), sp.Matrix(cols).T, name="my_arm")
+
+
+def test_5_5_selfcheck_judges_the_students_robot():
+    from kinlib import robots
+    from kinlib.course.workbook import selfcheck
+
+    spec = fingerprint(robots.planar_rpp(), "property:nonsingular", salt="5.5:redesign")
+    assert spec == "property|nonsingular|-"  # the spec holds nothing of the printed design
+    right = [robots.planar_rpp(), _planar_chain([("P", 1, 0), ("P", 0, 1), ("R", 2, 1)])]  # printed; another valid
+    for arm in right:
+        status, msg = verdict(arm, spec, salt="5.5:redesign")
+        assert status == "correct", msg
+    wrong = {
+        "1 with no robot": 1,
+        "2": sp.Integer(2),
+        "cos²+1": sp.cos(th1) ** 2 + 1,
+        "the original arm": robots.planar_offset_3r(),
+        "joints on a line": _planar_chain([("R", 0, 0), ("R", 1, 0), ("R", 2, 0)]),
+    }
+    for label, value in wrong.items():
+        status, msg = verdict(value, spec, salt="5.5:redesign")
+        assert status == "incorrect", (label, msg)
+        assert "R-P-P" not in msg and "prismatic" not in msg, msg
+    assert "robot" in verdict(1, spec)[1]
+    assert verdict(..., spec)[0] == "unanswered"
+    with pytest.raises(ValueError, match="fails its property"):  # a solution notebook whose answer is not valid
+        fingerprint(robots.planar_offset_3r(), "property:nonsingular")
+    assert "SerialChain" in selfcheck.describe_answer(robots.planar_rpp(), "property:nonsingular")

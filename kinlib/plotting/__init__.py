@@ -35,6 +35,9 @@ Functions (each returns an object to update or inspect):
 * ``plot_joint_contributions(ax, values, *, title=None)`` (bar chart of one row of J);
 * ``plot_manipulability_curve(chain, joint, q_fixed=None, *, rows=None, measure="yoshikawa")`` → :class:`CurvePlot`;
   ``plot_manipulability_map(chain, joints=(1, 2), q_fixed=None, *, rows=None, singular=True)`` → :class:`MapPlot`;
+* ``plot_singularity_cost(chain, joint, q_singular, V, *, offsets=None, damping=0.05)`` → :class:`CostPlot`
+  (what a singularity costs: ‖J⁻¹V‖ beside damped least squares and its velocity error, log scales);
+* ``legend_beside(ax, where="right")``: a legend outside the axes (never over the drawing);
 * ``sweep(chain, joint, values, q_fixed=None)`` and ``animate_singularity(chain, path)`` → a FuncAnimation
   (``.to_jshtml()`` plays in a static page and shows frame 0 at once; as a cell's value it also carries a
   static image/png of frame 0).
@@ -48,7 +51,7 @@ Modules: :mod:`~kinlib.plotting.common` (input checks, colours), :mod:`~kinlib.p
 fitting, label placement), :mod:`~kinlib.plotting.primitives` (movable arrows, lines, text),
 :mod:`~kinlib.plotting.artists` (the artist classes), :mod:`~kinlib.plotting.drawing` (the ``draw_*``
 functions), :mod:`~kinlib.plotting.plots` (bar charts, directions, manipulability curve and map, sweeps),
-:mod:`~kinlib.plotting.animation`.
+:mod:`~kinlib.plotting.cost`, :mod:`~kinlib.plotting.animation`.
 
 >>> import kinlib.plotting as P
 >>> from kinlib.robots import planar_offset_3r
@@ -63,6 +66,7 @@ from ..taskspace import ROW_LABELS, ROW_NAMES, ROW_TEX, is_planar, task_row_indi
 from .animation import animate_singularity
 from .artists import ChainArtist, EllipseArtist, JointVelocitiesArtist, VelocityArtist
 from .common import FRAME_COLORS, JOINT_COLORS, default_ranges
+from .cost import CostPlot, plot_singularity_cost
 from .drawing import (
     VelocityEllipses,
     draw_chain,
@@ -77,12 +81,13 @@ from .plots import (
     CurvePlot,
     MapPlot,
     draw_directions,
+    held_span,
     plot_joint_contributions,
     plot_manipulability_curve,
     plot_manipulability_map,
     sweep,
 )
-from .view import new_axes, pi_ticks
+from .view import legend_beside, new_axes, pi_ticks
 
 __all__ = [
     "is_planar",
@@ -102,6 +107,9 @@ __all__ = [
     "EllipseArtist",
     "draw_ellipse",
     "draw_directions",
+    "held_span",
+    "plot_singularity_cost",
+    "CostPlot",
     "plot_joint_contributions",
     "plot_manipulability_curve",
     "plot_manipulability_map",
@@ -110,6 +118,7 @@ __all__ = [
     "sweep",
     "animate_singularity",
     "new_axes",
+    "legend_beside",
     "pi_ticks",
     "ROW_NAMES",
     "ROW_LABELS",

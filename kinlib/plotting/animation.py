@@ -24,9 +24,9 @@ import numpy as np
 from matplotlib.animation import FuncAnimation
 
 from .._backend import describe
-from ..manipulability import manipulability_values, measure_label
+from ..manipulability import manipulability_values, measure_label, peak_manipulability, singularity_state
 from ..taskspace import default_task_rows, is_planar, rows_label, task_row_indices, task_rows
-from .common import checked_numeric
+from .common import checked_numeric, default_ranges
 from .drawing import draw_chain, draw_velocity_ellipses
 
 __all__ = ["animate_singularity", "SingularityAnimation", "first_frame_html"]
@@ -197,7 +197,8 @@ def animate_singularity(
     :func:`kinlib.taskspace.default_task_rows`) along the path with a moving marker. ``.values`` holds the
     manipulability per step. Play it in a static page with ``anim.to_jshtml()`` (``IPython.display.HTML``),
     or make it a cell's value (:class:`SingularityAnimation`: the player showing frame 0 at once, and a static
-    image/png of frame 0 for a notebook opened without running it).
+    image/png of frame 0 for a notebook opened without running it). Its figure is closed in pyplot (no second,
+    static copy below the cell); the player still draws it.
 
     >>> from kinlib.robots import planar_offset_3r
     >>> anim = animate_singularity(planar_offset_3r(1), np.zeros((3, 3)))
@@ -232,7 +233,6 @@ def animate_singularity(
         ax.legend(loc="lower right", fontsize=7, framealpha=0.8)
     J = task_rows(chain.jacobian_geometric(P), r)
     w = manipulability_values(J, "yoshikawa")
-    ic = manipulability_values(J, "inverse_condition")
     w_label = measure_label("yoshikawa", len(r), chain.n)
     s = np.arange(P.shape[0])
     ax2.plot(s, w, lw=2)
@@ -257,12 +257,12 @@ def animate_singularity(
     )
     fig.tight_layout()
 
+    # one "near" rule for the course (kinlib.manipulability.NEAR_SINGULAR): w < 0.1 w_max of the same arm
+    states = singularity_state(J, peak_manipulability(chain, r, default_ranges(chain), extra=P))
+    words = {"singular": "SINGULAR configuration", "near": "near a singular configuration", "regular": ""}
+
     def status(k):
-        if ic[k] < 1e-6:
-            return "SINGULAR configuration"
-        if ic[k] < 0.1:
-            return "near a singular configuration"
-        return ""
+        return words[str(states[k])]
 
     def frame(k):
         arm.update(P[k])
@@ -278,4 +278,5 @@ def animate_singularity(
     anim.frame_function, anim.n_frames = frame, P.shape[0]
     anim.movers = [*arm.artists, *ells.artists, mark, txt]
     anim.summary = f"animation of {chain.name} along a path of {P.shape[0]} configurations (frame 0 shown)"
+    plt.close(fig)  # shown by its player only: an inline backend would print a second, static copy of frame 0
     return anim

@@ -32,6 +32,7 @@ from .view import include, pi_ticks
 __all__ = [
     "plot_joint_contributions",
     "draw_directions",
+    "held_span",
     "CurvePlot",
     "MapPlot",
     "plot_manipulability_curve",
@@ -121,10 +122,14 @@ def draw_directions(
     linestyles=None,
     fontsize=9,
     lw=2.0,
+    hold=None,
 ) -> list:
     """Arrows from ``origin`` along each vector (a list of vectors, or a matrix whose *columns* are the
     vectors, e.g. a column-space basis). ``components``: which entries of each vector to draw (e.g. (1, 2)
-    for the ṗ_x, ṗ_y part of a (ω_z, ṗ_x, ṗ_y) vector); ``length``: rescale each arrow to this length;
+    for the ṗ_x, ṗ_y part of a (ω_z, ṗ_x, ṗ_y) vector); ``hold``: entries held at zero (e.g. (0,), the
+    orientation rate ω_z): the vectors are first replaced by an orthonormal basis of the part of their span
+    with those entries 0 (:func:`held_span`), so any basis of the same span gives the same arrows, and the
+    arrows are the motions possible with the orientation held; ``length``: rescale each arrow to this length;
     ``both_ways``: a double-headed arrow (a direction, not a sense); ``linestyles``: e.g. ['-', '--'] to
     tell "can move" from "cannot move". Returns the list of FancyArrowPatch (2-D) or arrow artists (3-D).
 
@@ -132,6 +137,8 @@ def draw_directions(
     >>> arts = draw_directions(ax, (0, 0), [[0, 3, 4]], ["can move"], components=(1, 2), length=1)
     >>> [type(a).__name__ for a in arts]
     ['FancyArrowPatch', 'Annotation']
+    >>> len(draw_directions(ax, (0, 0), np.array([[0.0, 1.0], [1.0, 0.0], [-1.0, 0.0]]), hold=(0,), components=(1, 2)))
+    1
     """
     d = 3 if is_3d(ax) else 2
     if isinstance(vectors, sp.MatrixBase) or (isinstance(vectors, np.ndarray) and vectors.ndim == 2):
@@ -150,6 +157,10 @@ def draw_directions(
                 f"vectors must be a matrix (one vector per column) or a list of numeric vectors, "
                 f"got {describe(vectors)}"
             ) from None
+    if hold is not None:
+        vecs = list(held_span(np.column_stack(vecs), hold).T)
+        if labels is not None:
+            labels = list(labels)[: len(vecs)]
     if components is not None:
         comp = list(components)
         vecs = [v[comp] for v in vecs]
@@ -215,6 +226,47 @@ def draw_directions(
     ends = [o + 1.2 * v for v in vecs] + ([o - v for v in vecs] if both_ways else []) + [o]
     include(ax, np.column_stack(ends))
     return out
+
+
+def held_span(vectors, hold, tol: float = 1e-9) -> np.ndarray:
+    """An orthonormal basis (columns) of {x ∈ span(vectors) : x[i] = 0 for i in ``hold``}: the directions of a
+    span that keep the held entries at zero (e.g. the tool translations of range J with ω_z = 0). Any basis of
+    the same span gives the same subspace; the basis is ordered by its first nonzero entry's index.
+
+    >>> held_span(np.array([[1.0, 0.0], [0.0, 1.0], [0.0, -1.0]]), (0,)).round(6).T.tolist()
+    [[0.0, 0.707107, -0.707107]]
+    >>> held_span(np.array([[0.0, 1.0], [1.0, 0.0], [-1.0, 0.0]]), (0,)).round(6).T.tolist()   # columns swapped
+    [[0.0, 0.707107, -0.707107]]
+    """
+    A = np.asarray(vectors, float)
+    if A.ndim != 2:
+        raise ValueError(f"vectors must be a matrix (one vector per column), got {describe(vectors)}")
+    hold = [int(i) for i in hold]
+    if any(not 0 <= i < A.shape[0] for i in hold):
+        raise ValueError(f"hold must list entries 0…{A.shape[0] - 1}, got {describe(hold)}")
+    U, s, _ = np.linalg.svd(A, full_matrices=False)
+    B = U[:, s > tol * max(s[0] if s.size else 0.0, 1.0)]  # orthonormal basis of the span
+    if not B.size:
+        return np.zeros((A.shape[0], 0))
+    _, s2, Vt = np.linalg.svd(B[hold, :]) if hold else (None, np.zeros(0), np.eye(B.shape[1]))
+    rank = int(np.sum(s2 > tol))
+    N = Vt[rank:].T  # combinations of B with the held entries 0
+    H = B @ N
+    if not H.size:
+        return H
+    Q, _ = np.linalg.qr(H)
+    Q = Q[:, : H.shape[1]]
+    # a canonical orthonormal basis of the subspace: the rows of its projector, reduced
+    P = Q @ Q.T
+    cols = []
+    for j in range(P.shape[0]):
+        v = P[:, j] - sum((c @ P[:, j]) * c for c in cols)
+        if np.linalg.norm(v) > 1e-6:
+            v = v / np.linalg.norm(v)
+            cols.append(v * (1 if v[np.flatnonzero(np.abs(v) > 1e-9)[0]] > 0 else -1))
+        if len(cols) == Q.shape[1]:
+            break
+    return np.column_stack(cols)
 
 
 # --- manipulability over one or two joints ----------------------------------------------------------------
@@ -383,8 +435,6 @@ def plot_manipulability_map(
             sing.append(
                 ax.plot(xs, ys, color="red", lw=2, label=lab if lab else ("singular set" if k == 0 else None))[0]
             )
-    if sing:
-        ax.legend(loc="upper right", fontsize=8)
     ax.set_xlim(xlo, xhi)
     ax.set_ylim(ylo, yhi)
     ax.set_xlabel(theta_tex(i + 1))
@@ -392,7 +442,9 @@ def plot_manipulability_map(
     for k, (lo, hi), axis in ((i, (xlo, xhi), ax.xaxis), (j, (ylo, yhi), ax.yaxis)):
         if chain.joint_types[k] == "R" and hi - lo >= math.pi / 2:
             pi_ticks(axis, lo, hi, 2)
-    ax.set_title(f"{chain.name}: {label} of rows ({rows_label(r, tex=True)})")
+    # the singular set is named in the title, not in a legend box that would sit on the map's curves
+    note = "\nred: the singular set" if sing else ""
+    ax.set_title(f"{chain.name}: {label} of rows ({rows_label(r, tex=True)}){note}")
     return MapPlot(ax, im, x, y, vals, (i + 1, j + 1), sing)
 
 

@@ -24,6 +24,7 @@ from .common import is_3d
 __all__ = [
     "new_axes",
     "pi_ticks",
+    "legend_beside",
     "fit_view",
     "ViewState",
     "view_state",
@@ -52,6 +53,25 @@ def new_axes(planar: bool, ax=None, figsize=None):
         fig = plt.figure(figsize=figsize or (6, 5.5))
         ax = fig.add_subplot(projection="3d")
     return ax
+
+
+def legend_beside(ax, where: str = "right", **kwargs):
+    """A legend outside the axes, so it never covers the drawing: to the ``"right"`` of the axes (top-aligned)
+    or ``"below"`` them (centred, under the x label); other keywords go to ``ax.legend``. ``tight_layout`` and
+    constrained layout make room for it.
+
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots(); _ = ax.plot([0, 1], [0, 1], label="arm")
+    >>> legend_beside(ax).get_bbox_to_anchor().bounds == legend_beside(ax).get_bbox_to_anchor().bounds
+    True
+    """
+    spots = {"right": ("upper left", (1.02, 1.0)), "below": ("upper center", (0.5, -0.14))}
+    if where not in spots:
+        raise ValueError(f"where must be 'right' or 'below', got {where!r}")
+    loc, anchor = spots[where]
+    kwargs.setdefault("fontsize", 8)
+    kwargs.setdefault("borderaxespad", 0.0)
+    return ax.legend(loc=loc, bbox_to_anchor=anchor, **kwargs)
 
 
 def pi_ticks(axis, lo: float, hi: float, step_fraction: int = 2):

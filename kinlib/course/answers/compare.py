@@ -26,7 +26,7 @@ from fractions import Fraction
 import numpy as np
 
 from . import mistakes
-from .properties import PROPERTIES, exact_ranks
+from .properties import exact_ranks, judge
 
 __all__ = [
     "compare",
@@ -578,29 +578,21 @@ def _compare_component(s, r, periodic):
 
 def compare_property(stu: dict, ref: dict, name: str, prop: str = "nonsingular") -> tuple[bool, str]:
     """An open-ended answer graded by the property asked, never by one design's value (the reference is not
-    used). ``prop``: "nonsingular": the answer is det(J Jᵀ) of the student's own design (or its task
-    Jacobian J), and it must be nonzero for every joint value, proved exactly (kinlib.singularities).
+    used): :func:`kinlib.course.answers.properties.judge`. ``prop``: "nonsingular": the answer is the student's own
+    redesigned robot (or its task Jacobian J), whose det(J Jᵀ) must be nonzero for every joint value, proved
+    exactly (kinlib.singularities); a bare value of det(J Jᵀ) belongs to no robot and fails.
 
-    >>> compare_property({"tag": "scalar", "tree": ["rat", "1", "2"]}, {}, "d")
-    (True, 'det(J Jᵀ) ≠ 0 for every joint value: proved')
-    >>> compare_property({"tag": "scalar", "tree": ["pow", ["fn", "sin", ["sym", "theta2", False]], ["int", "2"]]},
-    ...                  {}, "d")[1]
-    'd: det(J Jᵀ) = 0 where theta2 = 0, pi (+ 2πk): your design still has singular configurations'
+    >>> compare_property({"tag": "scalar", "tree": ["int", "1"]}, {}, "d")[0]
+    False
+    >>> col = lambda *xs: [["int", str(x)] for x in xs]
+    >>> three_r = col(0, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, -1, -2, 0, 0, 0)   # joints at x = 0, 1, 2
+    >>> compare_property({"tag": "robot", "tree": ["matrix", 6, 3, *three_r]}, {}, "d")[1]
+    'd: det(J Jᵀ) of your robot = 0 where theta2 = 0, pi (+ 2πk): your design still has singular configurations'
     """
     na = _not_answered(stu)
     if na:
         return False, f"{name} {na}"
-    if stu.get("tag") not in ("matrix", "scalar"):
-        return False, f"{name} is a {stu.get('type')}; expected a SymPy expression or Matrix"
-    if prop not in PROPERTIES:
-        return False, f"{name} could not be graded (unknown property {prop!r}: a problem in the solution notebook)"
-    if "tree" not in stu:
-        why = stu.get("tree_error") or "no expression"
-        return False, f"{name} could not be read exactly ({why}): use SymPy numbers, symbols, sin and cos"
-    try:
-        return PROPERTIES[prop](stu, name)
-    except (ValueError, TypeError, RecursionError) as exc:
-        return False, f"{name} could not be read exactly ({str(exc)[:120]})"
+    return judge(prop, stu, name)
 
 
 # ----------------------------------------------------------------------------- choices

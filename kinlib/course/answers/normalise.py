@@ -15,7 +15,10 @@ form one of them accepts, the other accepts too:
   (their union, as ``kinlib.singular_configurations`` returns; ``[]`` is the empty set);
 * **choices** (:func:`choice_value`): an int, string or bool, or a list/tuple/set/array/Matrix/FiniteSet
   of them (ties as tuples); strings compare without case or extra spaces, integral floats as ints;
-* **yes/no** (:func:`is_bool`) and **not answered** (:func:`is_unanswered`: ``...`` or ``None``).
+* **yes/no** (:func:`is_bool`) and **not answered** (:func:`is_unanswered`: ``...`` or ``None``);
+* **a robot** for an answer judged by a property of the student's own design (:func:`property_answer`): an
+  object with a 6×n ``screws`` matrix (a kinlib ``SerialChain``, found by duck typing: this module never
+  imports kinlib), or its task Jacobian as a matrix.
 
 It imports only the standard library, NumPy and SymPy (never kinlib): the checker sends its source text
 into each student kernel, where it must not depend on anything the submission could have changed.
@@ -37,6 +40,8 @@ __all__ = [
     "choice_value",
     "type_name",
     "expr_tree",
+    "robot_screws",
+    "property_answer",
 ]
 
 
@@ -303,3 +308,53 @@ def expr_tree(obj, max_nodes=_TREE_MAX_NODES):
     if isinstance(obj, sp.MatrixBase):
         return ["matrix", obj.rows, obj.cols, *[walk(x) for x in obj]]
     return walk(sp.sympify(obj))
+
+
+def robot_screws(value):
+    """The space screw axes (a 6×n SymPy Matrix, one per column) of a robot answer, or None when ``value`` is
+    not a robot: any object, not itself a matrix, number, container or SymPy object, whose ``screws``
+    attribute is a 6×n matrix (a kinlib ``SerialChain``; duck typing, never an import of kinlib).
+
+    >>> class Arm:
+    ...     screws = sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 0, 1, 0, 0]]).T
+    >>> robot_screws(Arm()).shape, robot_screws(sp.eye(6)), robot_screws([1, 2])
+    ((6, 2), None, None)
+    """
+    if isinstance(value, (sp.Basic, sp.MatrixBase, np.ndarray, list, tuple, dict, set, str, bytes, numbers.Number)):
+        return None
+    try:
+        screws = getattr(value, "screws", None)
+    except Exception:  # noqa: BLE001  (a property that raises: not a robot)
+        return None
+    if screws is None:
+        return None
+    tag, S = to_sympy(screws)
+    if tag != "matrix" or S.rows != 6 or not 1 <= S.cols <= 12:
+        return None
+    return S
+
+
+def property_answer(value) -> dict:
+    """An answer judged by a property of the student's own design (problem 5.5: "your redesign has no singular
+    configuration") as plain JSON data for the judge (:mod:`kinlib.course.answers.properties`): ``{"tag": "robot",
+    "tree": …}`` for a robot (its screw axes, :func:`robot_screws`), ``{"tag": "matrix"|"scalar", "tree": …}``
+    for a matrix (its task Jacobian) or an expression, with the exact :func:`expr_tree`; ``tree_error`` says
+    why there is none; other tags as :func:`to_sympy`.
+
+    >>> property_answer(sp.Matrix([[1, 0], [0, 1]]))["tree"][:3]
+    ['matrix', 2, 2]
+    >>> property_answer(...)["tag"], property_answer("robot")["tag"]
+    ('ellipsis', 'other')
+    """
+    S = robot_screws(value)
+    if S is not None:
+        tag, obj = "robot", S
+    else:
+        tag, obj = to_sympy(value)
+    out = {"tag": tag, "type": type_name(value)}
+    if obj is not None:
+        try:
+            out["tree"] = expr_tree(obj)
+        except Exception as exc:  # noqa: BLE001  (any failure is reported, not raised)
+            out["tree_error"] = str(exc)[:200]
+    return out

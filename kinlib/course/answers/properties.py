@@ -8,16 +8,30 @@ property to its decision, ``(ok, message)``; the message talks about the student
 
 :func:`exact_ranks` compares constant exact subspaces exactly (:func:`kinlib.course.answers.compare.compare_subspace`).
 
-* ``nonsingular`` (problem 5.5): det(J Jᵀ) of the student's redesign (or its task Jacobian J) is nonzero for
-  every joint value, proved exactly by :func:`kinlib.singularities.singular_configurations` (trigonometric
-  normal forms, :mod:`kinlib.trigsign` proofs of non-vanishing).
+* ``nonsingular`` (problem 5.5): the student's redesigned robot (a ``SerialChain``: the judge computes its J from
+  its screw axes) or its task Jacobian J has det(J Jᵀ) ≠ 0 for every joint value, proved exactly by
+  :func:`kinlib.singularities.singular_configurations` (trigonometric normal forms, :mod:`kinlib.trigsign`
+  proofs of non-vanishing). A bare value of det(J Jᵀ) belongs to no robot and is refused.
+
+The same judges serve the workbook self-check (:func:`kinlib.course.workbook.selfcheck.verdict`, spec
+``property|nonsingular|-``) and the grader (:func:`kinlib.course.compare.compare_property`).
 """
 
 from __future__ import annotations
 
 import math
 
-__all__ = ["from_tree", "exact_ranks", "nonsingular", "PROPERTIES", "MAX_TERMS_ESTIMATE"]
+__all__ = [
+    "from_tree",
+    "exact_ranks",
+    "nonsingular",
+    "judge",
+    "PROPERTIES",
+    "MAX_TERMS_ESTIMATE",
+    "MAX_ROBOT_JOINTS",
+    "judge_value",
+    "property_spec",
+]
 
 MAX_TERMS_ESTIMATE = 50_000  # a bound on the terms of det(J Jᵀ) expanded (see _terms_estimate)
 
@@ -199,55 +213,157 @@ def _never_zero(M, what: str):
     return True, None
 
 
-def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
-    """det(J Jᵀ) ≠ 0 for every joint value, decided exactly: the answer is det(J Jᵀ) itself (a scalar) or the
-    task Jacobian J. Proofs by :func:`kinlib.singularities.singular_configurations` (on J, or on the diagonal
-    matrix diag(det(J Jᵀ), 1, …) whose determinant it is): no condition and complete ⇔ never 0.
+_NOT_A_ROBOT = (
+    "{name} is a number or an expression: give your redesigned robot itself (a kinlib SerialChain, e.g. "
+    "SerialChain(screws, M)) or its task Jacobian J (rows ω_z, v_x, v_y) as a Matrix; a value of det(J Jᵀ) "
+    "alone does not say which robot it belongs to"
+)
+MAX_ROBOT_JOINTS = 6  # a redesign with more joints is not decided here (the proof's cost grows fast)
 
-    >>> nonsingular({"tree": ["add", ["int", "2"], ["fn", "sin", ["sym", "theta1", False]]]}, "d")
-    (True, 'det(J Jᵀ) ≠ 0 for every joint value: proved')
-    >>> nonsingular({"tree": ["fn", "sin", ["sym", "theta1", False]]}, "d")[1]
-    'd: det(J Jᵀ) = 0 where theta1 = 0, pi (+ 2πk): your design still has singular configurations'
-    """
+
+def _matrix(tree, syms: dict, budget: list, name: str):
+    """A matrix rebuilt from its tree, or a message (str) saying why not."""
     import sympy as sp
 
+    if len(tree) < 3 or not all(isinstance(x, int) and 0 < x <= 12 for x in tree[1:3]):
+        return f"{name} could not be read (malformed matrix)"
+    r, c = tree[1], tree[2]
+    if len(tree) != 3 + r * c:
+        return f"{name} could not be read (malformed matrix)"
+    return sp.Matrix(r, c, [from_tree(x, syms, budget) for x in tree[3:]])
+
+
+def _robot_task_jacobian(S, name: str):
+    """The task rows (ω_z, v_x, v_y) of the space Jacobian of the planar robot with screw axes S (6×n), or a
+    message (str) saying why the robot cannot be judged: not planar, not valid screws, too many joints."""
+    import sympy as sp
+
+    from kinlib.jacobians import jacobian_space
+
+    if S.cols > MAX_ROBOT_JOINTS:
+        return f"{name}: a robot of {S.cols} joints is more than this check decides (at most {MAX_ROBOT_JOINTS})"
+    off_plane = [i + 1 for i in range(S.cols) if any(sp.simplify(S[k, i]) != 0 for k in (0, 1, 5))]
+    if off_plane:
+        return (
+            f"{name}: joint(s) {', '.join(map(str, off_plane))} move the tool out of the plane (a planar robot's "
+            "revolute axes are along z and its slides lie in the xy-plane: screw rows ω_x, ω_y, v_z are 0)"
+        )
+    thetas = [sp.Symbol(f"theta{i + 1}", real=True) for i in range(S.cols)]
+    try:
+        Js = jacobian_space(S, thetas)
+    except (ValueError, TypeError) as exc:
+        return f"{name}: its screw axes are not valid ({str(exc)[:160]})"
+    return Js[2:5, :]
+
+
+def _judge_task_jacobian(J, syms: dict, name: str, what: str) -> tuple[bool, str]:
+    import sympy as sp
+
+    r, c = J.shape
+    if r == 6:
+        return False, f"{name}: give the task rows (ω_z, v_x, v_y) of J, a 3×{c} matrix (task_rows(J, 'planar'))"
+    if r > c:
+        return False, f"{what} is 0 everywhere: your J has more rows ({r}) than columns ({c}): J Jᵀ is singular"
+    if any(_terms_estimate(e) > MAX_TERMS_ESTIMATE for e in J):
+        return False, f"{what} is too large to decide exactly: simplify J (kinlib.trig_simplify) and try again"
+    positive = {v for v in syms.values() if v.is_positive} | {s for s in J.free_symbols if s.is_positive}
+    if any(sp.fraction(sp.together(e))[1].free_symbols - positive for e in J):
+        return False, f"{what} could not be decided exactly: J has fractions in the joint variables"
+    ok, msg = _never_zero(J, what)
+    return (True, "det(J Jᵀ) ≠ 0 for every joint value: proved") if ok else (False, msg)
+
+
+def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
+    """The student's own redesign has no singular configuration: det(J Jᵀ) ≠ 0 for every joint value, decided
+    exactly for **their robot**. The answer (:func:`kinlib.course.answers.normalise.property_answer`) is the robot (tag
+    "robot": its space screw axes, 6×n; the judge computes J_s from them, :func:`kinlib.jacobians.jacobian_space`,
+    and takes its task rows ω_z, v_x, v_y; the robot must be planar) or its task Jacobian J (a 3×n matrix). A
+    number or expression alone (a claimed det(J Jᵀ), e.g. 1) is refused: it belongs to no robot. Proofs by
+    :func:`kinlib.singularities.singular_configurations` on J: no condition and complete ⇔ never singular.
+
+    >>> rpp = ["matrix", 6, 3, *[["int", str(x)] for x in (0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0)]]
+    >>> nonsingular({"tag": "robot", "tree": rpp}, "redesign")
+    (True, 'det(J Jᵀ) ≠ 0 for every joint value: proved')
+    >>> nonsingular({"tag": "scalar", "tree": ["int", "1"]}, "redesign")[0]
+    False
+    """
     syms: dict = {}
-    tree = stu["tree"]
+    tree = stu.get("tree")
+    tag = stu.get("tag")
     what = f"{name}: det(J Jᵀ)"
-    if isinstance(tree, list) and tree[:1] == ["matrix"]:
-        if len(tree) < 3 or not all(isinstance(x, int) and 0 < x <= 12 for x in tree[1:3]):
-            return False, f"{name} could not be read (malformed matrix)"
-        r, c = tree[1], tree[2]
-        if len(tree) != 3 + r * c:
-            return False, f"{name} could not be read (malformed matrix)"
-        budget = [20_000]
-        J = sp.Matrix(r, c, [from_tree(x, syms, budget) for x in tree[3:]])
-        if r > c:
-            return False, f"{what} is 0 everywhere: your J has more rows ({r}) than columns ({c}): J Jᵀ is singular"
-        if any(_terms_estimate(e) > MAX_TERMS_ESTIMATE for e in J):
-            return False, f"{what} is too large to decide exactly: simplify J (kinlib.trig_simplify) and try again"
-        if any(sp.fraction(sp.together(e))[1].free_symbols - {v for v in syms.values() if v.is_positive} for e in J):
-            return False, f"{what} could not be decided exactly: J has fractions in the joint variables"
-        ok, msg = _never_zero(J, what)
-        return (True, "det(J Jᵀ) ≠ 0 for every joint value: proved") if ok else (False, msg)
-    D = from_tree(tree, syms, [20_000])
-    if _terms_estimate(D) > 4 * MAX_TERMS_ESTIMATE:
-        return False, f"{what} is too large to decide exactly: simplify it (kinlib.trig_simplify) and try again"
-    num, den = sp.fraction(sp.together(D))
-    for part, label in ((num, what), (den, f"{what} has a denominator that")):
-        if part.free_symbols - {v for v in syms.values() if v.is_positive}:
-            nv = len([s for s in part.free_symbols if not s.is_positive])
-            ok, msg = _never_zero(sp.diag(part, *[1] * (nv - 1)), label)
-            if not ok:
-                return False, msg
-        elif part == 0:
-            return False, f"{what} is 0 for every θ: every configuration of your design is singular"
-    # nonzero on a connected set of values, hence of one sign: one value tells which
-    at = {s: (sp.Integer(1) if s.is_positive else sp.Rational(1, 3)) for s in D.free_symbols}
-    val = sp.N((num / den).xreplace(at), 30)
-    if val.is_real and val < 0:
-        return False, f"{what} is negative for every θ, but det(J Jᵀ) ≥ 0 for every matrix J: check it"
-    return True, "det(J Jᵀ) ≠ 0 for every joint value: proved"
+    if not isinstance(tree, list) or tree[:1] != ["matrix"]:
+        return False, _NOT_A_ROBOT.format(name=name)
+    M = _matrix(tree, syms, [20_000], name)
+    if isinstance(M, str):
+        return False, M
+    if tag == "robot":
+        if M.rows != 6:
+            return False, f"{name}: a robot's screw axes are 6-vectors, got {M.rows} rows"
+        J = _robot_task_jacobian(M, name)
+        if isinstance(J, str):
+            return False, J
+        return _judge_task_jacobian(J, syms, name, f"{name}: det(J Jᵀ) of your robot")
+    return _judge_task_jacobian(M, syms, name, what)
 
 
 PROPERTIES = {"nonsingular": nonsingular}
+
+
+def judge(prop: str, stu: dict, name: str) -> tuple[bool, str]:
+    """``(ok, message)``: the property ``prop`` of :data:`PROPERTIES` judged on the answer description ``stu``
+    (:func:`kinlib.course.answers.normalise.property_answer`); never raises.
+
+    >>> judge("nonsingular", {"tag": "ellipsis"}, "redesign")
+    (False, 'redesign is not answered yet')
+    """
+    if stu.get("tag") in ("ellipsis", "none"):
+        return False, f"{name} is not answered yet"
+    if prop not in PROPERTIES:
+        return False, f"{name} could not be judged (unknown property {prop!r}: a problem in the solution notebook)"
+    if "tree" not in stu:
+        if stu.get("tag") in ("matrix", "scalar", "robot"):
+            why = stu.get("tree_error") or "no expression"
+            return False, f"{name} could not be read exactly ({why}): use SymPy numbers, symbols, sin and cos"
+        return False, _NOT_A_ROBOT.format(name=name).replace("is a number or an expression", f"is a {stu.get('type')}")
+    try:
+        return PROPERTIES[prop](stu, name)
+    except (ValueError, TypeError, RecursionError) as exc:
+        return False, f"{name} could not be read exactly ({str(exc)[:120]})"
+
+
+def judge_value(prop: str, value, name: str) -> tuple[bool, str]:
+    """:func:`judge` on a value itself (the workbook self-check's side, in the student's kernel), described by
+    :func:`kinlib.course.answers.normalise.property_answer` exactly as the grader's kernel describes it.
+
+    >>> judge_value("nonsingular", 1, "redesign")[0]
+    False
+    """
+    from .normalise import property_answer
+
+    return judge(prop, property_answer(value), name)
+
+
+def property_spec(value, prop: str) -> str:
+    """The self-check spec of an answer judged by a property (kind "property:<p>"): ``"property|<p>|-"``; it holds
+    nothing of the reference answer, which must have the property itself (else ValueError: a problem in the
+    solution notebook).
+
+    >>> from kinlib.robots import planar_rpp
+    >>> property_spec(planar_rpp(), "nonsingular")
+    'property|nonsingular|-'
+    """
+    ok, msg = judge_value(prop, value, "the reference answer")
+    if not ok:
+        raise ValueError(f"the solution's own answer fails its property {prop!r}: {msg}")
+    return f"property|{prop}|-"
+
+
+def property_verdict(prop: str, value) -> tuple[str, str]:
+    """The workbook self-check's ``(status, message)`` for a property answer: correct or incorrect, by
+    :func:`judge_value` (the grader's judgement); the message talks about the student's own design only.
+
+    >>> property_verdict("nonsingular", 2)[0]
+    'incorrect'
+    """
+    ok, message = judge_value(prop, value, "your answer")
+    return ("correct", f"correct: {message}") if ok else ("incorrect", f"not right yet: {message}")

@@ -283,7 +283,8 @@ def _print_all(jobs: list, log) -> list[Path]:
 
 
 def print_pdfs(out: Path, *, log=print) -> list[Path]:
-    """Print every ``out/problems/*.html`` and ``out/solutions/*.html`` to ``out/pdf/<kind>/<stem>.pdf``
+    """Print every ``out/problems/*.html``, ``out/solutions/*.html`` and ``out/reference/*.html`` (the cheat
+    sheet) to ``out/pdf/<kind>/<stem>.pdf``
     (A4, margins :data:`MARGINS_MM`, content :func:`printable_width_px` CSS pixels wide); return the PDFs.
 
     One chromium (Debian's, :data:`CHROMIUM`) prints them all, offline. A folder with no pages gives no
@@ -303,7 +304,7 @@ def print_pdfs(out: Path, *, log=print) -> list[Path]:
     out = Path(out)
     jobs = [
         (src, out / "pdf" / kind / f"{src.stem}.pdf")
-        for kind in ("problems", "solutions")
+        for kind in ("problems", "solutions", "reference")
         for src in sorted((out / kind).glob("*.html"))
     ]
     if not jobs:

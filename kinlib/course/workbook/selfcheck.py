@@ -17,7 +17,8 @@ those of :mod:`kinlib.course.answers.normalise`, the normaliser the instructor c
 - ``"set"``: a SymPy Set (or Python set/list of values, a number, a dict {symbol: Set} or a list of
   those dicts), compared through its points in [-2π, 2π] taken modulo 2π (angles), intervals by their
   end points;
-- ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector.
+- ``"subspace"``: a Matrix whose columns span a subspace, compared through its orthogonal projector;
+- ``"property:<p>"``: the student's own design (5.5) judged as the grader does (:mod:`..answers.properties`).
 
 A wrong answer is tried against the known mistakes of :mod:`kinlib.course.answers.mistakes` (transposed, wrong
 sign, [v; ω] order, columns swapped, degrees, wrong shape, ...; the instructor checker uses the same):
@@ -41,6 +42,7 @@ import sympy as sp
 
 from ..answers import mistakes
 from ..answers import normalise as answers
+from ..answers.properties import property_spec, property_verdict
 from ..schema import KINDS
 from .needs import answer_status, last_results, needs
 
@@ -425,10 +427,12 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     >>> fingerprint((2, 1), "choice") == fingerprint([1, 2, 2], "choice")
     True
     """
-    if kind not in _CANON:
-        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     if answers.is_unanswered(value):
         raise Unanswered("the value is missing or ...")
+    if str(kind).startswith("property:"):
+        return property_spec(value, kind.partition(":")[2])
+    if kind not in _CANON:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
     form, shape, canon = _CANON[kind](value)
     return f"{form}|{shape}|{_hash(form, canon, salt)}"
 
@@ -439,6 +443,8 @@ def describe_answer(value, kind: str = "default") -> str:
     >>> describe_answer(sp.zeros(6, 3)), describe_answer(3, "choice"), describe_answer({sp.Symbol("t"): {0}}, "set")
     ('a 6×3 Matrix', 'a joint number or a tuple of joint numbers (1-based)', 'a dict {symbol: SymPy Set}')
     """
+    if str(kind).startswith("property:"):
+        return "your robot (a kinlib SerialChain) or its task Jacobian J (a Matrix)"
     if kind == "choice":
         return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"
     if kind == "set":
@@ -473,14 +479,7 @@ def _parse_spec(spec: str):
     return form, shape, digest
 
 
-_FORM_KIND = {
-    "matrix": "default",
-    "scalar": "default",
-    "bool": "default",
-    "choice": "choice",
-    "set": "set",
-    "subspace": "subspace",
-}
+_FORM_KIND = dict.fromkeys(("matrix", "scalar", "bool"), "default") | {f: f for f in ("choice", "set", "subspace")}
 
 
 def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
@@ -500,6 +499,8 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
         return "unanswered", "not answered yet"
     if form == "none":
         return "error", "this answer has no automatic self-check: compare it with the worked solution"
+    if form == "property":  # judged by the property asked, on the student's own design (answers.properties)
+        return property_verdict(shape, value)
     kind = _FORM_KIND.get(form)
     if kind is None:
         raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
@@ -640,6 +641,8 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
             what = (
                 _shape_words(shape)
                 if form in ("matrix", "scalar")
+                else "your robot, a SerialChain, or its task Jacobian J"
+                if form == "property"
                 else ("see the question" if form == "none" else "True or False" if form == "bool" else f"a {form}")
             )
             message = f"not answered yet: replace the ... in `{name} = ...` above with your answer ({what})"

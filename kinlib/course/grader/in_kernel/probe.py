@@ -350,19 +350,19 @@ def describe_subspace(value, points, seed=0):
 
 
 def describe_property(value, points, seed=0):
-    """An answer graded by a property (``kind`` "property:<name>"): described as an expression, plus its
-    exact expression tree (``answers.expr_tree``) for the grader's proof.
+    """An answer graded by a property (``kind`` "property:<name>"): a robot as its screw axes' exact tree
+    (``answers.property_answer``), anything else described as an expression plus its exact expression tree
+    (``answers.expr_tree``), for the grader's proof.
 
     >>> import sympy as sp
     >>> describe_property(sp.Rational(1, 2), [{}])["tree"]
     ['rat', '1', '2']
     """
+    prop = answers.property_answer(value)  # a robot (its screw axes), a matrix or an expression, as a tree
+    if prop["tag"] == "robot":
+        return prop
     out = describe_expr(value, points, seed)
-    if out.get("tag") in ("matrix", "scalar"):
-        try:
-            out["tree"] = answers.expr_tree(answers.to_sympy(value)[1])
-        except Exception as exc:  # noqa: BLE001
-            out["tree_error"] = str(exc)[:200]
+    out.update({k: v for k, v in prop.items() if k in ("tree", "tree_error")})
     return out
 
 
