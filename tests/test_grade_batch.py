@@ -352,11 +352,12 @@ def _batch_dir(tmp_path, slow: dict, plain: int = 2) -> Path:
 
 def _killer(target: str, times: int, subs, after: float = 1.0):
     """An on_event hook: SIGKILL the worker that starts grading ``target``, its first ``times`` times."""
-    seen = {"kills": 0}
+    seen = {"kills": 0, "pids": []}
 
     def on_event(kind, pid, i):
         if kind == "start" and subs[i].relpath == target and seen["kills"] < times:
             seen["kills"] += 1
+            seen["pids"].append(pid)
             threading.Timer(after, lambda: _kill(pid)).start()
 
     return on_event, seen
@@ -382,6 +383,8 @@ def test_a_worker_killed_mid_batch_loses_nothing(tmp_path, kills):
             log=None, on_event=hook,
         )  # fmt: skip
     assert seen["kills"] == kills
+    left = [m for m in Path("/proc/self/mountinfo").read_text().split() if "kinlib-grade-" in m]
+    assert not [m for m in left if any(f"kinlib-grade-{pid}-" in m for pid in seen["pids"])], left
     res = {r["relpath"]: r for r in summary["results"]}
     assert set(res) == {"s0.ipynb", "s1.ipynb", "victim.ipynb"}
     for name in ("s0.ipynb", "s1.ipynb"):  # the others are graded as usual

@@ -172,8 +172,9 @@ def release(pid: int | None = None) -> list[int]:
     >>> release(2**22 + 1)
     []
     """
+    pid = os.getpid() if pid is None else int(pid)
     left = []
-    for base in _bases(os.getpid() if pid is None else pid):
+    for base in _bases(pid):
         subs = [c for c in base.iterdir() if c.is_dir()] if base.is_dir() else []
         for c in subs:
             left += kill_cgroup([c])
@@ -189,7 +190,22 @@ def release(pid: int | None = None) -> list[int]:
             base.rmdir()
         except OSError:
             pass
+    _remove_folders(pid)
     return left
+
+
+def _remove_folders(pid: int) -> None:
+    """Unmount and delete the submission folders a (dead) grader process ``pid`` left."""
+    prefix = os.path.join(tempfile.gettempdir(), f"kinlib-grade-{int(pid)}-")
+    try:
+        mounts = [line.split()[4] for line in Path("/proc/self/mountinfo").read_text().splitlines()]
+    except (OSError, IndexError):
+        mounts = []
+    for m in mounts:
+        if m.startswith(prefix):
+            _umount(m)
+    for d in Path(tempfile.gettempdir()).glob(f"kinlib-grade-{int(pid)}-*"):
+        shutil.rmtree(d, ignore_errors=True)
 
 
 def cgroup_support() -> tuple[str, object]:
@@ -292,7 +308,7 @@ class Enclosure:
 
     def __init__(self, limits: Limits | None = None, tag: str = ""):
         self.limits = limits or Limits()
-        self.folder = tempfile.mkdtemp(prefix="kinlib-grade-")
+        self.folder = tempfile.mkdtemp(prefix=f"kinlib-grade-{os.getpid()}-")  # release(pid) finds it by name
         self.tmpfs = _mount_tmpfs(self.folder, self.limits.disk_bytes)
         self.tmp_dir = self.shm_dir = ""
         if self.tmpfs:
