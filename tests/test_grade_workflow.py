@@ -18,7 +18,7 @@ import pytest
 import workflow_fixture as wf
 from kinlib.course import schema
 from kinlib.course.cli import main
-from kinlib.course.grader import credit, report
+from kinlib.course.grader import credit, intake, report
 
 ROOT = Path(__file__).resolve().parent.parent
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
@@ -144,17 +144,23 @@ def test_section_5_totals_25_with_the_drawing_as_a_manual_row():
 
 
 @pytest.mark.parametrize(
-    "path, pattern, expected",
+    "relpath, pattern, expected",
     [
-        ("/subs/ann_lee.ipynb", None, "ann_lee"),  # default: the stem
-        ("/subs/ann/ps4.ipynb", r"([^/]+)/[^/]+$", "ann"),  # one folder per student
-        ("/dl/leeann_LATE_12345_678_ps4-1.ipynb", r"[^/_]+_(?:LATE_|late_)?(?P<id>\d+)_\d+_[^/]*$", "12345"),
-        ("/dl/leeann_12345_678_ps4.ipynb", r"[^/_]+_(?:LATE_|late_)?(?P<id>\d+)_\d+_[^/]*$", "12345"),
-        ("/subs/readme.ipynb", r"(?P<id>\d{5})", "readme"),  # no match: the stem
+        ("ann_lee.ipynb", None, "ann_lee"),  # default: the path relative to the submissions root
+        ("ann/ps4.ipynb", None, "ann/ps4"),
+        ("ann/ps4.ipynb", r"([^/]+)/[^/]+$", "ann"),  # one folder per student
+        ("leeann_LATE_12345_678_ps4-1.ipynb", r"[^/_]+_(?:LATE_|late_)?(?P<id>\d+)_\d+_[^/]*$", "12345"),
+        ("leeann_12345_678_ps4.ipynb", r"[^/_]+_(?:LATE_|late_)?(?P<id>\d+)_\d+_[^/]*$", "12345"),
+        ("readme.ipynb", r"(?P<id>\d{5})", "readme"),  # no match: named by its path, with a warning
+        ("aaron/bob/02.ipynb", r"([^/]+)/[^/]+$", "aaron/bob/02"),  # a nested folder is never student bob
+        ("王伟/ps4.ipynb", r"([^/]+)/[^/]+$", "王伟"),  # kept as written
+        ("José/ps4.ipynb", r"([^/]+)/[^/]+$", "José"),
     ],
 )
-def test_student_id_from_the_path(path, pattern, expected):
-    assert credit.student_id(path, pattern) == expected
+def test_student_id_from_the_path(relpath, pattern, expected):
+    sid, warning = intake.student_id(relpath, pattern)
+    assert sid == expected
+    assert bool(warning) == (pattern is not None and expected == relpath[:-6]), warning
 
 
 # ----------------------------------------------------------------------------------------- overrides
@@ -288,7 +294,7 @@ def test_regrading_one_student_leaves_every_other_row_byte_identical(tmp_path):
 def test_the_id_pattern_is_remembered_and_a_new_one_rekeys_everyone(tmp_path):
     def sub(folder, verdicts=None):
         res = _scored("x", verdicts)
-        res["path"] = f"/class/{folder}/ps.ipynb"
+        res["path"], res["relpath"] = f"/class/{folder}/ps.ipynb", f"{folder}/ps.ipynb"
         return res
 
     report.write_outputs(tmp_path, [sub("ann"), sub("bob")], id_pattern=r"([^/]+)/[^/]+$")
@@ -296,7 +302,7 @@ def test_the_id_pattern_is_remembered_and_a_new_one_rekeys_everyone(tmp_path):
     rows = _read(tmp_path / "grades.csv")
     assert sorted({r["student_id"] for r in rows}) == ["ann", "bob"]
     assert {r["points"] for r in rows if r["student_id"] == "bob" and r["part"] == "1.1"} == {"3"}
-    report.write_outputs(tmp_path, [], id_pattern=r"(?P<id>[^/]+)\.ipynb$")  # every file is ps.ipynb
+    report.write_outputs(tmp_path, [], id_pattern=r"[^/]+/(?P<id>[^/]+)\.ipynb$")  # every file is ps.ipynb
     assert {r["student_id"] for r in _read(tmp_path / "grades.csv")} == {"ps", "ps-2"}  # re-keyed, none lost
     assert sorted(p.name for p in (tmp_path / "results").iterdir()) == [
         f"ps--{wf.NB_ID}.json",

@@ -3,7 +3,8 @@
     kinlib handouts notebooks --out build/handouts [--jobs 2] [--timeout 120] [--no-verify] [--only 05]
     kinlib execute notebooks [--timeout 600]      (run notebooks in place, saving widget state: make notebooks)
     kinlib grade SUBMISSIONS... --out build/grades [--jobs 2] [--timeout 300] [--cell-timeout 60]
-                 [--id-pattern REGEX] [--overrides FILE] [--fresh]
+                 [--id-pattern REGEX] [--root DIR] [--overrides FILE] [--fresh]
+                 [--memory 2G] [--processes 256] [--disk 512M] [--batch-timeout S]
     kinlib grade gradescope --out autograder.zip [--only 05] [--visibility visible] [--no-sandbox]
     kinlib grade prairielearn --out build/prairielearn [--only 05]
     kinlib grade canvas build/grades --assignment "Problem Set 4" --out canvas.csv [--roster export.csv]
@@ -53,6 +54,15 @@ def _positive_float(text: str) -> float:
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be positive, got {text}")
     return value
+
+
+def _size(text: str) -> int:
+    from .grader.isolation.limits import parse_size
+
+    try:
+        return parse_size(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _one_line(exc: BaseException) -> str:
@@ -167,6 +177,28 @@ def build_parser() -> argparse.ArgumentParser:
     )
     _add_class_options(g)
     g.add_argument(
+        "--root",
+        type=Path,
+        default=None,
+        help="the submissions root student ids are read relative to, for files given by themselves "
+        "(default: the folder given, or the one remembered in OUT/class.json)",
+    )
+    g.add_argument("--memory", type=_size, default="2G", help="memory per submission, all its processes (default 2G)")
+    g.add_argument("--processes", type=_positive_int, default=256, help="processes per submission (default 256)")
+    g.add_argument(
+        "--disk",
+        type=_size,
+        default="512M",
+        help="bytes a submission may write in all, /tmp and /dev/shm included (default 512M)",
+    )
+    g.add_argument(
+        "--batch-timeout",
+        type=_positive_float,
+        default=None,
+        help="seconds for the whole batch; submissions not graded by then are reported as infrastructure "
+        "(default: no limit beyond each submission's)",
+    )
+    g.add_argument(
         "--fresh",
         action="store_true",
         help="forget the results kept in OUT (default: merge, so grading one student replaces only their rows)",
@@ -180,8 +212,9 @@ def _add_class_options(p) -> None:
         "--id-pattern",
         default=None,
         metavar="REGEX",
-        help="student id: this pattern searched in the submission's absolute path (group 'id', else group 1); "
-        r"default: the file's stem. E.g. one folder per student: '([^/]+)/[^/]+$'",
+        help="student id: this pattern matched from the start of the submission's path relative to the "
+        "submissions root (group 'id', else group 1); a path it does not fit keeps that path as its id; "
+        r"default: the path without .ipynb. E.g. one folder per student: '([^/]+)/[^/]+$'",
     )
     p.add_argument(
         "--overrides",
@@ -339,13 +372,15 @@ def _handouts(args) -> int:
 
 
 def _grade(args) -> int:
-    from .grader.grade import SandboxUnavailable, find_submissions, grade_batch
+    from .grader.grade import SandboxUnavailable, grade_batch
+    from .grader.intake import find_submissions
+    from .grader.isolation.limits import Limits
     from .grader.report import summary_table
 
     if not args.submissions:
         return _rewrite_class_files(args)
     try:
-        subs = find_submissions(args.submissions)
+        subs = find_submissions(args.submissions)  # usage errors now; grade_batch finds them again (ids: their roots)
     except FileNotFoundError as exc:
         args.parser.error(str(exc))
     if args.notebooks is not None and not args.notebooks.is_dir():
@@ -368,7 +403,7 @@ def _grade(args) -> int:
         return 2
     try:
         summary = grade_batch(
-            subs,
+            args.submissions,
             args.out,
             jobs=args.jobs,
             timeout=args.timeout,
@@ -381,6 +416,9 @@ def _grade(args) -> int:
             id_pattern=args.id_pattern,
             overrides=overrides,
             merge=not args.fresh,
+            root=args.root,
+            batch_timeout=args.batch_timeout,
+            limits=Limits(memory_bytes=args.memory, processes=args.processes, disk_bytes=args.disk),
         )
     except (SandboxUnavailable, ValueError) as exc:  # no sandbox here, or an unsafe/unreadable secret file
         print(f"{PROG} grade: {_one_line(exc)}", file=sys.stderr)

@@ -16,9 +16,10 @@ turns those verdicts into points, the way the solution notebook's ``kinlib`` cel
   optional). ``part`` is "5.2" (the part's only row), "4.1/joint_c" (one answer of an automatic part: its
   points are replaced and the part's score recomputed) or "5.2/drawing" (a manual item). An override beats
   the automatic score; its comment is shown in the feedback; an empty score only adds the comment.
-* **Student ids** come from the submission's path by a regular expression (``--id-pattern``, searched in the
-  absolute path with "/" separators; the group named ``id``, else group 1, else the whole match); the default
-  is the file's stem. Examples: Canvas downloads ``doejane_12345_678_ps4.ipynb`` (12345: the Canvas user id,
+* **Student ids** come from the submission's path relative to the submissions root
+  (:func:`kinlib.course.grader.intake.student_id`): by default that path without ``.ipynb``; with ``--id-pattern``,
+  the regular expression matched from the start of it (the group named ``id``, else group 1, else the whole
+  match). Examples: Canvas downloads ``doejane_12345_678_ps4.ipynb`` (12345: the Canvas user id,
   the ``ID`` column of a Canvas gradebook) → ``[^/_]+_(?:LATE_|late_)?(?P<id>\\d+)_\\d+_[^/]*$``; one folder per
   student ``ann/ps4.ipynb`` → ``([^/]+)/[^/]+$``.
 """
@@ -26,25 +27,20 @@ turns those verdicts into points, the way the solution notebook's ``kinlib`` cel
 from __future__ import annotations
 
 import csv
-import re
 from dataclasses import dataclass
 from fractions import Fraction
 from pathlib import Path
 
 __all__ = [
-    "DEFAULT_ID_PATTERN",
     "answer_max",
     "manual_items",
     "check_part_points",
     "score_parts",
-    "student_id",
     "Override",
     "load_overrides",
     "apply_overrides",
     "result_totals",
 ]
-
-DEFAULT_ID_PATTERN = r"(?P<id>[^/]+?)(?:\.ipynb)?$"
 
 
 def _frac(x) -> Fraction:
@@ -204,27 +200,6 @@ def _manual_row(like: dict, part: str, label: str, pts: Fraction) -> dict:
         "max_points": _num(pts),
         "message": f"{label}: graded by hand (pending)",
     }
-
-
-# ----------------------------------------------------------------------------------------- student ids
-
-
-def student_id(path, pattern: str | None = None) -> str:
-    """The student id in a submission's path: ``pattern`` searched in the absolute POSIX path (group ``id``,
-    else group 1, else the whole match); the file's stem when ``pattern`` is None or does not match.
-
-    >>> student_id("/subs/ann/ps4.ipynb"), student_id("/subs/ann/ps4.ipynb", r"([^/]+)/[^/]+$")
-    ('ps4', 'ann')
-    >>> student_id("/dl/doejane_late_12345_678_ps4.ipynb", r"(?P<id>[^/_]+)_(?:late_)?\\d+_\\d+_[^/]*$")
-    'doejane'
-    """
-    text = Path(path).absolute().as_posix() if str(path) else ""
-    m = re.search(pattern or DEFAULT_ID_PATTERN, text)
-    if m:
-        got = m.groupdict().get("id") if "id" in m.re.groupindex else (m.group(1) if m.re.groups else m.group(0))
-        if got:
-            return got
-    return Path(path).stem or str(path)
 
 
 # ----------------------------------------------------------------------------------------- overrides

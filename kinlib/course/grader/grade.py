@@ -2,6 +2,8 @@
 
     kinlib grade SUBMISSION.ipynb|FOLDER ... --out DIR [--timeout S] [--cell-timeout S] [--jobs N]
                  [--notebooks notebooks] [--cache build/grade-cache] [--quiet] [--secret FILE] [--no-sandbox]
+                 [--id-pattern REGEX] [--root DIR] [--memory 2G] [--processes 256] [--disk 512M]
+                 [--batch-timeout S]
 
 (the command line is :mod:`kinlib.course.cli`; the outputs are written by :mod:`kinlib.course.grader.report`)
 
@@ -17,7 +19,13 @@ How it works
   files); one whose metadata was lost (solution cells pasted into a new notebook) by its questions
   (:func:`kinlib.course.schema.match_notebook`: the answer names it assigns, the part numbers it mentions),
   with a note in its feedback. A file that is not JSON, not a notebook, or not one of ours gets one
-  ``error`` row.
+  ``error`` row; so does a link, a FIFO, a file over 50 MB, JSON nested too deep or a notebook of the wrong
+  types (:mod:`kinlib.course.grader.intake` reads every file defensively and says what was wrong).
+* **The batch** (:func:`grade_batch`): with ``--jobs`` > 1, grading workers started and watched by the grader
+  itself (:mod:`kinlib.course.grader.batch`); a worker that dies or stops answering is replaced and its
+  submission tried once more, then reported as infrastructure; the outputs are always written for everyone
+  graded. Student ids come from each file's path relative to the submissions folder
+  (:func:`kinlib.course.grader.intake.student_id`).
 * **Reference answers** come from executing the solution notebooks in ``--notebooks`` (never from the
   installed package, which holds no answer key). For each graded part (a ``question`` markdown cell,
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
@@ -66,7 +74,10 @@ Threat model
 Each kernel runs in the sandbox: its own user, PID, network and IPC namespaces (no network, no view of
 the grader's processes; everything it starts dies with it), a read-only system and Python environment,
 the ``kinlib`` package folder but not the repository around it (no notebooks, build folder, reference
-cache, secret, output folder or home), and writable only its own scratch folder and a private /tmp.
+cache, secret, output folder or home), and writable only its own scratch folder, a private /tmp and a
+small /dev/shm (``/dev`` read-only). Each submission has limits in all (:mod:`kinlib.course.grader.isolation.limits`:
+2 GiB of memory and 256 processes in a cgroup of its own, 512 MiB written on one size-limited tmpfs that
+holds every folder it can write); a limit reached is a ``limits`` row and the other parts are graded.
 grades.csv and the feedback are written after every kernel of the batch, and every process a submission
 started, is gone (checked: :func:`kinlib.course.grader.isolation.sandbox.reap_namespaces`). Without bubblewrap the grader
 refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.
@@ -84,20 +95,17 @@ undone before the answers are exported, and cannot reach the grader's SymPy, whi
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import random
-import shutil
-import tempfile
 import time
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict
 from pathlib import Path
 
 from ..schema import cell_meta, cell_part, match_notebook, notebook_id, stash_points
-from . import credit
+from . import batch, credit, intake
 from .isolation.kernel import NotebookRun
+from .isolation.limits import Enclosure, Limits, release
 from .isolation.sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
 from .judge import N_POINTS
 from .refdata import (
@@ -130,7 +138,7 @@ __all__ = [
 NO_SANDBOX_NOTE = (
     "graded WITHOUT the sandbox (--no-sandbox): the submission's code ran with the grader's files and network"
 )
-MAX_SUBMISSION_BYTES = 50 * 2**20
+MAX_SUBMISSION_BYTES = intake.MAX_SUBMISSION_BYTES
 
 
 # ----------------------------------------------------------------------------------------- one submission
@@ -176,6 +184,9 @@ def grade_submission(
     display_name: str | None = None,
     sandbox=True,
     secret=None,
+    relpath: str | None = None,
+    root: str | None = None,
+    limits: Limits | None = None,
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises).
 
@@ -202,26 +213,14 @@ def grade_submission(
     sub = display_name or str(path)
     out = {"submission": sub, "notebook": "", "title": "", "rows": [], "cells": [], "restarts": 0, "output_bytes": 0}
     out["sandbox"] = sandbox is not False
-    out["path"] = str(Path(path).absolute())  # the student id is read from it (credit.student_id)
+    out["path"] = str(Path(path).absolute())
+    out["relpath"] = relpath or Path(path).name  # the student id is read from it (intake.student_id)
+    out["root"] = root or str(Path(path).absolute().parent)
     if sandbox is False:
         out["notes"] = [NO_SANDBOX_NOTE]
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        out["rows"] = [Row(sub, "", "-", "error", 0, f"cannot read the file: {exc}")]
-        return _done(out, t0)
-    if len(data) > MAX_SUBMISSION_BYTES:
-        out["rows"] = [
-            Row(sub, "", "-", "error", 0, f"not graded: the file is larger than {MAX_SUBMISSION_BYTES // 2**20} MB")
-        ]
-        return _done(out, t0)
-    try:
-        nb = json.loads(data.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError) as exc:
-        out["rows"] = [Row(sub, "", "-", "error", 0, f"not a notebook: the file is not JSON ({str(exc)[:120]})")]
-        return _done(out, t0)
-    if not isinstance(nb, dict) or not isinstance(nb.get("cells"), list) or nb.get("nbformat", 4) < 4:
-        out["rows"] = [Row(sub, "", "-", "error", 0, "not a notebook: JSON, but not a version-4 Jupyter notebook")]
+    data, nb, problem = intake.read_notebook(path)  # never raises, never blocks, never recurses deeply
+    if problem:
+        out["rows"] = [Row(sub, "", "-", "error", 0, problem)]
         return _done(out, t0)
     nid = notebook_id(nb)
     if nid is None:  # metadata lost (solution cells pasted into a new notebook): recognised by its questions
@@ -279,7 +278,9 @@ def grade_submission(
             part_of_cell[i] = part
     stash_after = stash_points(nb)
 
-    tmp = tempfile.mkdtemp(prefix="kinlib-grade-")
+    enc = Enclosure(limits or Limits(), tag=out["relpath"])  # the submission's cgroup and size-limited tmpfs
+    tmp = enc.folder
+    out["limits"] = enc.describe()
     run, cpu0 = None, time.process_time()
     try:
         scratch = os.path.join(tmp, "work")
@@ -287,7 +288,7 @@ def grade_submission(
         with open(os.path.join(scratch, Path(path).name), "wb") as f:
             f.write(data)
         run = NotebookRun(
-            code, scratch, tmp, cell_timeout, total_timeout, stash_after=stash_after, sandbox=sandbox or None
+            code, scratch, tmp, cell_timeout, total_timeout, stash_after, sandbox=sandbox or None, enclosure=enc
         )
         rows, exact = _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         out["restarts"] = run.restarts
@@ -300,7 +301,11 @@ def grade_submission(
             run.close()
             out["namespaces"], out["start_failures"] = run.namespaces, run.start_failures
             out["cpu_seconds"] = round(run.cpu_seconds + time.process_time() - cpu0, 3)
-        shutil.rmtree(tmp, ignore_errors=True)
+        reached = enc.reached()
+        enc.close()  # every process of the submission killed, its tmpfs gone
+    if reached:  # a row that says which limit stopped what (the parts' rows say what it cost)
+        out["limits_reached"] = reached
+        rows.append(Row(sub, nid, "limits", "error", 0, "limit reached: " + "; ".join(reached), 0.0))
     out["rows"] = rows
     out["exact"] = exact
     return _done(out, t0)
@@ -324,7 +329,7 @@ def _done(out, t0):
 
 def find_submissions(paths) -> list[Path]:
     """Files given, plus every .ipynb under folders given (hidden folders such as .ipynb_checkpoints
-    skipped), in order.
+    skipped, links not followed: :func:`kinlib.course.grader.intake.find_submissions`), in order.
 
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as d:
@@ -335,45 +340,55 @@ def find_submissions(paths) -> list[Path]:
     ...     [p.relative_to(root).as_posix() for p in find_submissions([root / "ann", root / "bob.ipynb"])]
     ['ann/hw2.ipynb', 'bob.ipynb']
     """
-    found = []
-    for p in map(Path, paths):
-        if p.is_dir():
-            found += sorted(
-                q for q in p.rglob("*.ipynb") if not any(part.startswith(".") for part in q.relative_to(p).parts[:-1])
-            )
-        elif p.exists():
-            found.append(p)
-        else:
-            raise FileNotFoundError(f"no such file or folder: {p}")
-    return found
+    return [s.path for s in intake.find_submissions(paths)]
 
 
 def _peek_id(path: Path, unmatched: bool = False):
     """The notebook id of a submission (None if none); ``unmatched``: whether it is a notebook without one."""
-    try:
-        with open(path, "rb") as f:
-            data = f.read(MAX_SUBMISSION_BYTES + 1)
-        nb = json.loads(data)
-        if unmatched:
-            return isinstance(nb, dict) and isinstance(nb.get("cells"), list) and notebook_id(nb) is None
-        return notebook_id(nb)
-    except (OSError, ValueError, UnicodeDecodeError, AttributeError):
-        return None
+    _, nb, problem = intake.read_notebook(path)
+    if problem:
+        return None if not unmatched else False
+    return notebook_id(nb) is None if unmatched else notebook_id(nb)
 
 
-_REFS: dict = {}
-_CTX: dict = {}
+def worker_handler(init: dict):
+    """The function a grading worker (:mod:`kinlib.course.grader.batch`) applies to each task: ``init`` holds the
+    references (as dicts), the sandbox, the secret and the time limits; a task names one submission."""
+    refs = {k: Reference(**v) for k, v in init["refs"].items()}
+
+    def handle(task: dict) -> dict:
+        return grade_submission(
+            task["path"],
+            refs,
+            init["cell_timeout"],
+            init["timeout"],
+            display_name=task["name"],
+            sandbox=init["sandbox"],
+            secret=init["secret"],
+            relpath=task["relpath"],
+            root=task["root"],
+            limits=init.get("limits"),
+        )
+
+    return handle
 
 
-def _init_worker(refs_json, sandbox, secret):
-    global _REFS
-    _REFS = {k: Reference(**v) for k, v in refs_json.items()}
-    _CTX.update(sandbox=sandbox, secret=secret)
-
-
-def _work(args):
-    path, name, cell_timeout, total_timeout = args
-    return grade_submission(path, _REFS, cell_timeout, total_timeout, display_name=name, **_CTX)
+def not_graded(sub: intake.Submission, refs: dict, why: str, name: str | None = None) -> dict:
+    """The result of a submission the batch could not grade (an infrastructure failure: a worker that died
+    twice, none that could start, the batch's time limit): one error row per part of its notebook."""
+    t0 = time.monotonic()
+    name = name or sub.relpath
+    out = {"submission": name, "notebook": "", "title": "", "rows": [], "cells": [], "restarts": 0}
+    out.update(path=str(sub.path), relpath=sub.relpath, root=sub.root, infrastructure=why, output_bytes=0)
+    nid = _peek_id(sub.path)
+    ref = refs.get(nid) if nid else None
+    msg = f"not graded: infrastructure: {why}"
+    if ref is None:
+        out["rows"] = [Row(name, nid or "", "-", "error", 0, msg)]
+    else:
+        out.update(notebook=nid, title=ref.title, parts=ref.parts)
+        out["rows"] = _error_rows(name, nid, ref.parts, msg)
+    return _done(out, t0)
 
 
 def grade_batch(
@@ -390,17 +405,29 @@ def grade_batch(
     id_pattern=None,
     overrides=None,
     merge: bool = True,
+    batch_timeout: float | None = None,
+    on_event=None,
+    root=None,
+    limits: Limits | None = None,
 ) -> dict:
     """Grade every submission in ``paths`` (files or folders) into ``out``; returns a summary dict.
 
     ``summary = {"results": [per-submission dict], "rows": [...], "seconds": wall time,
     "per_minute": submissions per minute, "reference_seconds": ..., "infrastructure_errors": n,
-    "sandbox": bool}``. Never raises for a bad submission. Each student kernel runs in the bubblewrap
-    sandbox (:mod:`kinlib.course.grader.isolation.sandbox`); without it (bwrap missing) this raises SandboxUnavailable
-    unless ``sandbox=False`` (``--no-sandbox``), and then every feedback page and the summary say so.
-    ``secret``: the grader secret's file (default :func:`~kinlib.course.grader.secret.default_secret_path`,
-    created on first use) or bytes. grades.csv and the feedback are written only after every kernel of
-    the batch (and every process a submission started) is gone.
+    "sandbox": bool}``. Never raises for a bad submission (a link, a FIFO, deep or mistyped JSON: an error
+    row each). Each student kernel runs in the bubblewrap sandbox (:mod:`kinlib.course.grader.isolation.sandbox`);
+    without it (bwrap missing) this raises SandboxUnavailable unless ``sandbox=False`` (``--no-sandbox``), and
+    then every feedback page and the summary say so. ``secret``: the grader secret's file (default
+    :func:`~kinlib.course.grader.secret.default_secret_path`, created on first use) or bytes.
+
+    With ``jobs`` > 1 the submissions are graded by supervised worker processes
+    (:mod:`kinlib.course.grader.batch`): a worker that dies or hangs is replaced and its submission retried
+    once, then reported as infrastructure; ``batch_timeout`` (seconds) bounds the whole batch. ``limits``: what
+    each submission may use in all (:class:`kinlib.course.grader.isolation.limits.Limits`: 2 GiB, 256
+    processes, 512 MiB written). ``root``: the folder student ids are read relative to, for files given by
+    themselves (default: the one remembered in ``out/class.json``). grades.csv, totals.csv and the feedback are
+    written for everyone graded, even when the batch is interrupted, and only after every kernel of the batch
+    (and every process a submission started) is gone.
 
     It runs the solution notebooks and every submission in Jupyter kernels (seconds to minutes;
     tests/test_grade.py exercises it), hence not run here:
@@ -408,12 +435,14 @@ def grade_batch(
     >>> summary = grade_batch(["submissions/"], "build/grades", jobs=2, log=None)  # doctest: +SKIP
     >>> summary["n"], sorted({r["status"] for r in summary["rows"]})  # submissions, statuses seen  # doctest: +SKIP
     >>> sorted(p.name for p in Path("build/grades").iterdir())  # doctest: +SKIP
-    ['feedback', 'grades.csv']
+    ['class.json', 'feedback', 'grades.csv', 'results', 'totals.csv']
     """
+    from .report import remembered_root
+
     t0 = time.monotonic()
     log = log or (lambda *a, **k: None)
     out = Path(out)
-    subs = find_submissions(paths)
+    subs = intake.find_submissions(paths, root=root or remembered_root(out))
     notebooks = Path(notebooks) if notebooks else default_notebooks()
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
@@ -424,44 +453,30 @@ def grade_batch(
         if not ok:
             raise SandboxUnavailable(f"{why}; to grade without the sandbox pass --no-sandbox")
         hidden = [notebooks, out, cache or "", "" if isinstance(secret, bytes) else secret or default_secret_path()]
-        sb = Sandbox(hidden=[str(Path(h).resolve()) for h in hidden if h] + [str(p.resolve().parent) for p in subs])
+        sb = Sandbox(hidden=[str(Path(h).resolve()) for h in hidden if h] + sorted({s.root for s in subs}))
         sb.command(["true"], cwd="/tmp", rw=[], env={})  # refuses now if a bind would expose a hidden folder
     else:
         log(f"WARNING: {NO_SANDBOX_NOTE}")
-    ids = {i for i in (_peek_id(p) for p in subs) if i}
-    if any(_peek_id(p, unmatched=True) for p in subs):
+    readable = [s.path for s in subs if not s.refused]
+    ids = {i for i in (_peek_id(p) for p in readable) if i}
+    if any(_peek_id(p, unmatched=True) for p in readable):
         ids = None  # a notebook without its id is matched against every assignment's questions
     refs = load_references(notebooks, Path(cache) if cache else None, ids, log=log, jobs=max(1, int(jobs)), secret=key)
     t_ref = time.monotonic() - t0
-    names = _display_names(subs)
     jobs = max(1, int(jobs))
-    work = [(str(p), n, cell_timeout, timeout) for p, n in zip(subs, names)]
-    results = []
-    if jobs == 1 or len(work) <= 1:
-        for k, w in enumerate(work, 1):
-            results.append(
-                grade_submission(w[0], refs, cell_timeout, timeout, display_name=w[1], sandbox=sb or False, secret=key)
+    results: list = []  # filled as submissions are graded: an interrupted batch still writes what it graded
+    try:
+        opts = dict(timeout=timeout, cell_timeout=cell_timeout, sandbox=sb or False, secret=key, limits=limits)
+        _grade_all(results, subs, refs, jobs, opts, batch_timeout, on_event, log)
+    finally:
+        # every kernel is stopped by now; make sure no process of any sandbox survives before writing results
+        survivors = reap_namespaces([n for r in results for n in r.get("namespaces", [])])
+        if survivors:
+            raise RuntimeError(
+                f"processes {survivors} of the batch's sandboxes could not be killed: no results written"
             )
-            _progress(log, k, len(work), results[-1])
-    else:
-        import multiprocessing as mp
-
-        refs_json = {k: asdict(v) for k, v in refs.items()}
-        with ProcessPoolExecutor(
-            max_workers=min(jobs, len(work)),
-            mp_context=mp.get_context("spawn"),
-            initializer=_init_worker,
-            initargs=(refs_json, sb or False, key),
-        ) as pool:
-            for k, r in enumerate(pool.map(_work, work), 1):
-                results.append(r)
-                _progress(log, k, len(work), r)
-    # every kernel is stopped by now; make sure no process of any sandbox survives before writing results
-    survivors = reap_namespaces([n for r in results for n in r.get("namespaces", [])])
-    if survivors:
-        raise RuntimeError(f"processes {survivors} of the batch's sandboxes could not be killed: no results written")
+        write_outputs(out, results, id_pattern=id_pattern, overrides=overrides, merge=merge, log=log, roots=subs)
     wall = time.monotonic() - t0
-    write_outputs(out, results, id_pattern=id_pattern, overrides=overrides, merge=merge, log=log)
     summary = {
         "results": results,
         "rows": [r for res in results for r in res["rows"]],
@@ -472,25 +487,59 @@ def grade_batch(
         "infrastructure_errors": sum(1 for r in results if r.get("infrastructure")),
         "sandbox": sb is not None,
     }
-    log(summary_table(results, wall, t_ref, jobs))
+    log(summary_table(results, wall, t_ref, jobs))  # control characters already escaped
     return summary
 
 
+def _grade_all(done, subs, refs, jobs, opts, batch_timeout, on_event, log) -> None:
+    """Append one result per submission to ``done``: in this process (one job, or one submission), else by
+    supervised workers (in the submissions' order once all are in)."""
+    n = len(subs)
+    if jobs == 1 or n <= 1:
+        try:
+            for k, s in enumerate(subs, 1):
+                o = opts
+                args = (o["cell_timeout"], o["timeout"], s.relpath, o["sandbox"], o["secret"], s.relpath, s.root)
+                done.append(grade_submission(s.path, refs, *args, limits=o["limits"]))
+                _progress(log, k, n, done[-1])
+        except KeyboardInterrupt:
+            log(f"interrupted: writing the {len(done)} result(s) graded so far")
+            raise
+        return
+    tasks = [
+        {"i": k, "path": str(s.path), "name": s.relpath, "relpath": s.relpath, "root": s.root}
+        for k, s in enumerate(subs)
+    ]
+    init = {"handler": f"{__name__}:worker_handler", "refs": {k: asdict(v) for k, v in refs.items()}, **opts}
+
+    def event(kind, pid, i):
+        if kind in ("died", "stuck", "retry", "gave-up") and i is not None:
+            log(f"grading worker {pid} {kind} while grading {subs[i].relpath}")
+        if on_event is not None:
+            on_event(kind, pid, i)
+
+    def result(i, res):
+        done.append(res)
+        _progress(log, len(done), n, res)
+
+    task_limit = 2 * opts["timeout"] + 600.0  # the kernel's own limits end a submission long before this
+    results = batch.run(
+        tasks,
+        jobs,
+        init,
+        lambda task, why: not_graded(subs[task["i"]], refs, why),
+        task_limit,
+        batch_timeout=batch_timeout,
+        on_event=event,
+        on_result=result,
+        cleanup=release,
+    )
+    done[:] = results
+
+
 def _progress(log, k, n, r):
+    from .report import printable
+
     tot = sum(x["points"] for x in r["rows"])
     mx = sum(x.get("max_points", 0) for x in r["rows"])
-    log(f"[{k}/{n}] {r['submission']}: {tot:g}/{mx:g} ({r['seconds']:.1f} s)")
-
-
-def _display_names(subs) -> list[str]:
-    names = []
-    try:
-        common = Path(os.path.commonpath([str(p.resolve().parent) for p in subs])) if subs else None
-    except ValueError:
-        common = None
-    for p in subs:
-        try:
-            names.append(str(p.resolve().relative_to(common)) if common else str(p))
-        except ValueError:
-            names.append(str(p))
-    return names
+    log(printable(f"[{k}/{n}] {r['submission']}: {tot:g}/{mx:g} ({r['seconds']:.1f} s)"))

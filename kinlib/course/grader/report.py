@@ -27,9 +27,11 @@ import json
 import os
 import re
 import tempfile
+import unicodedata
 from pathlib import Path
 
 from . import credit
+from .intake import file_key, student_id
 
 __all__ = [
     "COLUMNS",
@@ -42,6 +44,11 @@ __all__ = [
     "atomic_write",
     "student_totals",
     "default_overrides",
+    "csv_cell",
+    "csv_text",
+    "md_text",
+    "md_code",
+    "printable",
 ]
 
 COLUMNS = [
@@ -62,8 +69,65 @@ COLUMNS = [
 ]
 
 
+_MD_SPECIAL = re.compile(r"([\\`*_\[\]<>!|~&@])")
+_AUTOLINK = re.compile(r"(?i)(?<=\w)(:)(?=//)|(?<=www)(\.)")
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,79}")
+
+
+def printable(s) -> str:
+    r"""``s`` without anything a terminal would act on: control and format characters (escape sequences,
+    carriage returns, bidirectional overrides) are shown as ``\x..``/``\u....`` escapes.
+
+    >>> print(printable("ann\x1b[2J\rbob\u202e"))
+    ann\x1b[2J\rbob\u202e
+    """
+    out = []
+    for ch in str(s):
+        if unicodedata.category(ch) in ("Cc", "Cf", "Zl", "Zp", "Cs", "Co", "Cn") and ch != " ":
+            out.append(repr(ch)[1:-1] if ch.isascii() or ord(ch) < 0x100 else f"\\u{ord(ch):04x}")
+        else:
+            out.append(ch)
+    return "".join(out)
+
+
+def md_text(s) -> str:
+    r"""Student-controlled text as inert Markdown: one line, every character that starts markup, HTML or an
+    entity backslash-escaped (no raw HTML, no link, no image), autolinks (``http://``, ``www.``, e-mail)
+    broken, control characters shown as escapes.
+
+    >>> print(md_text("<img src=x onerror=alert(1)> [click](javascript:alert(1)) ![](http://evil/p.png) a|b"))
+    \<img src=x onerror=alert(1)\> \[click\](javascript:alert(1)) \!\[\](http\://evil/p.png) a\|b
+    """
+    text = printable(" ".join(str(s).split("\n")))
+    return _AUTOLINK.sub(lambda m: "\\" + (m.group(1) or m.group(2)), _MD_SPECIAL.sub(r"\\\1", text))
+
+
+def md_code(s) -> str:
+    r"""A name as inline code when it is a plain identifier, else as :func:`md_text`.
+
+    >>> print(md_code("joint_c"), md_code("`x` <b>"))
+    `joint_c` \`x\` \<b\>
+    """
+    s = str(s)
+    return f"`{s}`" if _IDENT.fullmatch(s) else md_text(s)
+
+
 def _md(s) -> str:
-    return str(s).replace("|", "\\|").replace("\n", " ").replace("<", "&lt;")
+    return md_text(s)
+
+
+def csv_cell(v) -> str:
+    r"""One CSV cell: a number as a number (negative ones too), text neutralised by OWASP's rule (a cell that
+    starts with ``=``, ``+``, ``-``, ``@``, a tab or a carriage return gets a leading ``'``, so a spreadsheet
+    shows it instead of running it; a lone ``-``, the part of a whole-file error row, cannot run and stays).
+
+    >>> [csv_cell(x) for x in (-1.5, 3, "=HYPERLINK(1)", "-2+3", "@SUM(A1)", "\tx", "ann", "")]
+    ['-1.5', '3', "'=HYPERLINK(1)", "'-2+3", "'@SUM(A1)", "'\tx", 'ann', '']
+    """
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        return f"{float(v):g}"
+    s = "" if v is None else str(v)
+    return "'" + s if s[:1] in ("=", "+", "-", "@", "\t", "\r") and s != "-" else s
 
 
 def _g(x) -> str:
@@ -92,13 +156,13 @@ def feedback_markdown(res: dict) -> str:
     score = f"**Score: {_g(tot['points'])} / {_g(tot['max_points'])} points**"
     if pend:
         score += (
-            f" (pending: {', '.join(tot['pending'])}, {_g(sum(r.get('max_points', 0) for r in pend))} points "
+            f" (pending: {_md(', '.join(tot['pending']))}, {_g(sum(r.get('max_points', 0) for r in pend))} points "
             "graded by hand)"
         )
     lines = [
-        f"# Feedback: {res.get('title') or res.get('notebook') or 'submission'}",
+        f"# Feedback: {_md(res.get('title') or res.get('notebook') or 'submission')}",
         "",
-        f"Submission `{res['submission']}`" + (f" (notebook `{res['notebook']}`)" if res.get("notebook") else ""),
+        f"Submission {_md(res['submission'])}" + (f" (notebook {_md(res['notebook'])})" if res.get("notebook") else ""),
         "",
         score,
         "",
@@ -110,7 +174,7 @@ def feedback_markdown(res: dict) -> str:
     lines += ["| Part | Points | Result | Feedback |", "|---|---|---|---|"]
     for r in rows:
         pts = "–" if r.get("status") == "pending" else _g(r.get("points"))
-        status = r["status"] + (" (override)" if r.get("override") else "")
+        status = _md(r["status"]) + (" (override)" if r.get("override") else "")
         if r.get("kind") == "manual":
             status += ", graded by hand"
         msg = r.get("message", "")
@@ -122,23 +186,23 @@ def feedback_markdown(res: dict) -> str:
         lines += ["", "## Points per answer", "", "| Part | Answer | Points | Result |", "|---|---|---|---|"]
         for r in multi:
             for a in r["answers"]:
-                st = a["status"] + (" (override)" if a.get("override") else "")
+                st = _md(a["status"]) + (" (override)" if a.get("override") else "")
                 lines.append(
-                    f"| {_md(r['part'])} | `{_md(a['answer'])}` | {_g(a['points'])} / {_g(a['max_points'])} | {st} |"
+                    f"| {_md(r['part'])} | {md_code(a['answer'])} | {_g(a['points'])} / {_g(a['max_points'])} | {st} |"
                 )
     bad = [c for c in res.get("cells", []) if c["status"] != "ok"]
     if bad or res.get("restarts"):
         lines += ["", "## Cells that did not run cleanly", ""]
         for c in bad:
             what = cell_text(c)
-            part = f" (part {c['part']})" if c.get("part") else ""
+            part = f" (part {_md(c['part'])})" if c.get("part") else ""
             lines.append(f"- code cell {c['index'] + 1}{part}: {_md(what)}")
         if res.get("restarts"):
             lines.append(
                 f"- the kernel was restarted {res['restarts']} time(s); the cells that stopped it were skipped"
             )
     if res.get("restored") and isinstance(res["restored"], list):
-        names = ", ".join(f"`{n}`" for n in res["restored"][:8]) + (" …" if len(res["restored"]) > 8 else "")
+        names = ", ".join(md_code(n) for n in res["restored"][:8]) + (" …" if len(res["restored"]) > 8 else "")
         lines += [
             "",
             f"Your notebook replaced {names}; the checker put the originals back before reading your answers.",
@@ -171,20 +235,18 @@ def cell_text(c: dict) -> str:
 # ----------------------------------------------------------------------------------------- class files
 
 
-def _safe(s: str) -> str:
-    return re.sub(r"[^A-Za-z0-9_.-]+", "_", s).strip("._")[:120] or "submission"
-
-
 def result_key(res: dict) -> str:
-    """The name a result is kept under in the class folder: student id and notebook (or the file's stem).
+    """The name a result is kept under in the class folder: student id and notebook (or the file's stem),
+    each in :func:`kinlib.course.grader.intake.file_key`'s collision-free form (plain lower-case ids as they are,
+    any other id as a slug plus a hash: ``王伟``, ``josé``/``josè``, ``Ann``/``ann`` never share a file).
 
     >>> result_key({"student_id": "ann", "notebook": "05_singularities_planar", "submission": "x/hw.ipynb"})
     'ann--05_singularities_planar'
     >>> result_key({"student_id": "bob lee", "notebook": "", "submission": "x/garbage.ipynb"})
-    'bob_lee--garbage'
+    'bob_lee~482bc94ae4--garbage'
     """
     nb = res.get("notebook") or Path(str(res.get("submission", ""))).stem
-    return f"{_safe(str(res.get('student_id') or 'unknown'))}--{_safe(nb)}"
+    return f"{file_key(str(res.get('student_id') or 'unknown'))}--{file_key(nb)}"
 
 
 def atomic_write(path: Path, text: str) -> bool:
@@ -249,12 +311,28 @@ def student_totals(results: list) -> dict:
     return {sid: credit.result_totals(rs) for sid, rs in rows.items()}
 
 
-def _csv(rows: list) -> str:
+def csv_text(rows: list) -> str:
+    """CSV text of ``rows``, every cell through :func:`csv_cell` (numbers stay numbers, text is neutralised).
+
+    >>> print(csv_text([["id", "points"], ["=cmd|' /C calc'!A0", -2.0]]), end="")
+    id,points
+    '=cmd|' /C calc'!A0,-2
+    """
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
+    quoted = csv.writer(buf, lineterminator="\n", quoting=csv.QUOTE_ALL)
     for r in rows:
-        w.writerow(r)
+        cells = [csv_cell(v) for v in r]
+        # the csv module quotes a cell with "\n" but not one with a lone "\r", which readers take as a line end
+        (quoted if any("\r" in c for c in cells) else w).writerow(cells)
     return buf.getvalue()
+
+
+_csv = csv_text
+
+
+def _num(x) -> float:
+    return float(x or 0)
 
 
 def _grades_csv(results: list, totals: dict) -> str:
@@ -273,12 +351,12 @@ def _grades_csv(results: list, totals: dict) -> str:
                     r.get("answer", ""),
                     r.get("kind", "auto"),
                     r["status"],
-                    "" if pending else _g(r.get("points")),
-                    _g(r.get("max_points")),
+                    "" if pending else _num(r.get("points")),
+                    _num(r.get("max_points")),
                     r.get("message", ""),
                     r.get("comment", ""),
-                    _g(t["points"]),
-                    _g(t["max_points"]),
+                    _num(t["points"]),
+                    _num(t["max_points"]),
                     " ".join(t["pending"]),
                 ]
             )
@@ -295,8 +373,8 @@ def _totals_csv(results: list, totals: dict) -> str:
         out.append(
             [
                 sid,
-                _g(t["points"]),
-                _g(t["max_points"]),
+                _num(t["points"]),
+                _num(t["max_points"]),
                 "pending" if t["pending"] else "complete",
                 " ".join(t["pending"]),
                 " ".join(nbs.get(sid, [])),
@@ -310,21 +388,32 @@ def _key_results(kept: list, new: list, pattern) -> tuple:
     the kept one of the same student and notebook. Results that still share a key (two files of one batch with
     the same id) are all kept, the 2nd, 3rd, ... (by path) with the id suffixed "-2", "-3", and a warning."""
     groups: dict = {}
+    warnings = []
     for res in [*kept, *new]:
-        res["student_id"] = credit.student_id(res.get("path") or res["submission"], pattern)
+        if res.get("relpath"):
+            res["student_id"], why = student_id(res["relpath"], pattern)
+        else:  # kept by an older kinlib: its id as that version read it (the pattern searched in the whole path)
+            res["student_id"], why = _legacy_id(str(res.get("path") or res["submission"]), pattern), ""
+        if why:
+            warnings.append(why)
         for r in res["rows"]:
             r.setdefault("kind", "auto")
             r.setdefault("answer", "")
         groups.setdefault(result_key(res), []).append(res)
-    table, warnings = {}, []
+    table = {}
     fresh = {id(r) for r in new}
     for key, group in groups.items():
         newer = [r for r in group if id(r) in fresh]
         group = sorted(newer or group, key=lambda r: str(r.get("path") or r["submission"]))
         table[key] = group[0]
-        for k, res in enumerate(group[1:], 2):
+        k = 1
+        for res in group[1:]:
             sid = res["student_id"]
-            res["student_id"] = f"{sid}-{k}"
+            while True:  # a suffixed id that no other result has
+                k += 1
+                res["student_id"] = f"{sid}-{k}"
+                if result_key(res) not in groups and result_key(res) not in table:
+                    break
             table[result_key(res)] = res
             warnings.append(
                 f"{res.get('path') or res['submission']} has the same student id {sid!r} as "
@@ -332,6 +421,32 @@ def _key_results(kept: list, new: list, pattern) -> tuple:
                 "give --id-pattern (one folder per student: '([^/]+)/[^/]+$')"
             )
     return table, warnings
+
+
+def _legacy_id(path: str, pattern) -> str:
+    """The id of a result kept without ``relpath`` (an older kinlib): ``pattern`` searched in its absolute path,
+    else the file's stem.
+
+    >>> _legacy_id("/class/ann/ps4.ipynb", r"([^/]+)/[^/]+$"), _legacy_id("/class/ann/ps4.ipynb", None)
+    ('ann', 'ps4')
+    """
+    m = re.search(pattern, path) if pattern else None
+    if m:
+        got = m.groupdict().get("id") if "id" in m.re.groupindex else (m.group(1) if m.re.groups else m.group(0))
+        if got:
+            return got
+    return Path(path).stem or path
+
+
+def remembered_root(out: Path) -> list:
+    """The submissions roots remembered in ``out/class.json`` (files graded again alone are read relative to
+    them), most recent first.
+
+    >>> remembered_root(Path("/nonexistent"))
+    []
+    """
+    roots = _read_settings(out).get("roots")
+    return [str(r) for r in roots if isinstance(r, str)] if isinstance(roots, list) else []
 
 
 def _read_settings(out: Path) -> dict:
@@ -353,29 +468,33 @@ def default_overrides(out: Path):
     return None
 
 
-def write_outputs(out: Path, results: list, id_pattern=None, overrides=None, merge: bool = True, log=None) -> list:
+def write_outputs(
+    out: Path, results: list, id_pattern=None, overrides=None, merge: bool = True, log=None, roots=()
+) -> list:
     """Keep ``results`` in the class folder ``out`` and write ``grades.csv``, ``totals.csv`` and
     ``feedback/<key>.md`` from every result kept there; sets each result's ``student_id`` and ``feedback``.
 
-    ``id_pattern``: :func:`kinlib.course.grader.credit.student_id`'s pattern (searched in ``res["path"]``, else the
-    submission name). ``overrides``: a path or a list of :class:`kinlib.course.grader.credit.Override` (default:
+    ``id_pattern``: :func:`kinlib.course.grader.intake.student_id`'s pattern, matched from the start of the
+    submission's path relative to its submissions root (``res["relpath"]``; default: that path without
+    ``.ipynb``); ``roots``: the batch's submissions roots (remembered in ``class.json``). ``overrides``: a path
+    or a list of :class:`kinlib.course.grader.credit.Override` (default:
     ``out/overrides.toml`` or ``out/overrides.csv`` if present). ``merge=False`` forgets the results kept
     before. Returns the overrides' warnings (a ValueError is raised for a bad override, before writing).
 
     >>> import tempfile
-    >>> res = {"submission": "ann/hw 2.ipynb", "notebook": "02_planar", "rows": [
+    >>> res = {"submission": "ann/hw 2.ipynb", "relpath": "ann/hw 2.ipynb", "notebook": "02_planar", "rows": [
     ...     {"submission": "ann/hw 2.ipynb", "notebook": "02_planar", "part": "2.1", "status": "pass",
     ...      "points": 5, "max_points": 5, "message": ""}]}
     >>> with tempfile.TemporaryDirectory() as d:
-    ...     write_outputs(Path(d), [res])
+    ...     write_outputs(Path(d), [res], id_pattern=r"([^/]+)/")
     ...     print(sorted(p.relative_to(d).as_posix() for p in Path(d).rglob("*")))
     ...     print((Path(d) / "grades.csv").read_text(), end="")
     []
-    ['class.json', 'feedback', 'feedback/hw_2--02_planar.md', 'grades.csv', 'results', 'results/hw_2--02_planar.json', 'totals.csv']
+    ['class.json', 'feedback', 'feedback/ann--02_planar.md', 'grades.csv', 'results', 'results/ann--02_planar.json', 'totals.csv']
     student_id,submission,notebook,part,answer,kind,status,points,max_points,message,comment,student_total,student_max,student_pending
-    hw 2,ann/hw 2.ipynb,02_planar,2.1,,auto,pass,5,5,,,5,5,
+    ann,ann/hw 2.ipynb,02_planar,2.1,,auto,pass,5,5,,,5,5,
     >>> Path(res["feedback"]).name
-    'hw_2--02_planar.md'
+    'ann--02_planar.md'
     """
     out = Path(out)
     log = log or (lambda s: None)
@@ -400,7 +519,9 @@ def write_outputs(out: Path, results: list, id_pattern=None, overrides=None, mer
     for p in store.glob("*.json"):
         if p.stem not in table:
             p.unlink()
-    atomic_write(out / "class.json", json.dumps({"id_pattern": pattern}, indent=1) + "\n")
+    known = [getattr(r, "root", r) for r in roots] + remembered_root(out)
+    settings = {"id_pattern": pattern, "roots": list(dict.fromkeys(str(r) for r in known))[:20]}
+    atomic_write(out / "class.json", json.dumps(settings, indent=1, ensure_ascii=False) + "\n")
     totals = student_totals(final)
     fb.mkdir(parents=True, exist_ok=True)
     for res in final:
@@ -413,7 +534,7 @@ def write_outputs(out: Path, results: list, id_pattern=None, overrides=None, mer
     for res in results:
         res["feedback"] = str(fb / f"{result_key(res)}.md")
     for w in warnings:
-        log(f"warning: {w}")
+        log(f"warning: {printable(w)}")
     return warnings
 
 
@@ -425,15 +546,16 @@ def summary_table(results: list, wall: float, t_ref: float, jobs: int) -> str:
     """
     if not results:
         return "kinlib grade: no submissions"
-    w = max(10, min(48, max(len(r["submission"]) for r in results)))
-    nbw = max(8, min(30, max(len(r["notebook"] or "-") for r in results)))
+    names = {id(r): (printable(r["submission"]), printable(r["notebook"] or "-")) for r in results}
+    w = max(10, min(48, max(len(n[0]) for n in names.values())))
+    nbw = max(8, min(30, max(len(n[1]) for n in names.values())))
     lines = [f"{'submission':<{w}}  {'notebook':<{nbw}}  {'score':>9}  pass fail error pending  seconds"]
     for r in results:
         rows = r["rows"]
         t = credit.result_totals(rows)
         c = {s: sum(1 for x in rows if x["status"] == s) for s in ("pass", "fail", "error", "pending")}
         lines.append(
-            f"{r['submission'][:w]:<{w}}  {(r['notebook'] or '-')[:nbw]:<{nbw}}  "
+            f"{names[id(r)][0][:w]:<{w}}  {names[id(r)][1][:nbw]:<{nbw}}  "
             f"{t['points']:>4g}/{t['max_points']:<4g}  "
             f"{c['pass']:>4} {c['fail']:>4} {c['error']:>5} {c['pending']:>7}  {r.get('seconds', 0.0):7.1f}"
         )
@@ -458,4 +580,4 @@ def summary_table(results: list, wall: float, t_ref: float, jobs: int) -> str:
         f"{n} submission(s) in {wall:.1f} s ({t_ref:.1f} s for references), --jobs {jobs}: "
         f"{60 * n / max(graded, 1e-9):.1f} submissions/minute"
     )
-    return "\n".join(lines)
+    return "\n".join(printable(line) for line in lines)

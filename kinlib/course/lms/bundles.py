@@ -41,7 +41,6 @@ so in every result. For testing, the roots are ``--root`` (or ``KINLIB_AUTOGRADE
 from __future__ import annotations
 
 import csv
-import io
 import json
 import os
 import shutil
@@ -509,7 +508,7 @@ def canvas_csv(
                     v = (row.get(col) or "").strip()
                     if v and v != "Points Possible":
                         ident.setdefault(v, {c: (row.get(c) or "").strip() for c in CANVAS_IDENTITY})
-    rows = [CANVAS_IDENTITY + [assignment], ["Points Possible", "", "", "", ""] + [f"{possible:g}"]]
+    rows = [CANVAS_IDENTITY + [assignment], ["Points Possible", "", "", "", ""] + [possible]]
     for sid in sorted(totals):
         t = totals[sid]
         who = ident.get(sid)
@@ -517,14 +516,12 @@ def canvas_csv(
             warnings.append(f"{sid}: not in the roster {roster}; left out")
             continue
         who = who or dict.fromkeys(CANVAS_IDENTITY, "") | {id_column: sid}
-        score = f"{t['points']:g}"
+        score = t["points"]  # a number: report.csv_text keeps it one
         if t["pending"] and not include_pending:
             warnings.append(f"{sid}: pending {' '.join(t['pending'])}: left blank (ungraded in Canvas)")
             score = ""
         rows.append([who[c] for c in CANVAS_IDENTITY] + [score])
-    buf = io.StringIO()
-    csv.writer(buf, lineterminator="\n").writerows(rows)
-    report.atomic_write(Path(out), buf.getvalue())
+    report.atomic_write(Path(out), report.csv_text(rows))  # text cells neutralised (OWASP's rule)
     return warnings
 
 

@@ -1,5 +1,6 @@
 """Where student code runs, seen from the trusted host: the Jupyter kernel of one submission and the
-checker's code sent into it (:mod:`.kernel`), and the bubblewrap sandbox around it (:mod:`.sandbox`).
+checker's code sent into it (:mod:`.kernel`), the bubblewrap sandbox around it (:mod:`.sandbox`), and the
+submission's limits in all: its cgroup and size-limited tmpfs (:mod:`.limits`).
 
 Importing this package imports nothing (import the modules you need).
 """

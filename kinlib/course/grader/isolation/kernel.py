@@ -20,6 +20,7 @@ kills one), with the only code the grader ships into a kernel (:data:`SHIPPED`: 
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import queue
@@ -77,6 +78,8 @@ _LAUNCH = (
     "_lim(resource.RLIMIT_AS, {mem})\n"
     "_lim(resource.RLIMIT_FSIZE, {fsize})\n"
     "_lim(resource.RLIMIT_CORE, 0)\n"
+    "if {nproc}:\n"
+    "    _lim(resource.RLIMIT_NPROC, {nproc})\n"
     "sys.path[:] = [p for p in sys.path if p not in ('', '.')]\n"
     "from ipykernel import kernelapp as app\n"
     "app.launch_new_instance()\n"
@@ -152,6 +155,7 @@ class Kernel:
     startup_timeout: float = 120.0
     grace: float = 3.0
     sandbox: object | None = None  # a kinlib.course.grader.isolation.sandbox.Sandbox, or None (a plain subprocess)
+    enclosure: object | None = None  # a kinlib.course.grader.isolation.limits.Enclosure: cgroup and tmpfs
     proc: subprocess.Popen | None = None
     kc: BlockingKernelClient | None = None
     dead_reason: str = ""
@@ -180,7 +184,11 @@ class Kernel:
         base = os.path.join(self.conn_dir, f"k{os.getpid()}-{Kernel._counter}")
         fn, _ = write_connection_file(fname=base + ".json", transport="ipc", ip=base)
         extra = {"MPLBACKEND": "Agg", "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
-        code = _LAUNCH.format(mem=int(self.mem_bytes), fsize=int(self.fsize_bytes))
+        mem, fsize, nproc = int(self.mem_bytes), int(self.fsize_bytes), 0
+        if self.enclosure is not None:
+            rl = self.enclosure.rlimits()
+            mem, fsize, nproc = int(rl["as"]), int(rl["fsize"]), int(rl.get("nproc", 0))
+        code = _LAUNCH.format(mem=mem, fsize=fsize, nproc=nproc)
         argv = [sys.executable, "-P", "-B", "-c", code, "-f", fn, "--HistoryManager.enabled=False"]
         argv += ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
         fds: tuple = ()
@@ -189,8 +197,11 @@ class Kernel:
             rfd, wfd = os.pipe()
             fds = (wfd,)
             env = self.sandbox.environment(extra)
+            sb = self.sandbox
+            if self.enclosure is not None and self.enclosure.tmp_dir:
+                sb = dataclasses.replace(sb, tmp_dir=self.enclosure.tmp_dir, shm_dir=self.enclosure.shm_dir)
             try:
-                argv = self.sandbox.command(argv, cwd=self.cwd, rw=[self.conn_dir, self.cwd], env=env, info_fd=wfd)
+                argv = sb.command(argv, cwd=self.cwd, rw=[self.conn_dir, self.cwd], env=env, info_fd=wfd)
             except Exception:
                 os.close(rfd)
                 os.close(wfd)
@@ -198,6 +209,8 @@ class Kernel:
         else:
             env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
             env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+        if self.enclosure is not None:
+            argv = self.enclosure.wrap(argv)  # every process the kernel starts is in the submission's cgroup
         try:
             self.proc = subprocess.Popen(
                 argv,
@@ -435,8 +448,10 @@ class NotebookRun:
         stash_after: dict | None = None,
         snapshot: bool = True,
         sandbox=None,
+        enclosure=None,
     ):
         self.cells = cells
+        self.enclosure = enclosure  # kinlib.course.grader.isolation.limits.Enclosure: the submission's limits, or None
         self.cwd, self.tmp = cwd, tmp
         self.cell_timeout, self.total = cell_timeout, total_timeout
         self.stash_after = stash_after or {}
@@ -452,7 +467,7 @@ class NotebookRun:
         self.t0 = time.monotonic()
 
     def _start(self):
-        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp, sandbox=self.sandbox)
+        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp, sandbox=self.sandbox, enclosure=self.enclosure)
         try:
             self.kernel.start()
         finally:
@@ -488,6 +503,8 @@ class NotebookRun:
                 else:
                     r = self.kernel.run(src, timeout=min(self.cell_timeout, left), index=i)
                     self.results[i] = r
+                    if self.enclosure is not None:
+                        self.enclosure.check_disk()  # a file written, then deleted, still reached the limit
                     if r.status in ("died", "timeout") and not self.kernel.alive():
                         died_at = i
                         break

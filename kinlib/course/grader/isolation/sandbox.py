@@ -12,8 +12,11 @@ Each student kernel is started as ``bwrap <options> python -P -B -c <launcher> .
   and the ``kinlib`` package folder (not the repository around it: no ``notebooks/``, ``build/``, tests,
   reference cache, grader secret, output folder or the instructor's home);
 * a **private writable scratch**: a fresh tmpfs on ``/tmp`` (HOME, IPython's and matplotlib's folders
-  are in it) and, read-write, the one folder of this submission (the submission copy as the working
-  directory, the kernel's connection file, its unix sockets and the result files the grader reads).
+  are in it), a small ``/dev/shm`` (``/dev`` itself read-only) and, read-write, the one folder of this
+  submission (the submission copy as the working directory, the kernel's connection file, its unix sockets
+  and the result files the grader reads). With ``tmp_dir``/``shm_dir`` (:class:`kinlib.course.grader.isolation.limits.Enclosure`)
+  ``/tmp`` and ``/dev/shm`` are folders of the submission's one size-limited tmpfs, so that everything it
+  writes counts against one limit.
 
 The kernel talks to the grader over ZMQ's ``ipc`` transport: unix sockets in that bound folder, which a
 network namespace does not cut (loopback TCP would be). Measured in this project's container (Debian 12,
@@ -118,7 +121,10 @@ class Sandbox:
     """
 
     hidden: list = field(default_factory=list)
-    tmpfs_bytes: int = 512 * 2**20
+    tmpfs_bytes: int = 512 * 2**20  # the private /tmp, when ``tmp_dir`` is not given
+    shm_bytes: int = 64 * 2**20  # the private /dev/shm, when ``shm_dir`` is not given
+    tmp_dir: str = ""  # a host folder to be the sandbox's /tmp (on the submission's size-limited tmpfs)
+    shm_dir: str = ""  # a host folder to be the sandbox's /dev/shm (idem)
 
     def command(self, argv: list, cwd: str, rw: list, env: dict, info_fd: int | None = None) -> list:
         """The bwrap command line running ``argv`` in ``cwd`` with only ``rw`` writable and env exactly ``env``."""
@@ -130,9 +136,19 @@ class Sandbox:
                     raise SandboxUnavailable(f"the sandbox would expose {h} (inside {b}); move it elsewhere")
         cmd = [shutil.which("bwrap") or "bwrap", "--unshare-all", "--die-with-parent", "--new-session"]
         cmd += ["--cap-drop", "ALL", "--proc", "/proc", "--dev", "/dev"]
+        # a small /dev/shm of its own, then /dev read-only (bwrap's /dev is otherwise a writable tmpfs as large
+        # as the host's memory allows)
+        if self.shm_dir:
+            cmd += ["--bind", _real(self.shm_dir), "/dev/shm"]
+        else:
+            cmd += ["--size", str(int(self.shm_bytes)), "--tmpfs", "/dev/shm"]
+        cmd += ["--remount-ro", "/dev"]
         # the private /tmp first: binds after it land on top of it (an environment or checkout that lives under
         # the host's /tmp, e.g. a fresh clone in mktemp -d, stays visible instead of being covered by the tmpfs)
-        cmd += ["--size", str(int(self.tmpfs_bytes)), "--tmpfs", "/tmp", "--dir", "/tmp/home"]
+        if self.tmp_dir:
+            cmd += ["--bind", _real(self.tmp_dir), "/tmp", "--dir", "/tmp/home"]
+        else:
+            cmd += ["--size", str(int(self.tmpfs_bytes)), "--tmpfs", "/tmp", "--dir", "/tmp/home"]
         cmd += binds
         for d in rw:
             cmd += ["--bind", _real(d), _real(d)]
