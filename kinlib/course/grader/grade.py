@@ -198,12 +198,14 @@ def grade_submission(
     display_name: str | None = None,
     sandbox=True,
     secret=None,
+    user=None,
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises).
 
     ``sandbox``: a :class:`~kinlib.course.grader.isolation.sandbox.Sandbox`, True (the default one) or False (no sandbox:
     said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
-    :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points.
+    :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points; ``user``:
+    without the sandbox, a :class:`~kinlib.course.grader.isolation.unprivileged.StudentUser` the kernel runs as.
 
     A file that is not one of the notebooks gets one ``error`` row, without starting a kernel:
 
@@ -309,7 +311,7 @@ def grade_submission(
         with open(os.path.join(scratch, Path(path).name), "wb") as f:
             f.write(data)
         run = NotebookRun(
-            code, scratch, tmp, cell_timeout, total_timeout, stash_after=stash_after, sandbox=sandbox or None
+            code, scratch, tmp, cell_timeout, total_timeout, stash_after=stash_after, sandbox=sandbox or None, user=user
         )
         rows, exact = _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         out["restarts"] = run.restarts
