@@ -559,3 +559,61 @@ def test_the_platform_commands(tmp_path, capsys):
     args = ["--notebooks", str(tmp_path), "--secret", str(tmp_path / "s")]
     assert main(["grade", "prairielearn", "--out", str(tmp_path / "pl"), *args]) == 2
     assert "no solution notebooks" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------------------------- the parts, quickly
+
+
+def test_requirements_come_from_what_the_notebooks_and_kinlib_import(tmp_path):
+    from kinlib.course.lms import environment
+
+    nbs = sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb"))
+    reqs, modules = environment.requirements(nbs, NOTEBOOKS.parent / "environment.txt")
+    names = {r.split("==")[0].lower().replace("_", "-") for r in reqs}
+    # what the workbooks import (modern_robotics was the one missing), what kinlib needs, and the kernel
+    assert {"modern-robotics", "numpy", "sympy", "matplotlib", "jupyter-client", "ipykernel"} <= names
+    assert "playwright" not in names and "jupyterlite-core" not in names  # handout tools stay on the instructor's side
+    assert all("==" in r for r in reqs) and "modern_robotics" in modules
+    pins = dict(line.split("==") for line in (NOTEBOOKS.parent / "environment.txt").read_text().split() if "==" in line)
+    assert all(pins.get(r.split("==")[0], r.split("==")[1]) == r.split("==")[1] for r in reqs)  # environment.txt's
+    nb = wf.solution()
+    nb["cells"].append(
+        {"cell_type": "code", "metadata": {}, "source": "import surely_not_a_module_kinlib", "outputs": []}
+    )
+    (tmp_path / "x.ipynb").write_text(json.dumps(nb))
+    with pytest.raises(ValueError, match="surely_not_a_module_kinlib .imported by x.ipynb. is not installed"):
+        environment.requirements([tmp_path / "x.ipynb"])
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="switching users needs root")
+def test_every_process_of_the_student_user_is_ended(tmp_path):
+    """Processes of an unused uid (no account needed: Popen switches by number), one a daemon in a session of its own
+    that keeps forking: end_all leaves none, and give() makes a folder that user's alone."""
+    from kinlib.course.grader.isolation.unprivileged import StudentUser
+
+    uid = 61000 + int.from_bytes(os.urandom(2), "big") % 3000
+    user = StudentUser("test-student", uid, uid)
+    assert user.processes() == []
+    forker = (
+        "import os, subprocess, sys, time\n"
+        "subprocess.Popen([sys.executable, '-c', 'import os, time\\nwhile True:\\n    if os.fork() == 0: time.sleep(60)\\n"
+        "    time.sleep(0.05)'], start_new_session=True)\n"
+        "time.sleep(60)\n"
+    )
+    procs = [subprocess.Popen(["/usr/bin/python3", "-c", forker], cwd="/", **user.popen_kwargs()) for _ in range(2)]
+    try:
+        deadline = 0
+        while len(user.processes()) < 6 and deadline < 200:
+            deadline += 1
+            subprocess.run(["sleep", "0.05"])
+        assert len(user.processes()) >= 6
+        assert user.end_all() == [] and user.processes() == []
+    finally:
+        for p in procs:
+            p.kill()
+            p.wait()
+    (tmp_path / "w" / "sub").mkdir(parents=True)
+    (tmp_path / "w" / "sub" / "f").write_text("x")
+    user.give(tmp_path / "w")
+    assert {(p.stat().st_uid, p.stat().st_gid) for p in [tmp_path / "w", *(tmp_path / "w").rglob("*")]} == {(uid, uid)}
+    assert (tmp_path / "w").stat().st_mode & 0o777 == 0o700

@@ -6,18 +6,25 @@ Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.g
 * ``kinlib grade gradescope --out autograder.zip`` writes a Gradescope autograder (Autograder
   Specifications, https://gradescope-autograders.readthedocs.io/en/latest/specs/): ``setup.sh`` and
   ``run_autograder`` at the root of the zip, plus the bundle: a copy of the ``kinlib`` package
-  (``kinlib-src/``), its pins (``constraints.txt``, the repository's ``environment.txt``), the reference
-  answers as data (``references.json``, computed here by the instructor's grader), a grader secret derived
-  for this zip (never the instructor's own) and ``config.json``. Gradescope runs each submission in its own
+  (``kinlib-src/``), what the container must install (``requirements.txt``: the distributions of every module
+  the notebooks and kinlib's grading code import, read from that code by :mod:`kinlib.course.lms.environment`,
+  pinned by ``constraints.txt``, the repository's ``environment.txt``; ``imports.txt``: the modules
+  ``setup.sh`` checks), the reference answers as data (``references.json``, computed here by the instructor's
+  grader), a grader secret derived for this zip (never the instructor's own) and ``config.json``.
+  ``setup.sh`` (run once, as root, when Gradescope builds the image) makes ``/autograder/venv`` and the
+  unprivileged user ``kinlib-student``. Gradescope runs each submission in its own
   container: ``/autograder/submission/`` (the student's files), ``/autograder/source/`` (the zip),
   ``/autograder/results/results.json`` (written by ``run_autograder``: ``score``, ``output``,
   ``execution_time``, ``stdout_visibility`` and ``tests`` [{``name``, ``number``, ``score``, ``max_score``,
   ``status``, ``output``, ``visibility``}], one test per automatically graded part; visibility is one of
   ``visible``, ``hidden``, ``after_due_date``, ``after_published``). Use a Gradescope base image with
   Python ≥ 3.11 (Ubuntu 24.04).
-* ``kinlib grade prairielearn --out DIR`` writes ``DIR/serverFilesCourse/kinlib_grader/`` (the same bundle
-  and ``run.sh``) and ``DIR/info-externalGradingOptions.json`` (External Grading,
-  https://prairielearn.readthedocs.io/en/latest/externalGrading/): the student's files are in
+* ``kinlib grade prairielearn --out DIR [--image NAME]`` writes ``DIR/serverFilesCourse/kinlib_grader/``
+  (``run.sh``, the references, the key, ``config.json``), ``DIR/image/`` (the grading image: ``Dockerfile``,
+  the same ``setup.sh``, requirements and kinlib; no answers and no key, since images are public on Docker Hub)
+  and ``DIR/info-externalGradingOptions.json`` (External Grading,
+  https://prairielearn.readthedocs.io/en/latest/externalGrading/), which names the image: build and push it
+  (``docker build -t NAME DIR/image``). The student's files are in
   ``/grade/student/``, the results go to ``/grade/results/results.json`` (created by ``run.sh``):
   ``gradable``, ``score`` in [0, 1], ``message``, ``output``, ``tests`` [{``name``, ``description``,
   ``points``, ``max_points``, ``message``, ``output``}]; a file that is not a notebook is ``gradable:
@@ -33,8 +40,12 @@ Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.g
 
 Work graded by hand (``manual`` items, e.g. 5.2's drawing) is not part of the platforms' automatic score:
 the results' output lists it; grade it with the platform's own manual grading. Within the container the
-student's kernel runs in the sandbox when bubblewrap can run there; a zip built with ``--no-sandbox`` says
-so in every result. For testing, the roots are ``--root`` (or ``KINLIB_AUTOGRADER_ROOT`` /
+student's kernel runs in the sandbox when the bundle asks for it and bubblewrap can run there. Otherwise (a zip
+built with ``--no-sandbox``, or Docker's default seccomp profile blocking bubblewrap) it runs as the unprivileged
+user ``kinlib-student`` (:mod:`kinlib.course.grader.isolation.unprivileged`): before any kernel starts, the
+bundle (key, references), the submission and the results folder are made root's alone and checked unreadable by
+that user; after each kernel and before the results are written every process of that user is ended; every
+result says how the code ran. For testing, the roots are ``--root`` (or ``KINLIB_AUTOGRADER_ROOT`` /
 ``KINLIB_GRADE_ROOT``), default ``/autograder`` and ``/grade``.
 """
 
@@ -57,6 +68,7 @@ from pathlib import Path
 from ..grader import credit, report
 from ..grader.isolation import unprivileged
 from . import environment
+from .scripts import DOCKERFILE, GS_VENV, PL_IMAGE, PL_VENV, RUN_AUTOGRADER, RUN_PL, SETUP_SH
 
 __all__ = [
     "VISIBILITIES",
@@ -72,81 +84,6 @@ __all__ = [
 
 VISIBILITIES = ("visible", "hidden", "after_due_date", "after_published")
 _ROOTS = {"gradescope": ("KINLIB_AUTOGRADER_ROOT", "/autograder"), "prairielearn": ("KINLIB_GRADE_ROOT", "/grade")}
-
-SETUP_SH = r"""#!/usr/bin/env bash
-# Builds the grading environment once, as root: Gradescope runs it when it builds the autograder's image,
-# PrairieLearn's image runs it from its Dockerfile. It makes a Python venv with exactly what the workbooks and the
-# grader import (requirements.txt, pinned by constraints.txt; derived from the code by kinlib.course.lms.environment)
-# plus this bundle's own copy of kinlib, and the unprivileged user the student's kernels run as where bubblewrap
-# cannot (Docker's default seccomp profile blocks its namespaces).
-set -euo pipefail
-HERE="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
-VENV="${KINLIB_VENV:-@VENV@}"
-STUDENT="${KINLIB_STUDENT_USER:-@USER@}"
-PY="${KINLIB_SETUP_PYTHON:-python3}"
-need=()
-"$PY" -c 'import sys, venv, ensurepip; sys.exit(sys.version_info < (3, 11))' 2>/dev/null || need+=(python3 python3-venv)
-command -v useradd >/dev/null || need+=(passwd)
-[ "@SANDBOX@" = 1 ] && ! command -v bwrap >/dev/null && need+=(bubblewrap)
-if [ "${#need[@]}" -gt 0 ]; then
-  export DEBIAN_FRONTEND=noninteractive
-  apt-get update -qq
-  apt-get install -y -qq --no-install-recommends "${need[@]}"
-  PY=python3
-fi
-"$PY" -c 'import sys; sys.exit(sys.version_info < (3, 11))' || {
-  echo "kinlib needs Python >= 3.11: choose a base image with Ubuntu 24.04 (or python:3.11)" >&2; exit 1; }
-"$PY" -m venv "$VENV"
-"$VENV/bin/python" -m pip install -q --disable-pip-version-check -r "$HERE/requirements.txt" -c "$HERE/constraints.txt"
-"$VENV/bin/python" -m pip install -q --disable-pip-version-check --no-deps "$HERE/kinlib-src"
-# every module the workbooks and the grader import must import now, not in a student's grade
-"$VENV/bin/python" -I -c 'import importlib, sys; [importlib.import_module(m) for m in sys.argv[1:]]' \
-  kinlib $(cat "$HERE/imports.txt")
-id -u "$STUDENT" >/dev/null 2>&1 || useradd --system --user-group --no-create-home --home-dir /nonexistent \
-  --shell /usr/sbin/nologin "$STUDENT"
-echo "kinlib grading environment ready: $VENV (student user $STUDENT)"
-"""
-
-RUN_AUTOGRADER = r"""#!/usr/bin/env bash
-# Gradescope runs this for every submission, as root: /autograder/submission -> /autograder/results/results.json
-ROOT="${KINLIB_AUTOGRADER_ROOT:-/autograder}"
-PY="${KINLIB_PYTHON:-$ROOT/venv/bin/python}"
-cd "$ROOT"
-if [ ! -x "$PY" ]; then
-  mkdir -p "$ROOT/results"
-  echo '{"score": 0, "output": "the autograder is broken: its environment is missing (setup.sh did not run)", "tests": []}' \
-    > "$ROOT/results/results.json"
-  exit 1
-fi
-exec "$PY" -I -m kinlib.course.lms.bundles run gradescope --root "$ROOT" --bundle "$ROOT/source"
-"""
-
-RUN_PL = r"""#!/usr/bin/env bash
-# PrairieLearn's entrypoint, as root in the course's image (image/Dockerfile): /grade/student -> /grade/results/results.json
-ROOT="${KINLIB_GRADE_ROOT:-/grade}"
-HERE="$ROOT/serverFilesCourse/kinlib_grader"
-PY="${KINLIB_PYTHON:-@VENV@/bin/python}"
-mkdir -p "$ROOT/results"
-if [ ! -x "$PY" ]; then
-  echo '{"gradable": false, "format_errors": ["the grader image has no kinlib environment: build it from image/Dockerfile and name it in externalGradingOptions.image"], "tests": []}' \
-    > "$ROOT/results/results.json"
-  exit 1
-fi
-exec "$PY" -I -m kinlib.course.lms.bundles run prairielearn --root "$ROOT" --bundle "$HERE"
-"""
-
-DOCKERFILE = """# PrairieLearn's grading image for this bundle (External Grading runs a course's own image from Docker Hub):
-#   docker build -t @IMAGE@ . && docker push @IMAGE@      (in this folder; then sync the course's Docker images)
-# This folder holds no answers and no key: those stay in serverFilesCourse/kinlib_grader/.
-FROM python:3.11-slim-bookworm
-COPY . /opt/kinlib/image
-RUN KINLIB_VENV=@VENV@ bash /opt/kinlib/image/setup.sh && rm -rf /root/.cache
-"""
-
-GS_VENV = "/autograder/venv"
-PL_VENV = "/opt/kinlib/venv"
-PL_IMAGE = "kinlib/grader:{version}"  # a placeholder name: push the image to your own Docker Hub account
-
 
 # ----------------------------------------------------------------------------------------- the bundle
 
