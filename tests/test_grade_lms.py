@@ -424,6 +424,7 @@ def _check_after(r, mark):
     assert "ALIVE" not in r.stdout, r.stdout  # no process of the student's user outlived the entry point
     leaks = [line for line in r.stdout.splitlines() if line.startswith("LEAK")]
     assert leaks and all("daemon started" in x for x in leaks), leaks  # it ran, it read nothing, rewrote nothing
+    assert all(" as uid 0" not in x for x in leaks), leaks  # as the student's user, never root
 
 
 @pytest.mark.slow
@@ -477,7 +478,12 @@ def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
     attack["cells"].append(
         _code_cell(_hostile(mark, "/autograder/results/results.json", "/autograder/source/grader-secret"))
     )
+    # ... graded by a bundle that asks for the sandbox, in a container where bubblewrap cannot run (as Docker's
+    # seccomp would have it): the kernels run as the student's user all the same
+    cfg_path = tmp_path / "ag" / "source" / "config.json"
+    cfg_path.write_text(json.dumps(json.loads(cfg_path.read_text()) | {"sandbox": True}))
     r, d = grade({"wrong": bad}, AFTER)
+    assert f"unprivileged user {STUDENT}" in d["output"], d["output"]
     mine = d["tests"]
     assert 0 < d["score"] < sum(t["max_score"] for t in mine) and mine[0]["score"] == 0, mine
     r, d = grade({"hostile": attack}, AFTER)

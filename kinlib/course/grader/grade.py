@@ -228,7 +228,9 @@ def grade_submission(
     out["sandbox"] = sandbox is not False
     out["path"] = str(Path(path).absolute())  # the student id is read from it (credit.student_id)
     if sandbox is False:
-        out["notes"] = [NO_SANDBOX_NOTE]
+        out["notes"] = [
+            NO_SANDBOX_NOTE if user is None else f"graded without bubblewrap, as the unprivileged user {user.name}"
+        ]
     try:
         data = Path(path).read_bytes()
     except OSError as exc:
