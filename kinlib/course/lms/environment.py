@@ -34,7 +34,14 @@ _SKIP = ("kinlib", "__future__")
 
 
 def code_imports(source: str) -> set[str]:
-    """Top-level module names imported by ``source`` (Python; lines starting with ``%`` or ``!`` skipped)."""
+    """Top-level module names imported by ``source`` (Python; lines starting with ``%`` or ``!`` skipped; code
+    that does not parse imports nothing).
+
+    >>> sorted(code_imports("def f():\\n    from mpl_toolkits.mplot3d import Axes3D\\n!pip install x"))
+    ['mpl_toolkits']
+    >>> code_imports("this is not Python")
+    set()
+    """
     text = "\n".join(line for line in source.splitlines() if not line.lstrip().startswith(("%", "!")))
     try:
         tree = ast.parse(text)
@@ -50,7 +57,15 @@ def code_imports(source: str) -> set[str]:
 
 
 def notebook_imports(paths) -> dict[str, list[str]]:
-    """{module: [notebook file names]} for the third-party modules the notebooks ``paths`` import."""
+    """{module: [notebook file names]} for the third-party modules the notebooks ``paths`` import.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     p = Path(d) / "05.ipynb"
+    ...     _ = p.write_text(json.dumps({"cells": [{"cell_type": "code", "source": ["import sympy as sp\\n", "import os"]}]}))
+    ...     notebook_imports([p])
+    {'sympy': ['05.ipynb']}
+    """
     out: dict = {}
     for p in paths:
         nb = json.loads(Path(p).read_text(encoding="utf-8"))
@@ -63,7 +78,12 @@ def notebook_imports(paths) -> dict[str, list[str]]:
 
 
 def kinlib_imports() -> dict[str, list[str]]:
-    """{module: [kinlib files]} for the third-party modules kinlib's own code imports, publish/ excluded."""
+    """{module: [kinlib files]} for the third-party modules kinlib's own code imports, publish/ excluded.
+
+    >>> found = kinlib_imports()
+    >>> "jupyter_client" in found and "numpy" in found, "playwright" in found
+    (True, False)
+    """
     import kinlib
 
     root = Path(kinlib.__file__).resolve().parent
@@ -99,7 +119,13 @@ def _norm(name: str) -> str:
 def requirements(notebooks, constraints: Path | None = None) -> tuple[list[str], list[str]]:
     """(requirement lines ``name==version``, module names to check) for grading ``notebooks`` (paths).
 
-    A module no installed distribution provides raises ValueError naming who imports it.
+    A module no installed distribution provides raises ValueError naming who imports it (tests/test_grade_lms.py);
+    the lesson notebooks need modern_robotics (their independent check) and the grader's kernel:
+
+    >>> nbs = sorted(Path(__file__).resolve().parents[3].joinpath("notebooks").glob("0*.ipynb"))
+    >>> reqs, modules = requirements(nbs)
+    >>> "modern_robotics" in modules, any(r.startswith("ipykernel==") for r in reqs)
+    (True, True)
     """
     wanted: dict = {}
     for src in (notebook_imports(notebooks), kinlib_imports(), {k: ["the grader's kernel"] for k in KERNEL}):
