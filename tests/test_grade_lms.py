@@ -12,11 +12,10 @@ The validators below are written from the platforms' documentation, not from kin
   is required, a number in [0, 1]; when not, ``format_errors`` (a string or a list of strings); tests have
   ``name``, ``description``, ``points``, ``max_points``, ``message``, ``output`` (and ``images``).
 
-The simulations run the real entry points (``run_autograder``, ``run.sh``) inside bubblewrap with a scratch
-folder bound at ``/autograder`` or ``/grade``, the rest of the system read-only, a private ``/tmp``. The host's
-``/proc`` is bound (not a new one) so that the grader's own sandbox can nest inside the simulated container
-(bubblewrap cannot mount a fresh procfs inside another bubblewrap's PID namespace here); the PrairieLearn
-simulation grades with the sandbox on, the Gradescope one with a ``--no-sandbox`` bundle.
+The bundles are tested where they run (see "where they run" below): each set up by its own ``setup.sh`` in an
+empty simulated container (never the development environment), then its own entry point (``run_autograder``,
+``run.sh``) on the six lesson notebooks answered, untouched, partly wrong, and hostile (reading the key, leaving a
+daemon that rewrites results.json), the student's kernels running as the unprivileged user.
 """
 
 from __future__ import annotations
