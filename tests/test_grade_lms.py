@@ -12,11 +12,10 @@ The validators below are written from the platforms' documentation, not from kin
   is required, a number in [0, 1]; when not, ``format_errors`` (a string or a list of strings); tests have
   ``name``, ``description``, ``points``, ``max_points``, ``message``, ``output`` (and ``images``).
 
-The simulations run the real entry points (``run_autograder``, ``run.sh``) inside bubblewrap with a scratch
-folder bound at ``/autograder`` or ``/grade``, the rest of the system read-only, a private ``/tmp``. The host's
-``/proc`` is bound (not a new one) so that the grader's own sandbox can nest inside the simulated container
-(bubblewrap cannot mount a fresh procfs inside another bubblewrap's PID namespace here); the PrairieLearn
-simulation grades with the sandbox on, the Gradescope one with a ``--no-sandbox`` bundle.
+The bundles are tested where they run (see "where they run" below): each set up by its own ``setup.sh`` in an
+empty simulated container (never the development environment), then its own entry point (``run_autograder``,
+``run.sh``) on the six lesson notebooks answered, untouched, partly wrong, and hostile (reading the key, leaving a
+daemon that rewrites results.json), the student's kernels running as the unprivileged user.
 """
 
 from __future__ import annotations
@@ -25,7 +24,6 @@ import json
 import os
 import shutil
 import subprocess
-import sys
 import zipfile
 from numbers import Real
 from pathlib import Path
@@ -253,122 +251,299 @@ def test_canvas_csv_points_possible_pending_and_roster(tmp_path):
     assert any("222: not in the roster" in x for x in w)
 
 
-# ----------------------------------------------------------------------------------------- simulations
+# ----------------------------------------------------------------------------------------- where they run
+#
+# Each bundle is set up by its own setup.sh in an EMPTY environment and run by its own entry point, in a simulated
+# container: bubblewrap, as root, with the system read-only (as an image would be), a writable copy of /etc (setup.sh
+# creates the student's user there), a PID namespace of its own (as a container has: "every process of the student's
+# user" means those of this container), a private /tmp, and a scratch folder at /autograder (Gradescope) or at
+# /grade and /opt/kinlib (PrairieLearn: the grading image's folder). Nothing of the development environment is
+# visible to the bundle but the system Python it builds its venv from; pip downloads (PyPI, this machine's pip
+# configuration) are cached in PIP_CACHE_DIR (default ~/.cache/pip) across runs. The bundles are built without
+# the sandbox (Docker's default seccomp blocks bubblewrap), so the student's kernels run as the unprivileged user.
+
+NOTEBOOKS = Path(__file__).resolve().parent.parent / "notebooks"
+STUDENT = "kinlib-student"
+SIM_PATH = "/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin"
 
 
 def _bwrap_works() -> bool:
-    if not shutil.which("bwrap"):
+    if not shutil.which("bwrap") or os.geteuid() != 0:
         return False
-    r = subprocess.run(["bwrap", *_system_binds(), "--dev", "/dev", "--proc", "/proc", "true"], capture_output=True)
+    r = subprocess.run(
+        ["bwrap", "--ro-bind", "/", "/", "--unshare-pid", "--proc", "/proc", "true"], capture_output=True
+    )
     return r.returncode == 0
 
 
-def _system_binds() -> list[str]:
-    """Every top-level folder read-only (as a container image would be), except those the sandbox makes."""
-    opts = []
-    for d in sorted(os.listdir("/")):
-        p = "/" + d
-        if d in ("proc", "dev", "tmp", "sys", "autograder", "grade") or not os.path.exists(p):
+needs_bwrap = pytest.mark.skipif(not _bwrap_works(), reason="bubblewrap cannot run here as root")
+
+
+def _pip_cache() -> str:
+    d = os.environ.get("PIP_CACHE_DIR") or os.path.expanduser("~/.cache/pip")
+    os.makedirs(d, exist_ok=True)
+    return os.path.realpath(d)
+
+
+class Container:
+    """A simulated platform container (see above) over ``scratch``; ``mounts`` = {container path: scratch subfolder}."""
+
+    def __init__(self, scratch: Path, mounts: dict):
+        self.scratch, self.mounts = scratch, mounts
+        shutil.copytree("/etc", scratch / "etc", symlinks=True, ignore_dangling_symlinks=True)
+        for sub in mounts.values():
+            (scratch / sub).mkdir(parents=True, exist_ok=True)
+
+    def run(self, script: str, timeout: float = 900) -> subprocess.CompletedProcess:
+        cmd = ["bwrap"]
+        for d in sorted(os.listdir("/")):
+            p = "/" + d
+            if d in ("proc", "dev", "tmp", "sys", "etc", "opt", "autograder", "grade") or not os.path.exists(p):
+                continue
+            cmd += ["--symlink", os.readlink(p), p] if os.path.islink(p) else ["--ro-bind", p, p]
+        cmd += ["--bind", str(self.scratch / "etc"), "/etc", "--tmpfs", "/opt"]
+        for d in sorted(os.listdir("/opt")):  # pip's local indexes (this machine's pip.conf) stay visible
+            cmd += ["--ro-bind", f"/opt/{d}", f"/opt/{d}"]
+        cmd += ["--dev", "/dev", "--unshare-pid", "--proc", "/proc", "--perms", "1777", "--tmpfs", "/tmp"]
+        cmd += ["--bind", _pip_cache(), _pip_cache()]
+        for inside, sub in self.mounts.items():
+            cmd += ["--bind", str(self.scratch / sub), inside]
+        cmd += ["--die-with-parent", "--clearenv", "--chdir", "/"]
+        env = {"PATH": SIM_PATH, "HOME": "/tmp", "LANG": "C.UTF-8", "PIP_CACHE_DIR": _pip_cache()}
+        for k, v in env.items():
+            cmd += ["--setenv", k, v]
+        return subprocess.run([*cmd, "bash", "-c", script], capture_output=True, text=True, timeout=timeout)
+
+
+#: after the entry point: every process of the student's user still alive in the container, and what leaked
+AFTER = f"""
+rc=$?
+echo "EXIT $rc"
+uid=$(id -u {STUDENT})
+for d in /proc/[0-9]*; do
+  if [ "$(stat -c %u "$d" 2>/dev/null)" = "$uid" ] && ! grep -q '^State:.*Z' "$d/status" 2>/dev/null; then
+    echo "ALIVE ${{d#/proc/}} $(tr '\\0' ' ' < "$d/cmdline")"
+  fi
+done
+cat /tmp/kinlib-leak-* 2>/dev/null | sed 's/^/LEAK /'
+exit 0
+"""
+
+
+def untouched(nb: dict, keep: tuple = ()) -> dict:
+    """The workbook a student is given (as make handouts makes it, nothing run): each solution code cell a stub
+    naming its answers, no check cells; parts in ``keep`` keep the solution's code (a student who answered them)."""
+    nb = json.loads(json.dumps(nb))
+    cells = []
+    for c in nb["cells"]:
+        tags = c["metadata"].get("tags", [])
+        if "check" in tags:
             continue
-        opts += ["--symlink", os.readlink(p), p] if os.path.islink(p) else ["--ro-bind", p, p]
-    return opts
+        if c["cell_type"] == "code":
+            c["outputs"], c["execution_count"] = [], None
+            meta = c["metadata"].get("kinlib", {})
+            if "solution" in tags and meta.get("part") not in keep and keep != "all":
+                names = meta.get("answers", [])
+                c["source"] = "\n".join(f"{n} = ...  # TODO" for n in names) or "# your work here"
+        cells.append(c)
+    nb["cells"] = cells
+    return nb
 
 
-def _simulate(mount: str, scratch: Path, entry: str) -> subprocess.CompletedProcess:
-    cmd = [
-        "bwrap", *_system_binds(),
-        "--dev", "/dev", "--bind", "/proc", "/proc", "--tmpfs", "/tmp",
-        # the Python environment (the platform's image has its packages installed): bound after the private
-        # /tmp, so a checkout in a mktemp folder (CI's fresh clone) stays visible
-        "--ro-bind", os.path.realpath(sys.prefix), os.path.realpath(sys.prefix),
-        "--bind", str(scratch), mount,
-        "--die-with-parent",
-        "--setenv", "HOME", "/tmp", "--setenv", "KINLIB_PYTHON", sys.executable,
-        "--chdir", mount,
-        entry,
-    ]  # fmt: skip
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+def _parts(nb: dict) -> list[str]:
+    return list(
+        dict.fromkeys(
+            c["metadata"]["kinlib"]["part"]
+            for c in nb["cells"]
+            if "solution" in c["metadata"].get("tags", []) and c["metadata"].get("kinlib", {}).get("answers")
+        )
+    )
 
 
-needs_bwrap = pytest.mark.skipif(not _bwrap_works(), reason="bubblewrap cannot run here")
+def _hostile(mark: str, results: str, key: str) -> str:
+    """A student's last cell: read the key and the references, and leave a daemon that keeps rewriting results.json
+    with full marks and reports what it could reach (in /tmp, which the check after the run reads)."""
+    daemon = (
+        "import json, os, time\n"
+        f"leak = '/tmp/kinlib-leak-{mark}'\n"
+        "def note(s):\n"
+        "    with open(leak, 'a') as f: f.write(s + '\\n')\n"
+        "note('daemon started as uid %d' % os.getuid())\n"
+        "t = time.time()\n"
+        "while time.time() - t < 600:\n"
+        "    try:\n"
+        f"        with open({results!r}, 'w') as f: json.dump({{'score': 1e6, 'gradable': True, 'tests': []}}, f)\n"
+        "        note('rewrote results.json')\n"
+        "    except OSError:\n"
+        "        pass\n"
+        "    time.sleep(0.2)\n"
+    )
+    return (
+        "import os, subprocess, sys\n"
+        f"for p in [{key!r}, {key.replace('grader-secret', 'references.json')!r}]:\n"
+        "    try:\n"
+        f"        open('/tmp/kinlib-leak-{mark}', 'a').write('read ' + p + ': ' + open(p).read()[:40] + '\\n')\n"
+        "    except OSError:\n"
+        "        pass\n"
+        f"subprocess.Popen([sys.executable, '-c', {daemon!r}], start_new_session=True, stdin=subprocess.DEVNULL,\n"
+        "                 stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)\n"
+    )
 
 
 @pytest.fixture(scope="module")
-def fixture_notebooks(tmp_path_factory):
-    d = tmp_path_factory.mktemp("nbs")
-    wf.write_solution(d)
-    return d
+def six(tmp_path_factory):
+    """The six lesson notebooks (one consistent copy while others edit them), their references computed once."""
+    if len(sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb"))) != 6:
+        pytest.skip("the six lesson notebooks are not all there")
+    d = tmp_path_factory.mktemp("six")
+    nbs = d / "notebooks"
+    nbs.mkdir()
+    for p in sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb")):
+        shutil.copy(p, nbs / p.name)
+    (d / "secret").write_text("s" * 64 + "\n")
+    (d / "secret").chmod(0o600)
+    kw = dict(notebooks=nbs, cache=d / "cache", secret=d / "secret", sandbox=False, timeout=240, cell_timeout=120)
+    return {"dir": d, "kw": kw, "nbs": {p.stem: json.loads(p.read_text()) for p in sorted(nbs.glob("*.ipynb"))}}
 
 
-def _sandbox_ok() -> bool:
-    try:
-        from kinlib.course.grader.isolation import sandbox
+def _write_submission(folder: Path, notebooks: dict):
+    if folder.exists():
+        shutil.rmtree(folder)
+    folder.mkdir(parents=True)
+    for name, nb in notebooks.items():
+        (folder / f"{name}.ipynb").write_text(json.dumps(nb))
 
-        sandbox.check()
-        return True
-    except Exception:  # noqa: BLE001
-        return False
+
+def _totals(d: dict, key_points: str, key_max: str) -> tuple[float, float]:
+    return sum(t[key_points] for t in d["tests"]), sum(t[key_max] for t in d["tests"])
+
+
+def _check_after(r, mark):
+    assert "EXIT 0" in r.stdout, r.stdout[-3000:] + r.stderr[-3000:]
+    assert "ALIVE" not in r.stdout, r.stdout  # no process of the student's user outlived the entry point
+    leaks = [line for line in r.stdout.splitlines() if line.startswith("LEAK")]
+    assert leaks and all("daemon started" in x for x in leaks), leaks  # it ran, it read nothing, rewrote nothing
+    assert all(" as uid 0" not in x for x in leaks), leaks  # as the student's user, never root
 
 
 @pytest.mark.slow
 @needs_bwrap
-def test_gradescope_autograder_zip_in_a_simulated_container(tmp_path, fixture_notebooks):
-    zpath = lms.gradescope_zip(
-        tmp_path / "autograder.zip", notebooks=fixture_notebooks, cache=None, secret=tmp_path / "secret",
-        sandbox=False, visibility="after_published", timeout=120, cell_timeout=30,
-    )  # fmt: skip
-    names = zipfile.ZipFile(zpath).namelist()
+def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
+    zpath = lms.gradescope_zip(tmp_path / "autograder.zip", visibility="after_published", **six["kw"])
+    z = zipfile.ZipFile(zpath)
+    names = z.namelist()
     assert {"setup.sh", "run_autograder", "config.json", "references.json", "grader-secret"} <= set(names)
-    assert "kinlib-src/kinlib/course/grader/grade.py" in names and not any("__pycache__" in n for n in names)
-    assert (tmp_path / "secret").read_bytes().strip() not in zipfile.ZipFile(zpath).read("grader-secret")
-    scratch = tmp_path / "ag"
-    zipfile.ZipFile(zpath).extractall(scratch / "source")
+    assert {"requirements.txt", "imports.txt", "constraints.txt"} <= set(names) and not any(
+        "__pycache__" in n for n in names
+    )
+    assert "modern_robotics" in z.read("imports.txt").decode().split()  # the workbooks import it
+    assert (six["dir"] / "secret").read_bytes().strip() not in z.read("grader-secret")
+    box = Container(tmp_path, {"/autograder": "ag"})
+    z.extractall(tmp_path / "ag" / "source")
     for f in ("run_autograder", "setup.sh"):
-        (scratch / "source" / f).chmod(0o755)
-    shutil.copy(scratch / "source" / "run_autograder", scratch / "run_autograder")
-    wf.write_submission(scratch / "submission" / "my work.ipynb", {"1.1": "a = th1\nb = sp.sin(th1)\nc = 0"})
-    r = _simulate("/autograder", scratch, "/autograder/run_autograder")
+        (tmp_path / "ag" / "source" / f).chmod(0o755)
+    # Gradescope: setup.sh once (building the image), run_autograder copied to /autograder
+    r = box.run("bash /autograder/source/setup.sh && cp /autograder/source/run_autograder /autograder/")
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
+    assert not (
+        tmp_path / "ag" / "venv" / "lib" / "python3.11" / "site-packages" / "kinlib" / "__init__.py"
+    ).is_symlink()
+    sub, res = tmp_path / "ag" / "submission", tmp_path / "ag" / "results" / "results.json"
+    nbs = six["nbs"]
+
+    def grade(notebooks, after=""):
+        _write_submission(sub, notebooks)
+        r = box.run("/autograder/run_autograder" + after)
+        d = json.loads(res.read_text())
+        assert validate_gradescope(d) == [], d
+        return r, d
+
+    # the six correct workbooks: full marks; kinlib is the bundle's own, installed in the venv setup.sh made
+    r, d = grade({k: untouched(nb, keep="all") for k, nb in nbs.items()})
     assert r.returncode == 0, r.stderr[-3000:]
-    assert "from /autograder/source/kinlib-src/kinlib" in r.stdout  # the zip's own copy of kinlib ran
-    path = scratch / "results" / "results.json"
-    d = json.loads(path.read_text())
-    assert validate_gradescope(d) == [], d
-    assert d["score"] == 1.5 + 3  # b of 1.1, d of 1.3
-    assert [(t["name"], t["score"], t["max_score"], t["visibility"]) for t in d["tests"]] == [
-        ("1.1", 1.5, 6.0, "after_published"),
-        ("1.3", 3.0, 3.0, "after_published"),
-    ]
-    assert "without the sandbox" in d["output"] and "1.2 drawing" in d["output"]
+    assert "from /autograder/venv/lib/" in r.stdout
+    got, top = _totals(d, "score", "max_score")
+    assert top > 50 and got == top == d["score"], [t for t in d["tests"] if t["score"] < t["max_score"]]
+    assert {t["visibility"] for t in d["tests"]} == {"after_published"}
+    assert f"unprivileged user {STUDENT}" in d["output"] and "without the sandbox" in d["output"]
+    # the six untouched workbooks: zero
+    r, d = grade({k: untouched(nb) for k, nb in nbs.items()})
+    assert d["score"] == 0 and _totals(d, "score", "max_score")[1] == top
+    # wrong: one notebook answered but its first part; a hostile one: unanswered, reads the key, leaves a daemon
+    first = next(iter(nbs))
+    mark = os.urandom(4).hex()
+    bad = untouched(nbs[first], keep=tuple(_parts(nbs[first])[1:]))
+    attack = untouched(nbs[first])
+    attack["cells"].append(
+        _code_cell(_hostile(mark, "/autograder/results/results.json", "/autograder/source/grader-secret"))
+    )
+    # ... graded by a bundle that asks for the sandbox, in a container where bubblewrap cannot run (as Docker's
+    # seccomp would have it): the kernels run as the student's user all the same
+    cfg_path = tmp_path / "ag" / "source" / "config.json"
+    cfg_path.write_text(json.dumps(json.loads(cfg_path.read_text()) | {"sandbox": True}))
+    r, d = grade({"wrong": bad}, AFTER)
+    assert f"unprivileged user {STUDENT}" in d["output"], d["output"]
+    mine = d["tests"]
+    assert 0 < d["score"] < sum(t["max_score"] for t in mine) and mine[0]["score"] == 0, mine
+    r, d = grade({"hostile": attack}, AFTER)
+    assert d["score"] == 0 and validate_gradescope(d) == [], d
+    _check_after(r, mark)
     # no notebook in the submission: still a valid results file, score 0
-    shutil.rmtree(scratch / "submission")
-    (scratch / "submission").mkdir()
-    r = _simulate("/autograder", scratch, "/autograder/run_autograder")
-    d = json.loads(path.read_text())
-    assert r.returncode == 0 and validate_gradescope(d) == [] and d["score"] == 0 and "No .ipynb" in d["output"]
+    r, d = grade({})
+    assert r.returncode == 0 and d["score"] == 0 and "No .ipynb" in d["output"]
+
+
+def _code_cell(src):
+    return {"cell_type": "code", "metadata": {}, "source": src, "outputs": [], "execution_count": None}
 
 
 @pytest.mark.slow
 @needs_bwrap
-def test_prairielearn_external_grader_in_a_simulated_container(tmp_path, fixture_notebooks):
-    out = lms.prairielearn_dir(
-        tmp_path / "pl", notebooks=fixture_notebooks, cache=None, secret=tmp_path / "secret",
-        sandbox=_sandbox_ok(), timeout=120, cell_timeout=30,
-    )  # fmt: skip
+def test_prairielearn_bundle_in_its_own_image(tmp_path, six):
+    out = lms.prairielearn_dir(tmp_path / "pl", image="someone/kinlib-grader:1", **six["kw"])
     opts = json.loads((out / "info-externalGradingOptions.json").read_text())["externalGradingOptions"]
     assert opts["entrypoint"] == "/grade/serverFilesCourse/kinlib_grader/run.sh" and opts["timeout"] <= 600
-    scratch = tmp_path / "grade"
-    shutil.copytree(out / "serverFilesCourse", scratch / "serverFilesCourse")
-    wf.write_submission(scratch / "student" / "w.ipynb")
-    r = _simulate("/grade", scratch, "/grade/serverFilesCourse/kinlib_grader/run.sh")
+    assert (
+        opts["image"] == "someone/kinlib-grader:1"
+        and "someone/kinlib-grader:1" in (out / "image" / "Dockerfile").read_text()
+    )
+    image = sorted(p.name for p in (out / "image").iterdir())
+    assert "grader-secret" not in image and "references.json" not in image and "setup.sh" in image
+    box = Container(tmp_path, {"/grade": "grade", "/opt/kinlib": "opt-kinlib"})
+    # the image: what its Dockerfile does (COPY . /opt/kinlib/image; RUN setup.sh)
+    shutil.copytree(out / "image", tmp_path / "opt-kinlib" / "image")
+    r = box.run("KINLIB_VENV=/opt/kinlib/venv bash /opt/kinlib/image/setup.sh")
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
+    shutil.copytree(out / "serverFilesCourse", tmp_path / "grade" / "serverFilesCourse")
+    sub, res = tmp_path / "grade" / "student", tmp_path / "grade" / "results" / "results.json"
+    nbs = six["nbs"]
+
+    def grade(notebooks, after=""):
+        _write_submission(sub, notebooks)
+        r = box.run("/grade/serverFilesCourse/kinlib_grader/run.sh" + after)
+        d = json.loads(res.read_text())
+        assert validate_prairielearn(d, res.stat().st_size) == [], d
+        return r, d
+
+    r, d = grade({k: untouched(nb, keep="all") for k, nb in nbs.items()})
     assert r.returncode == 0, r.stderr[-3000:]
-    path = scratch / "results" / "results.json"
-    d = json.loads(path.read_text())
-    assert validate_prairielearn(d, path.stat().st_size) == [], d
-    assert d["gradable"] is True and d["score"] == 1.0 and [t["points"] for t in d["tests"]] == [6.0, 3.0]
+    assert d["gradable"] is True and d["score"] == 1.0, [t for t in d["tests"] if t["points"] < t["max_points"]]
+    r, d = grade({k: untouched(nb) for k, nb in nbs.items()})
+    assert d["gradable"] is True and d["score"] == 0.0
+    first = next(iter(nbs))
+    mark = os.urandom(4).hex()
+    attack = untouched(nbs[first])
+    key = "/grade/serverFilesCourse/kinlib_grader/grader-secret"
+    attack["cells"].append(_code_cell(_hostile(mark, "/grade/results/results.json", key)))
+    r, d = grade({"hostile": attack}, AFTER)
+    assert d["gradable"] is True and d["score"] == 0.0, d
+    _check_after(r, mark)
     # a file that is not a notebook: not gradable, with a format error
-    (scratch / "student" / "w.ipynb").write_text("print('hello')")
-    r = _simulate("/grade", scratch, "/grade/serverFilesCourse/kinlib_grader/run.sh")
-    d = json.loads(path.read_text())
+    sub.joinpath("w.ipynb").write_text("print('hello')")
+    for p in sub.glob("hostile*"):
+        p.unlink()
+    r = box.run("/grade/serverFilesCourse/kinlib_grader/run.sh")
+    d = json.loads(res.read_text())
     assert r.returncode == 0 and validate_prairielearn(d) == [] and d["gradable"] is False
     assert "not JSON" in d["format_errors"][0]
 
@@ -389,3 +564,61 @@ def test_the_platform_commands(tmp_path, capsys):
     args = ["--notebooks", str(tmp_path), "--secret", str(tmp_path / "s")]
     assert main(["grade", "prairielearn", "--out", str(tmp_path / "pl"), *args]) == 2
     assert "no solution notebooks" in capsys.readouterr().err
+
+
+# ----------------------------------------------------------------------------------------- the parts, quickly
+
+
+def test_requirements_come_from_what_the_notebooks_and_kinlib_import(tmp_path):
+    from kinlib.course.lms import environment
+
+    nbs = sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb"))
+    reqs, modules = environment.requirements(nbs, NOTEBOOKS.parent / "environment.txt")
+    names = {r.split("==")[0].lower().replace("_", "-") for r in reqs}
+    # what the workbooks import (modern_robotics was the one missing), what kinlib needs, and the kernel
+    assert {"modern-robotics", "numpy", "sympy", "matplotlib", "jupyter-client", "ipykernel"} <= names
+    assert "playwright" not in names and "jupyterlite-core" not in names  # handout tools stay on the instructor's side
+    assert all("==" in r for r in reqs) and "modern_robotics" in modules
+    pins = dict(line.split("==") for line in (NOTEBOOKS.parent / "environment.txt").read_text().split() if "==" in line)
+    assert all(pins.get(r.split("==")[0], r.split("==")[1]) == r.split("==")[1] for r in reqs)  # environment.txt's
+    nb = wf.solution()
+    nb["cells"].append(
+        {"cell_type": "code", "metadata": {}, "source": "import surely_not_a_module_kinlib", "outputs": []}
+    )
+    (tmp_path / "x.ipynb").write_text(json.dumps(nb))
+    with pytest.raises(ValueError, match="surely_not_a_module_kinlib .imported by x.ipynb. is not installed"):
+        environment.requirements([tmp_path / "x.ipynb"])
+
+
+@pytest.mark.skipif(os.geteuid() != 0, reason="switching users needs root")
+def test_every_process_of_the_student_user_is_ended(tmp_path):
+    """Processes of an unused uid (no account needed: Popen switches by number), one a daemon in a session of its own
+    that keeps forking: end_all leaves none, and give() makes a folder that user's alone."""
+    from kinlib.course.grader.isolation.unprivileged import StudentUser
+
+    uid = 61000 + int.from_bytes(os.urandom(2), "big") % 3000
+    user = StudentUser("test-student", uid, uid)
+    assert user.processes() == []
+    forker = (
+        "import os, subprocess, sys, time\n"
+        "subprocess.Popen([sys.executable, '-c', 'import os, time\\nwhile True:\\n    if os.fork() == 0: time.sleep(60)\\n"
+        "    time.sleep(0.05)'], start_new_session=True)\n"
+        "time.sleep(60)\n"
+    )
+    procs = [subprocess.Popen(["/usr/bin/python3", "-c", forker], cwd="/", **user.popen_kwargs()) for _ in range(2)]
+    try:
+        deadline = 0
+        while len(user.processes()) < 6 and deadline < 200:
+            deadline += 1
+            subprocess.run(["sleep", "0.05"])
+        assert len(user.processes()) >= 6
+        assert user.end_all() == [] and user.processes() == []
+    finally:
+        for p in procs:
+            p.kill()
+            p.wait()
+    (tmp_path / "w" / "sub").mkdir(parents=True)
+    (tmp_path / "w" / "sub" / "f").write_text("x")
+    user.give(tmp_path / "w")
+    assert {(p.stat().st_uid, p.stat().st_gid) for p in [tmp_path / "w", *(tmp_path / "w").rglob("*")]} == {(uid, uid)}
+    assert (tmp_path / "w").stat().st_mode & 0o777 == 0o700

@@ -260,6 +260,12 @@ def build_lms_parser() -> argparse.ArgumentParser:
         )
         if name == "gradescope":
             b.add_argument("--visibility", choices=VISIBILITIES, default="visible", help="of every test")
+        else:
+            b.add_argument(
+                "--image",
+                default=None,
+                help="the grading image's Docker Hub name (build it from OUT/image/; default kinlib/grader:VERSION)",
+            )
         b.set_defaults(run=_lms_bundle, parser=b)
     c = sub.add_parser(
         "canvas",
@@ -296,7 +302,7 @@ def _lms_bundle(args) -> int:
         if args.platform == "gradescope":
             path = lms.gradescope_zip(args.out, visibility=args.visibility, **kw)
         else:
-            path = lms.prairielearn_dir(args.out, **kw)
+            path = lms.prairielearn_dir(args.out, image=args.image, **kw)
     except (RuntimeError, ValueError, OSError) as exc:
         print(f"{PROG} grade {args.platform}: error: {_one_line(exc)}", file=sys.stderr)
         return 2

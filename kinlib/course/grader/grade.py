@@ -187,12 +187,14 @@ def grade_submission(
     relpath: str | None = None,
     root: str | None = None,
     limits: Limits | None = None,
+    user=None,
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises).
 
     ``sandbox``: a :class:`~kinlib.course.grader.isolation.sandbox.Sandbox`, True (the default one) or False (no sandbox:
     said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
-    :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points.
+    :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points; ``user``:
+    without the sandbox, a :class:`~kinlib.course.grader.isolation.unprivileged.StudentUser` the kernel runs as.
 
     A file that is not one of the notebooks gets one ``error`` row, without starting a kernel:
 
@@ -217,7 +219,9 @@ def grade_submission(
     out["relpath"] = relpath or Path(path).name  # the student id is read from it (intake.student_id)
     out["root"] = root or str(Path(path).absolute().parent)
     if sandbox is False:
-        out["notes"] = [NO_SANDBOX_NOTE]
+        out["notes"] = [
+            NO_SANDBOX_NOTE if user is None else f"graded without bubblewrap, as the unprivileged user {user.name}"
+        ]
     data, nb, problem = intake.read_notebook(path)  # never raises, never blocks, never recurses deeply
     if problem:
         out["rows"] = [Row(sub, "", "-", "error", 0, problem)]
@@ -288,7 +292,15 @@ def grade_submission(
         with open(os.path.join(scratch, Path(path).name), "wb") as f:
             f.write(data)
         run = NotebookRun(
-            code, scratch, tmp, cell_timeout, total_timeout, stash_after, sandbox=sandbox or None, enclosure=enc
+            code,
+            scratch,
+            tmp,
+            cell_timeout,
+            total_timeout,
+            stash_after=stash_after,
+            sandbox=sandbox or None,
+            enclosure=enc,
+            user=user,
         )
         rows, exact = _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
         out["restarts"] = run.restarts

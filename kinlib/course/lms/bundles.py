@@ -6,18 +6,25 @@ Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.g
 * ``kinlib grade gradescope --out autograder.zip`` writes a Gradescope autograder (Autograder
   Specifications, https://gradescope-autograders.readthedocs.io/en/latest/specs/): ``setup.sh`` and
   ``run_autograder`` at the root of the zip, plus the bundle: a copy of the ``kinlib`` package
-  (``kinlib-src/``), its pins (``constraints.txt``, the repository's ``environment.txt``), the reference
-  answers as data (``references.json``, computed here by the instructor's grader), a grader secret derived
-  for this zip (never the instructor's own) and ``config.json``. Gradescope runs each submission in its own
+  (``kinlib-src/``), what the container must install (``requirements.txt``: the distributions of every module
+  the notebooks and kinlib's grading code import, read from that code by :mod:`kinlib.course.lms.environment`,
+  pinned by ``constraints.txt``, the repository's ``environment.txt``; ``imports.txt``: the modules
+  ``setup.sh`` checks), the reference answers as data (``references.json``, computed here by the instructor's
+  grader), a grader secret derived for this zip (never the instructor's own) and ``config.json``.
+  ``setup.sh`` (run once, as root, when Gradescope builds the image) makes ``/autograder/venv`` and the
+  unprivileged user ``kinlib-student``. Gradescope runs each submission in its own
   container: ``/autograder/submission/`` (the student's files), ``/autograder/source/`` (the zip),
   ``/autograder/results/results.json`` (written by ``run_autograder``: ``score``, ``output``,
   ``execution_time``, ``stdout_visibility`` and ``tests`` [{``name``, ``number``, ``score``, ``max_score``,
   ``status``, ``output``, ``visibility``}], one test per automatically graded part; visibility is one of
   ``visible``, ``hidden``, ``after_due_date``, ``after_published``). Use a Gradescope base image with
   Python ≥ 3.11 (Ubuntu 24.04).
-* ``kinlib grade prairielearn --out DIR`` writes ``DIR/serverFilesCourse/kinlib_grader/`` (the same bundle
-  and ``run.sh``) and ``DIR/info-externalGradingOptions.json`` (External Grading,
-  https://prairielearn.readthedocs.io/en/latest/externalGrading/): the student's files are in
+* ``kinlib grade prairielearn --out DIR [--image NAME]`` writes ``DIR/serverFilesCourse/kinlib_grader/``
+  (``run.sh``, the references, the key, ``config.json``), ``DIR/image/`` (the grading image: ``Dockerfile``,
+  the same ``setup.sh``, requirements and kinlib; no answers and no key, since images are public on Docker Hub)
+  and ``DIR/info-externalGradingOptions.json`` (External Grading,
+  https://prairielearn.readthedocs.io/en/latest/externalGrading/), which names the image: build and push it
+  (``docker build -t NAME DIR/image``). The student's files are in
   ``/grade/student/``, the results go to ``/grade/results/results.json`` (created by ``run.sh``):
   ``gradable``, ``score`` in [0, 1], ``message``, ``output``, ``tests`` [{``name``, ``description``,
   ``points``, ``max_points``, ``message``, ``output``}]; a file that is not a notebook is ``gradable:
@@ -33,8 +40,12 @@ Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.g
 
 Work graded by hand (``manual`` items, e.g. 5.2's drawing) is not part of the platforms' automatic score:
 the results' output lists it; grade it with the platform's own manual grading. Within the container the
-student's kernel runs in the sandbox when bubblewrap can run there; a zip built with ``--no-sandbox`` says
-so in every result. For testing, the roots are ``--root`` (or ``KINLIB_AUTOGRADER_ROOT`` /
+student's kernel runs in the sandbox when the bundle asks for it and bubblewrap can run there. Otherwise (a zip
+built with ``--no-sandbox``, or Docker's default seccomp profile blocking bubblewrap) it runs as the unprivileged
+user ``kinlib-student`` (:mod:`kinlib.course.grader.isolation.unprivileged`): before any kernel starts, the
+bundle (key, references), the submission and the results folder are made root's alone and checked unreadable by
+that user; after each kernel and before the results are written every process of that user is ended; every
+result says how the code ran. For testing, the roots are ``--root`` (or ``KINLIB_AUTOGRADER_ROOT`` /
 ``KINLIB_GRADE_ROOT``), default ``/autograder`` and ``/grade``.
 """
 
@@ -45,6 +56,7 @@ import json
 import os
 import shutil
 import stat
+import subprocess
 import sys
 import tempfile
 import time
@@ -53,6 +65,9 @@ from dataclasses import asdict
 from pathlib import Path
 
 from ..grader import credit, report
+from ..grader.isolation import unprivileged
+from . import environment
+from .scripts import DOCKERFILE, GS_VENV, PL_IMAGE, PL_VENV, RUN_AUTOGRADER, RUN_PL, SETUP_SH
 
 __all__ = [
     "VISIBILITIES",
@@ -68,39 +83,6 @@ __all__ = [
 
 VISIBILITIES = ("visible", "hidden", "after_due_date", "after_published")
 _ROOTS = {"gradescope": ("KINLIB_AUTOGRADER_ROOT", "/autograder"), "prairielearn": ("KINLIB_GRADE_ROOT", "/grade")}
-
-SETUP_SH = """#!/usr/bin/env bash
-# Gradescope runs this once, as root, when it builds the autograder image.
-set -euo pipefail
-export DEBIAN_FRONTEND=noninteractive
-apt-get update -qq
-apt-get install -y -qq python3 python3-venv python3-pip bubblewrap
-python3 -c 'import sys; sys.exit(sys.version_info < (3, 11))' || {
-  echo "kinlib needs Python >= 3.11: choose a Gradescope base image with Ubuntu 24.04" >&2; exit 1; }
-python3 -m venv /autograder/venv
-/autograder/venv/bin/pip install -q -c /autograder/source/constraints.txt "/autograder/source/kinlib-src[course]"
-"""
-
-RUN_AUTOGRADER = """#!/usr/bin/env bash
-# Gradescope runs this for every submission: /autograder/submission -> /autograder/results/results.json
-ROOT="${KINLIB_AUTOGRADER_ROOT:-/autograder}"
-PY="${KINLIB_PYTHON:-$ROOT/venv/bin/python}"
-[ -x "$PY" ] || PY=python3
-export PYTHONPATH="$ROOT/source/kinlib-src${PYTHONPATH:+:$PYTHONPATH}"
-cd "$ROOT"
-exec "$PY" -m kinlib.course.lms.bundles run gradescope --root "$ROOT" --bundle "$ROOT/source"
-"""
-
-RUN_PL = """#!/usr/bin/env bash
-# PrairieLearn's entrypoint: /grade/student -> /grade/results/results.json
-ROOT="${KINLIB_GRADE_ROOT:-/grade}"
-HERE="$ROOT/serverFilesCourse/kinlib_grader"
-PY="${KINLIB_PYTHON:-python3}"
-export PYTHONPATH="$HERE/kinlib-src${PYTHONPATH:+:$PYTHONPATH}"
-mkdir -p "$ROOT/results"
-exec "$PY" -m kinlib.course.lms.bundles run prairielearn --root "$ROOT" --bundle "$HERE"
-"""
-
 
 # ----------------------------------------------------------------------------------------- the bundle
 
@@ -172,12 +154,20 @@ def build_bundle(
         shutil.copy(env, dest / "constraints.txt")
     else:
         (dest / "constraints.txt").write_text("")
+    used = sorted(p for p in notebooks.glob("*.ipynb") if ids is None or p.stem in ids)
+    reqs, modules = environment.requirements(used, dest / "constraints.txt")
+    (dest / "requirements.txt").write_text("".join(r + "\n" for r in reqs))
+    (dest / "imports.txt").write_text("".join(m + "\n" for m in modules))
     points = {}
     for k, r in refs.items():
         auto = sum(sum(credit.answer_max(p).values()) for p in r.parts)
         manual = sum(sum(credit.manual_items(p).values()) for p in r.parts)
         points[k] = {"auto": float(auto), "manual": float(manual)}
+    import kinlib
+
     cfg = {
+        "kinlib": kinlib.__version__,
+        "student_user": unprivileged.DEFAULT_NAME,
         "notebooks": sorted(refs),
         "points": points,
         "sandbox": bool(sandbox),
@@ -203,8 +193,8 @@ def gradescope_zip(out, **kw) -> Path:
     out = Path(out)
     with tempfile.TemporaryDirectory(prefix="kinlib-gs-") as d:
         root = Path(d)
-        build_bundle(root, **kw)
-        _exe(root / "setup.sh", SETUP_SH)
+        cfg = build_bundle(root, **kw)
+        _exe(root / "setup.sh", _setup_sh(GS_VENV, cfg))
         _exe(root / "run_autograder", RUN_AUTOGRADER)
         out.parent.mkdir(parents=True, exist_ok=True)
         tmp = out.with_name(out.name + ".part")
@@ -218,22 +208,47 @@ def gradescope_zip(out, **kw) -> Path:
     return out
 
 
-def prairielearn_dir(out, **kw) -> Path:
-    """Write ``out/serverFilesCourse/kinlib_grader/`` (bundle + ``run.sh``) and the ``externalGradingOptions``
-    to put in each question's ``info.json`` (``out/info-externalGradingOptions.json``).
+def _setup_sh(venv: str, cfg: dict) -> str:
+    return (
+        SETUP_SH.replace("@VENV@", venv)
+        .replace("@USER@", cfg["student_user"])
+        .replace("@SANDBOX@", "1" if cfg["sandbox"] else "0")
+    )
+
+
+#: what the grading image needs (moved out of the PrairieLearn bundle: no answers, no key in the image)
+_IMAGE_FILES = ("kinlib-src", "constraints.txt", "requirements.txt", "imports.txt")
+
+
+def prairielearn_dir(out, image: str | None = None, **kw) -> Path:
+    """Write ``out/serverFilesCourse/kinlib_grader/`` (``run.sh``, the references, the key, ``config.json``),
+    ``out/image/`` (the grading image: ``Dockerfile``, ``setup.sh``, requirements and kinlib; no answers, no key)
+    and the ``externalGradingOptions`` to put in each question's ``info.json``
+    (``out/info-externalGradingOptions.json``, naming ``image``: build and push it, ``out/image/Dockerfile`` says
+    how).
 
     >>> prairielearn_dir("build/prairielearn", only=["05"])  # runs the solution notebooks  # doctest: +SKIP
     """
+    import kinlib
+
     out = Path(out)
     here = out / "serverFilesCourse" / "kinlib_grader"
-    if here.exists():
-        shutil.rmtree(here)
+    img = out / "image"
+    for d in (here, img):
+        if d.exists():
+            shutil.rmtree(d)
     cfg = build_bundle(here, **kw)
-    _exe(here / "run.sh", RUN_PL)
+    img.mkdir(parents=True)
+    for name in _IMAGE_FILES:
+        shutil.move(here / name, img / name)
+    image = image or PL_IMAGE.format(version=kinlib.__version__)
+    _exe(img / "setup.sh", _setup_sh(PL_VENV, cfg))
+    (img / "Dockerfile").write_text(DOCKERFILE.replace("@VENV@", PL_VENV).replace("@IMAGE@", image))
+    _exe(here / "run.sh", RUN_PL.replace("@VENV@", PL_VENV))
     opts = {
         "externalGradingOptions": {
             "enabled": True,
-            "image": "prairielearn/grader-python",
+            "image": image,
             "serverFilesCourse": ["kinlib_grader/"],
             "entrypoint": "/grade/serverFilesCourse/kinlib_grader/run.sh",
             "timeout": int(min(600, cfg["timeout"] + 60)),
@@ -376,7 +391,7 @@ def _load_refs(bundle: Path) -> dict:
     return {k: Reference(**v) for k, v in data.items()}
 
 
-def _grade(path: Path, refs: dict, cfg: dict, bundle: Path) -> dict:
+def _grade(path: Path, refs: dict, cfg: dict, bundle: Path, user=None) -> dict:
     import inspect
 
     from ..grader import grade
@@ -390,13 +405,58 @@ def _grade(path: Path, refs: dict, cfg: dict, bundle: Path) -> dict:
     if "secret" in params:
         kw["secret"] = (bundle / "grader-secret").read_bytes().strip()
     if "sandbox" in params:
-        kw["sandbox"] = bool(cfg.get("sandbox", True))
+        kw["sandbox"] = user is None and bool(cfg.get("sandbox", True))
+    if user is not None:
+        kw["user"] = user
     res = grade.grade_submission(path, refs, **kw)
     ref = refs.get(res.get("notebook"))
     if ref is not None and res.get("credit") != "scored":
         credit.score_parts(res, ref.parts)
-    res.setdefault("sandbox", bool(cfg.get("sandbox", True)))
+    res.setdefault("sandbox", user is None and bool(cfg.get("sandbox", True)))
     return res
+
+
+def _layout(platform: str, root: Path, bundle) -> tuple[Path, Path, Path]:
+    """(bundle, submission folder, results file) of the platform's layout under ``root``."""
+    if platform == "gradescope":
+        return Path(bundle) if bundle else root / "source", root / "submission", root / "results" / "results.json"
+    here = Path(bundle) if bundle else root / "serverFilesCourse" / "kinlib_grader"
+    return here, root / "student", root / "results" / "results.json"
+
+
+def _student_user(cfg: dict):
+    """The user the student's kernels run as: None in the sandbox (bubblewrap runs here and the bundle asks for
+    it), else the bundle's unprivileged user (UnprivilegedUnavailable if the grader cannot switch to it)."""
+    if cfg.get("sandbox", True):
+        from ..grader.isolation import sandbox
+
+        if sandbox.check()[0]:
+            return None
+    return unprivileged.StudentUser.require(cfg.get("student_user", unprivileged.DEFAULT_NAME))
+
+
+def _lock_down(root: Path, bundle: Path, subdir: Path, dest: Path, user) -> None:
+    """Root's files out of the student's user's reach: the bundle (key, references), the submission and the
+    results folder only root's (the platform's root folder traversable, not listable); then checked as the user."""
+    root.chmod(0o711)
+    dest.parent.mkdir(parents=True, exist_ok=True)
+    for d in (bundle, subdir, dest.parent, bundle.parent if bundle.parent != root else bundle):
+        if d.is_dir() and not d.is_symlink():
+            os.chown(d, 0, 0)
+            d.chmod(0o700)
+    probe = "import sys\nfor p in sys.argv[1:]:\n    try:\n        open(p, 'rb').read(1); print(p)\n    except OSError:\n        pass"
+    secret = [bundle / "grader-secret", bundle / "references.json", bundle / "config.json"]
+    r = subprocess.run(
+        [sys.executable, "-I", "-S", "-c", probe, *map(str, secret)],
+        capture_output=True,
+        text=True,
+        cwd="/",
+        env={"PATH": "/usr/bin:/bin"},
+        timeout=60,
+        **user.popen_kwargs(),
+    )
+    if r.returncode != 0 or r.stdout.strip():
+        raise RuntimeError(f"the student's user {user.name} can read {r.stdout.split() or r.stderr[-200:]}")
 
 
 def run_platform(platform: str, root=None, bundle=None) -> dict:
@@ -404,7 +464,9 @@ def run_platform(platform: str, root=None, bundle=None) -> dict:
 
     ``platform`` is "gradescope" (``ROOT/submission`` → ``ROOT/results/results.json``, ROOT default
     ``/autograder``) or "prairielearn" (``ROOT/student`` → ``ROOT/results/results.json``, ROOT ``/grade``).
-    tests/test_grade_lms.py runs it in a simulated container (bubblewrap); a platform it does not know:
+    Without bubblewrap the student's kernels run as the bundle's unprivileged user (root's files locked away from
+    it first), and every process of that user is ended before the results are written.
+    tests/test_grade_lms.py runs it in a simulated container; a platform it does not know:
 
     >>> run_platform("moodle")
     Traceback (most recent call last):
@@ -417,33 +479,41 @@ def run_platform(platform: str, root=None, bundle=None) -> dict:
         raise ValueError(f"platform must be gradescope or prairielearn, got {platform!r}")
     env, default = _ROOTS[platform]
     root = Path(root or os.environ.get(env) or default)
-    bundle = (
-        Path(bundle)
-        if bundle
-        else (root / "source" if platform == "gradescope" else root / "serverFilesCourse" / "kinlib_grader")
-    )
+    bundle, subdir, dest = _layout(platform, root, bundle)
     t0 = time.monotonic()
     import kinlib
 
     cfg = json.loads((bundle / "config.json").read_text())
     print(f"kinlib {kinlib.__version__} from {Path(kinlib.__file__).parent}", flush=True)  # the instructor's log
+    if cfg.get("kinlib", kinlib.__version__) != kinlib.__version__:
+        raise RuntimeError(
+            f"the bundle was built by kinlib {cfg['kinlib']} but this environment has kinlib {kinlib.__version__}: "
+            "rebuild the grading image (setup.sh) from the same bundle"
+        )
     refs = _load_refs(bundle)
-    subdir = root / ("submission" if platform == "gradescope" else "student")
+    user = _student_user(cfg)
+    if user is not None:
+        _lock_down(root, bundle, subdir, dest, user)
     subs = find_submissions([subdir]) if subdir.is_dir() else []
-    results = [_grade(p, refs, cfg, bundle) for p in subs]
+    try:
+        results = [_grade(p, refs, cfg, bundle, user) for p in subs]
+    finally:
+        left = user.end_all() if user is not None else []
+    if left:
+        raise RuntimeError(f"processes {left} of the student's user {user.name} could not be ended")
     broken = [res["infrastructure"] for res in results if res.get("infrastructure")]
     if broken:  # the platform's machine, not the student: report a failed run, never a grade of 0
         raise RuntimeError(broken[0])
     for res in results:
         print(report.summary_table([res], res.get("seconds", 0.0), 0.0, 1), flush=True)
+    sandboxed = user is None and cfg.get("sandbox", True)
     if platform == "gradescope":
-        out = gradescope_results(
-            results, cfg.get("visibility", "visible"), cfg.get("sandbox", True), time.monotonic() - t0
-        )
+        out = gradescope_results(results, cfg.get("visibility", "visible"), sandboxed, time.monotonic() - t0)
     else:
-        out = prairielearn_results(results, cfg.get("sandbox", True))
-    dest = root / "results" / "results.json"
-    dest.parent.mkdir(parents=True, exist_ok=True)
+        out = prairielearn_results(results, sandboxed)
+    if user is not None:
+        note = f"The code ran as the unprivileged user {user.name} (no bubblewrap in this container)."
+        out["output" if platform == "gradescope" else "message"] += "\n" + note
     report.atomic_write(dest, json.dumps(out, indent=1, ensure_ascii=False) + "\n")
     return out
 

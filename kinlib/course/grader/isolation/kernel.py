@@ -156,6 +156,7 @@ class Kernel:
     grace: float = 3.0
     sandbox: object | None = None  # a kinlib.course.grader.isolation.sandbox.Sandbox, or None (a plain subprocess)
     enclosure: object | None = None  # a kinlib.course.grader.isolation.limits.Enclosure: cgroup and tmpfs
+    user: object | None = None  # without a sandbox: a kinlib.course.grader.isolation.unprivileged.StudentUser to run as
     proc: subprocess.Popen | None = None
     kc: BlockingKernelClient | None = None
     dead_reason: str = ""
@@ -206,10 +207,19 @@ class Kernel:
                 os.close(rfd)
                 os.close(wfd)
                 raise
+        elif self.user is not None:  # the student's own user: its scratch folder (and nothing of root's) is its own
+            home = os.path.join(self.conn_dir, "home")
+            os.makedirs(home, exist_ok=True)
+            self.user.give(self.conn_dir)
+            env = self.user.environment(home, extra)
         else:
             env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
             env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+        as_user = self.user.popen_kwargs() if self.user is not None and self.sandbox is None else {}
         if self.enclosure is not None:
+            if as_user:  # the launcher joins the cgroup as the student's user: it may write cgroup.procs, nothing else
+                for cg in getattr(self.enclosure, "cgroups", ()):
+                    os.chown(cg / "cgroup.procs", self.user.uid, self.user.gid)
             argv = self.enclosure.wrap(argv)  # every process the kernel starts is in the submission's cgroup
         try:
             self.proc = subprocess.Popen(
@@ -221,6 +231,7 @@ class Kernel:
                 stderr=subprocess.DEVNULL,
                 start_new_session=True,
                 pass_fds=fds,
+                **as_user,
             )
         except OSError as exc:
             raise KernelStartError(f"cannot run {argv[0]}: {exc}") from None
@@ -299,6 +310,8 @@ class Kernel:
                 self.proc.wait(timeout=5)
             except subprocess.TimeoutExpired:
                 pass
+        if self.user is not None and self.sandbox is None:
+            self.user.end_all()  # every process of the student's user, daemons in new sessions included
 
     def _kernel_pid(self):
         """The kernel's PID as the grader sees it: the sandbox's init's child, or the process itself."""
@@ -449,9 +462,11 @@ class NotebookRun:
         snapshot: bool = True,
         sandbox=None,
         enclosure=None,
+        user=None,
     ):
         self.cells = cells
         self.enclosure = enclosure  # kinlib.course.grader.isolation.limits.Enclosure: the submission's limits, or None
+        self.user = user  # kinlib.course.grader.isolation.unprivileged.StudentUser (no sandbox), or None
         self.cwd, self.tmp = cwd, tmp
         self.cell_timeout, self.total = cell_timeout, total_timeout
         self.stash_after = stash_after or {}
@@ -467,7 +482,9 @@ class NotebookRun:
         self.t0 = time.monotonic()
 
     def _start(self):
-        self.kernel = Kernel(cwd=self.cwd, conn_dir=self.tmp, sandbox=self.sandbox, enclosure=self.enclosure)
+        self.kernel = Kernel(
+            cwd=self.cwd, conn_dir=self.tmp, sandbox=self.sandbox, enclosure=self.enclosure, user=self.user
+        )
         try:
             self.kernel.start()
         finally:
