@@ -500,3 +500,13 @@ def test_end_to_end_verdicts_and_a_notebook_without_metadata(tmp_path):
     assert all(r["status"] == "pass" and r["notebook"] == "90_grade_fixture" for r in pasted_rows.values()), pasted_rows
     res = next(r for r in summary["results"] if Path(r["submission"]).stem == "pasted")
     assert any("recognised as 90_grade_fixture" in n for n in res.get("notes", []))
+
+
+def test_5_5_the_reference_robot_is_kept_as_data():
+    """The solution notebook's answer to 5.5 is a robot: the answer key keeps its screw axes (the reference of a
+    property answer is data only; a robot's repr in the key broke every 05 grading once)."""
+    from kinlib.course.grader import refdata
+
+    ref = refdata.reference_answers({"redesign": {"tree": export(robots.planar_rpp())}}, {"redesign": PROP})
+    assert "error" not in ref["redesign"], ref
+    assert ref["redesign"]["kind"] == PROP and ref["redesign"]["srepr"].startswith("MutableDenseMatrix(")

@@ -429,6 +429,9 @@ def normalize_reference(kind, value):
 
     >>> normalize_reference("set", [0, 1]), normalize_reference("expr", [1, 2]).shape
     ({0, 1}, (2, 1))
+    >>> from kinlib.robots import planar_rpp
+    >>> normalize_reference("property:nonsingular", planar_rpp()).shape   # a robot: its screw axes
+    (6, 3)
     """
     import sympy as sp
 
@@ -439,6 +442,12 @@ def normalize_reference(kind, value):
         if obj is None:
             raise TypeError(f"reference answer of kind {kind!r} is {tag} ({answers.type_name(value)})")
         return obj
+    if str(kind).startswith("property"):  # judged by the property alone; the reference is kept as data only
+        screws = answers.robot_screws(value)  # a robot (the printed design): its screw axes
+        if screws is not None:
+            return screws
+        obj = answers.to_sympy(value)[1]
+        return obj if obj is not None else sp.Integer(0)
     if kind == "set":
         conds = answers.set_conditions(value)
         if conds is None or isinstance(value, sp.Set):
