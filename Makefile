@@ -15,10 +15,14 @@ setup: $(STAMP)
 
 # The exact pins, then kinlib itself as an editable install without dependencies (that is what puts the
 # `kinlib` console script into .venv/bin). Re-run when the pins or pyproject.toml change.
+# pip prints one line per package (progress); its download bars are off (they flood a CI log).
 $(STAMP): environment.txt pyproject.toml
+	@echo "setup: .venv from environment.txt ($$(grep -c '==' environment.txt) pinned packages; about a minute with a warm pip cache)"
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PIP) install --quiet --upgrade pip
-	$(PIP) install --quiet -r environment.txt
+	@{ $(PIP) install --progress-bar off -r environment.txt; echo $$? > $(VENV)/.pip-status; } \
+	    | grep --line-buffered -E '^(Collecting|Installing collected|Successfully)' | cut -c1-100; \
+	    test "$$(cat $(VENV)/.pip-status)" = 0 || { echo "setup: pip could not install environment.txt (above)"; exit 1; }
 	$(PIP) install --quiet --no-deps --no-build-isolation -e .
 	@touch $@
 
@@ -57,7 +61,7 @@ bubblewrap:
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
 test: $(STAMP) lint chromium poppler bubblewrap
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
-	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider $(PYTEST_ARGS)
+	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider --durations=15 $(PYTEST_ARGS)
 
 # Quick loop while developing: no browser, no notebooks, no slow tests, no lint (`make lint` for that).
 test-fast: $(STAMP) bubblewrap
@@ -80,8 +84,12 @@ notebooks: $(STAMP)
 	$(VENV)/bin/kinlib execute $(NB)
 
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
+# Incremental: a section, the site or a PDF whose inputs did not change is reused (the log says so).
+# `make handouts ONLY=05` builds one section (ONLY="02 05": several); `make handouts FRESH=1` builds everything again.
+ONLY ?=
+FRESH ?=
 handouts: $(STAMP) chromium
-	$(VENV)/bin/kinlib handouts notebooks --out build/handouts
+	$(VENV)/bin/kinlib handouts notebooks --out build/handouts $(if $(ONLY),--only $(ONLY)) $(if $(FRESH),--fresh)
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
 # http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.

@@ -451,3 +451,22 @@ def test_real_workbook_with_the_solutions_passes(stem, tmp_path):
     assert len(lines) == n_answers
     bad = [ln for ln in lines if "✓ correct" not in ln and "no automatic self-check" not in ln]
     assert not bad, bad
+
+
+def test_a_second_build_executes_nothing_and_changes_no_file(built, monkeypatch):
+    """`make handouts` twice in a row: the second build reuses the section (kinlib.course.publish.incremental)."""
+    out, first, _log = built
+    pages = sorted(p for p in out.rglob("*") if p.is_file() and p.name != "index.html" and "assets" not in p.parts)
+    before = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in pages}
+
+    def no_kernel(*a, **k):
+        raise AssertionError("a reused section must not be executed")
+
+    monkeypatch.setattr(handouts, "execute_notebook", no_kernel)
+    log: list = []
+    again = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=log.append)
+    assert any(f"{STEM}: reused" in line for line in log)
+    assert {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in pages} == before
+    assert again[0]["title"] == first["title"] and again[0]["sections"] == first["sections"]
+    assert again[0]["executed"].cells == first["executed"].cells
+    assert again[0]["problems"].cells == first["problems"].cells

@@ -60,6 +60,16 @@ from ..schema import (
 )
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
+from .incremental import (
+    Stamps,
+    build_site,
+    code_key,
+    keep_section,
+    key,
+    print_changed_pdfs,
+    reused_section,
+    section_files,
+)
 from .pages import HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_index
 
 __all__ = [
@@ -585,12 +595,18 @@ def build(
     only: list | None = None,
     site: bool = True,
     pdfs: bool = True,
+    fresh: bool = False,
     log=print,
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
     ``index.html``, ``problems/`` and ``solutions/`` (HTML), ``workbooks/`` (.ipynb), and unless switched off
     ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.publish.lite.build_lite`) and ``pdf/`` (``pdfs``:
     every page printed by Chromium, :func:`kinlib.course.publish.printing.print_pdfs`); the pages link only what is built.
+
+    Incremental (:mod:`kinlib.course.publish.incremental`): a section whose notebook, kinlib code, pins and options
+    are those of the outputs already in ``out/`` is reused, not executed again (the log says "reused"); the site
+    and each PDF likewise. ``fresh`` forgets what was built and makes everything again. With ``only``, the other
+    sections already built and still current stay on the index.
 
     A folder without ``NN_*.ipynb`` notebooks is refused before anything is written:
 
@@ -611,9 +627,10 @@ def build(
     t0 = time.perf_counter()
     notebooks, out = Path(notebooks), Path(out)
     links = tuple(k for k, on in (("pdf", pdfs), ("lite", site)) if on)
-    paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
+    all_paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
+    paths = all_paths
     if only:
-        paths = [p for p in paths if any(p.stem.startswith(o) for o in only)]
+        paths = [p for p in all_paths if any(p.stem.startswith(o) for o in only)]
     if not paths:
         raise FileNotFoundError(f"no notebooks named NN_*.ipynb in {notebooks}")
     vendor = Path(vendor) if vendor else out.parent / "vendor"
@@ -623,15 +640,34 @@ def build(
         f"  assets: MathJax (jupyter-server-mathjax), require.js {REQUIREJS[1]}, "
         f"{HTML_MANAGER[0]} {HTML_MANAGER[1]} ({time.perf_counter() - t0:.1f} s)"
     )
+    stamps = Stamps(out)
+    if fresh:
+        stamps.clear()
+    options = {"verify": verify, "links": list(links), "urls": urls}
+    keys = {p: key(code_key(), p.read_bytes(), options) for p in all_paths}
     entries: dict = {}
-    if jobs <= 1:
-        for k, p in enumerate(paths, 1):
-            log(f"[{k}/{len(paths)}] {p.name} ...")
-            entries[p] = build_one(p, out, urls, timeout, verify, log, links)
+    todo = []
+    for p in paths:
+        entries[p] = reused_section(p, out, keys[p], stamps)
+        if entries[p] is None:
+            todo.append(p)
+        else:
+            log(f"  {p.stem}: reused (notebook, kinlib and pins unchanged since it was built)")
+
+    def make(p):
+        stamps.forget(f"section-{p.stem}")
+        entry = build_one(p, out, urls, timeout, verify, log, links)
+        keep_section(entry, out, keys[p], stamps)
+        return entry
+
+    if jobs <= 1 or len(todo) <= 1:
+        for k, p in enumerate(todo, 1):
+            log(f"[{k}/{len(todo)}] {p.name} ...")
+            entries[p] = make(p)
     else:
         with ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = {p: pool.submit(build_one, p, out, urls, timeout, verify, log, links) for p in paths}
-            log(f"  running {len(paths)} notebooks, {jobs} at a time")
+            futures = {p: pool.submit(make, p) for p in todo}
+            log(f"  running {len(todo)} notebooks, {jobs} at a time")
             try:
                 for p, f in futures.items():
                     entries[p] = f.result()
@@ -639,15 +675,17 @@ def build(
                 for f in futures.values():
                     f.cancel()
                 raise
-    write_index(out, [entries[p] for p in paths], links)
+    others = [p for p in all_paths if p not in entries]  # --only: sections built before and still current
+    listed = {
+        p: entries.get(p) or stamps.current(f"section-{p.stem}", keys[p], section_files(out, p.stem)) for p in all_paths
+    }
+    write_index(out, [listed[p] for p in all_paths if listed[p] is not None], links)
+    if others:
+        log(f"  index: {sum(listed[p] is not None for p in others)} other section(s) kept from earlier builds")
     if site:
-        from .lite import build_lite  # the notebooks in the browser (JupyterLite, offline): out/lite/
-
-        build_lite(out, paths, log=log)
+        build_site(out, paths, [keys[p] for p in paths], stamps, log)
     if pdfs:
-        from .printing import print_pdfs  # the PDFs of the pages (chromium, offline): out/pdf/
-
-        print_pdfs(out, log=log)
+        print_changed_pdfs(out, stamps, log)
     log(
         f"kinlib handouts: wrote {out / 'index.html'} and {3 * len(paths)} handouts in {time.perf_counter() - t0:.1f} s"
     )

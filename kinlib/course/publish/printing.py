@@ -282,9 +282,10 @@ def _print_all(jobs: list, log) -> list[Path]:
     return done
 
 
-def print_pdfs(out: Path, *, log=print) -> list[Path]:
-    """Print every ``out/problems/*.html`` and ``out/solutions/*.html`` to ``out/pdf/<kind>/<stem>.pdf``
-    (A4, margins :data:`MARGINS_MM`, content :func:`printable_width_px` CSS pixels wide); return the PDFs.
+def print_pdfs(out: Path, *, pages=None, log=print) -> list[Path]:
+    """Print every ``out/problems/*.html`` and ``out/solutions/*.html`` (or only ``pages``, a list of those
+    files) to ``out/pdf/<kind>/<stem>.pdf`` (A4, margins :data:`MARGINS_MM`, content :func:`printable_width_px`
+    CSS pixels wide); return the PDFs.
 
     One chromium (Debian's, :data:`CHROMIUM`) prints them all, offline. A folder with no pages gives no
     PDFs and starts no browser:
@@ -301,11 +302,9 @@ def print_pdfs(out: Path, *, log=print) -> list[Path]:
     'pdf/problems/01_properties_of_jacobians.pdf'
     """
     out = Path(out)
-    jobs = [
-        (src, out / "pdf" / kind / f"{src.stem}.pdf")
-        for kind in ("problems", "solutions")
-        for src in sorted((out / kind).glob("*.html"))
-    ]
+    if pages is None:
+        pages = [src for kind in ("problems", "solutions") for src in sorted((out / kind).glob("*.html"))]
+    jobs = [(Path(src), out / "pdf" / Path(src).parent.name / f"{Path(src).stem}.pdf") for src in pages]
     if not jobs:
         return []
     if not Path(CHROMIUM).exists():
