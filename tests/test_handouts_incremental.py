@@ -28,7 +28,7 @@ def fake_step(monkeypatch):
     """handouts.build_one replaced by a stand-in that writes the three handouts and records each call."""
     calls = []
 
-    def build_one(path, out, urls, timeout, verify, log=print, links=()):
+    def build_one(path, out, urls, timeout, verify, log=print, links=(), audience="all"):
         calls.append(path.stem)
         nb = nbformat.read(path, as_version=4)
         for kind in ("solutions", "problems"):

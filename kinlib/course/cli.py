@@ -80,7 +80,19 @@ def build_parser() -> argparse.ArgumentParser:
         "from the executed notebooks; every page works offline.",
     )
     h.add_argument("notebooks", type=Path, help="folder with the NN_*.ipynb notebooks")
-    h.add_argument("--out", type=Path, default=Path("build/handouts"), help="output folder (default build/handouts)")
+    h.add_argument(
+        "--out",
+        type=Path,
+        default=None,
+        help="output folder (default build/handouts, or build/handouts-students with --audience students)",
+    )
+    h.add_argument(
+        "--audience",
+        choices=("all", "students"),
+        default="all",
+        help="all: problems, solutions and workbooks (for instructors); students: no solution page, PDF or "
+        "notebook anywhere (the folder to publish to students)",
+    )
     h.add_argument("--vendor", type=Path, default=None, help="cache of npm packages (default: OUT/../vendor)")
     h.add_argument("--jobs", type=int, default=2, help="notebooks executed at once (default 2)")
     h.add_argument("--timeout", type=int, default=120, help="seconds allowed per cell (default 120)")
@@ -302,6 +314,8 @@ def _execute(args) -> int:
 def _handouts(args) -> int:
     from .publish.handouts import NotebookFailed, build
 
+    if args.out is None:
+        args.out = Path("build/handouts-students" if args.audience == "students" else "build/handouts")
     try:
         build(
             args.notebooks,
@@ -314,6 +328,7 @@ def _handouts(args) -> int:
             site=args.site,
             pdfs=args.pdfs,
             fresh=args.fresh,
+            audience=args.audience,
             log=lambda s: print(s, flush=True),
         )
     except NotebookFailed as e:  # names the notebook and the cell, with the cell's first lines

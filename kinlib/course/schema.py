@@ -8,7 +8,10 @@ The solution notebooks in ``notebooks/`` follow one structure, read here for bot
 * **cell tags** (``metadata.tags``): ``question`` (a markdown cell opening a graded part; "(N points)" in
   its text gives the points), ``solution`` (code cells computing the answers, markdown cells explaining
   them), ``check`` (cells testing the answers: removed from problems and workbooks), ``selfcheck``
-  (the workbook's self-check cells, written by ``kinlib handouts``);
+  (the workbook's self-check cells, written by ``kinlib handouts``); the reading aids (kept in problems and
+  workbooks; see ``notebooks/README.md``): ``objectives``, ``summary``, ``predict`` and its folded
+  ``predict-answer``, ``hint`` (folded), ``mistake`` (a callout) and ``given`` (text a student needs inside a
+  worked solution);
 * **cell metadata** ``metadata.kinlib`` of a ``solution`` code cell: ``part`` ("2.1"), ``answers``
   (the variable names graded), ``kinds`` ({name: "expr" | "set" | "subspace" | "choice"}; "default"
   is "expr"), ``properties`` ({name: "nonsingular"}: graded by that property, see :func:`grading_kind`),
@@ -33,6 +36,16 @@ __all__ = [
     "CHECK",
     "SELFCHECK",
     "ANSWER_TAGS",
+    "OBJECTIVES",
+    "SUMMARY",
+    "PREDICT",
+    "PREDICT_ANSWER",
+    "HINT",
+    "MISTAKE",
+    "GIVEN",
+    "FOLDED_TAGS",
+    "is_source_hidden",
+    "set_source_hidden",
     "KINDS",
     "SELFCHECK_MODULES",
     "cell_tags",
@@ -60,6 +73,11 @@ __all__ = [
 
 QUESTION, SOLUTION, CHECK, SELFCHECK = "question", "solution", "check", "selfcheck"
 ANSWER_TAGS = frozenset({SOLUTION, CHECK})
+# Reading aids (issue 21): kept in the problems and the workbooks. ``predict-answer``, ``hint`` and ``check``
+# cells are folded (source hidden in JupyterLab, inside <details> on the pages).
+OBJECTIVES, SUMMARY, PREDICT, PREDICT_ANSWER = "objectives", "summary", "predict", "predict-answer"
+HINT, MISTAKE, GIVEN = "hint", "mistake", "given"
+FOLDED_TAGS = frozenset({PREDICT_ANSWER, HINT, CHECK})
 KINDS = ("default", "expr", "choice", "set", "subspace")
 # the module a workbook's self-check cells import ``check`` from: today's, and those of workbooks handed out
 # before kinlib.course was laid out in folders (kinlib.course.selfcheck) or existed (kinlib.selfcheck)
@@ -85,6 +103,29 @@ def cell_tags(cell) -> list[str]:
     """
     tags = _metadata(cell).get("tags") or []
     return [str(t) for t in tags] if isinstance(tags, (list, tuple)) else []
+
+
+def is_source_hidden(cell) -> bool:
+    """Whether JupyterLab shows the cell folded (``metadata.jupyter.source_hidden``).
+
+    >>> is_source_hidden({"metadata": {"jupyter": {"source_hidden": True}}}), is_source_hidden({})
+    (True, False)
+    """
+    jup = _metadata(cell).get("jupyter")
+    return isinstance(jup, dict) and jup.get("source_hidden") is True
+
+
+def set_source_hidden(cell) -> None:
+    """Fold the cell in JupyterLab (``metadata.jupyter.source_hidden = True``).
+
+    >>> c = {"metadata": {}}
+    >>> set_source_hidden(c); c["metadata"]
+    {'jupyter': {'source_hidden': True}}
+    """
+    md = cell.setdefault("metadata", {})
+    jup = md.get("jupyter") if isinstance(md.get("jupyter"), dict) else {}
+    jup["source_hidden"] = True
+    md["jupyter"] = jup
 
 
 def cell_source(cell) -> str:

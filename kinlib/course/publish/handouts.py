@@ -23,6 +23,13 @@ For every ``notebooks/NN_*.ipynb`` (executed with nbclient, then exported with n
   filled in, and say "fix the answer above first" if they fail on a wrong one (``%%needs``,
   :mod:`kinlib.course.workbook.needs`); outputs cleared. Unless ``--no-verify``, each
   workbook is then run top to bottom (the stubs must not crash it);
+- the reading aids (``notebooks/README.md``) stay in the problems and the workbooks: objectives, summary,
+  ``predict`` questions with their folded ``predict-answer`` (one that gives a graded answer away becomes a
+  pointer to the part's self-check), folded ``hint`` steps, ``mistake`` callouts, ``given`` text; the pages fold
+  checks, answers and hints in ``<details>`` (:func:`kinlib.course.publish.pages.fold_cells`); under a stub of an
+  answer form a student may not know (a set, a choice, a subspace) the workbook shows how to write it;
+- ``reference/cheatsheet.html``: the cheat sheet ``notebooks/cheatsheet.md``;
+- with ``--audience students`` no solution page, PDF or notebook at all (the folder to publish to students);
 - ``index.html`` linking everything, and ``assets/``: MathJax 2 (copied from the installed
   ``jupyter-server-mathjax``), require.js and the ``@jupyter-widgets/html-manager`` embed bundle
   (``npm pack`` from the npm registry into ``build/vendor`` once, then reused), so every page
@@ -36,6 +43,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import json
+import shutil
 import subprocess
 import time
 from concurrent.futures import ThreadPoolExecutor
@@ -57,20 +65,13 @@ from ..schema import (
     cell_tags,
     notebook_sections,
     notebook_title,
+    set_source_hidden,
 )
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
+from .aids import stub, student_reading_aid
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
-from .incremental import (
-    Stamps,
-    build_site,
-    code_key,
-    keep_section,
-    key,
-    print_changed_pdfs,
-    reused_section,
-    section_files,
-)
-from .pages import HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_index
+from .incremental import Stamps, build_sections, build_site, code_key, key, print_changed_pdfs
+from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
 
 __all__ = [
     "build",
@@ -362,6 +363,7 @@ def make_problems(executed) -> tuple:
     for i, c in enumerate(nb.cells):
         if dropped_cell(i, c):
             continue  # answers, worked-solution steps, what is computed from answers and its caption
+        student_reading_aid(c)
         if c.cell_type == "code":
             _student_setup(c, used)  # the student's setup: not the imports that give the method away
             kept = [o for o in c.outputs if not _leaks(o, texts, images)]
@@ -381,22 +383,6 @@ def make_problems(executed) -> tuple:
 
 
 # ---------------------------------------------------------------------------------------------------
-
-
-def _stub(cell, describe: dict) -> str:
-    meta = cell_meta(cell)
-    part = cell_part(meta)
-    answers = cell_answers(meta)
-    words = meta.get("describe") if isinstance(meta.get("describe"), dict) else {}
-    lines = [
-        f"# Part {part}: your answer. Replace each ... below; the self-check further down says whether it is right."
-        if answers
-        else f"# Part {part}: your work here."
-    ]
-    for name in answers:
-        what = ", ".join(x for x in (words.get(name), describe.get(name)) if x)
-        lines.append(f"{name} = ...  # TODO: {what or 'your answer'} (part {part})")
-    return "\n".join(lines) + "\n"
 
 
 def _selfcheck_source(answers: list, fps: dict) -> str:
@@ -456,7 +442,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
         if SOLUTION in tags:
             if cell.cell_type == "code":
                 d = {name: describe.get((i, name), "") for name in cell_answers(meta)}
-                cell.source = _stub(cell, d)
+                cell.source = stub(cell, d)
             else:
                 cell.source = f"**Your answer (part {part}):** *write it here.*"
                 cell.pop("attachments", None)
@@ -468,6 +454,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
         elif i in narrative:
             pass
         else:
+            student_reading_aid(cell)
             if i in needs:
                 cell.source = f"%%needs {' '.join(needs[i])}\n" + cell.source
             else:
@@ -480,6 +467,7 @@ def make_workbook(source_nb, groups: list, fps: dict):
             f"%load_ext {SELFCHECK_MODULES[0]}\n# (cells marked %%needs run once the answers they use are filled in)"
         )
         setup.metadata["tags"] = ["workbook-setup"]
+        set_source_hidden(setup)  # machinery, not reading: folded (it still runs)
         first_code = next((k for k, c in enumerate(cells) if c.cell_type == "code"), len(cells))
         cells.insert(first_code, setup)
     nb.cells = cells
@@ -492,6 +480,7 @@ def _selfcheck_cell(group: Group, fps: dict, original):
     if original is not None and "kinlib" in original.metadata:
         cell.metadata["kinlib"] = copy.deepcopy(original.metadata["kinlib"])
     cell.metadata["tags"] = [SELFCHECK]
+    set_source_hidden(cell)  # the student reads its verdict, not its fingerprints and imports
     return cell
 
 
@@ -531,7 +520,12 @@ def run_workbook(path: Path, timeout: int = 120):
 # The job
 
 
-def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log=print, links=LINKS) -> dict:
+AUDIENCES = ("all", "students")  # all: problems, solutions, workbooks; students: no solution in any form
+
+
+def build_one(
+    path: Path, out: Path, urls: dict, timeout: int, verify: bool, log=print, links=LINKS, audience: str = "all"
+) -> dict:
     """Execute one notebook and write its three handouts; return its index entry.
 
     It runs the notebook (and, with ``verify``, the workbook) in a Jupyter kernel (seconds;
@@ -549,9 +543,15 @@ def build_one(path: Path, out: Path, urls: dict, timeout: int, verify: bool, log
     executed, groups, fps = execute_notebook(path, timeout)
     t_exec = time.perf_counter() - t0
     title = notebook_title(executed, stem.replace("_", " "))
-    export_html(
-        executed, out / "solutions" / f"{stem}.html", urls, title=f"{title} (solutions)", problems=False, links=links
-    )
+    if audience == "all":
+        export_html(
+            executed,
+            out / "solutions" / f"{stem}.html",
+            urls,
+            title=f"{title} (solutions)",
+            problems=False,
+            links=links,
+        )
     problems, notes = make_problems(executed)
     export_html(
         problems, out / "problems" / f"{stem}.html", urls, title=f"{title} (problems)", problems=True, links=links
@@ -596,12 +596,18 @@ def build(
     site: bool = True,
     pdfs: bool = True,
     fresh: bool = False,
+    audience: str = "all",
     log=print,
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
     ``index.html``, ``problems/`` and ``solutions/`` (HTML), ``workbooks/`` (.ipynb), and unless switched off
     ``lite/`` (``site``: the JupyterLite site, :func:`kinlib.course.publish.lite.build_lite`) and ``pdf/`` (``pdfs``:
     every page printed by Chromium, :func:`kinlib.course.publish.printing.print_pdfs`); the pages link only what is built.
+    ``reference/cheatsheet.html`` (and its PDF) is the one-page cheat sheet (``notebooks/cheatsheet.md``).
+
+    ``audience="students"`` leaves out every solution: no ``solutions/`` pages or PDFs, no solution notebooks
+    in the in-browser site, no link to them in the index (what a course publishes to its students; a
+    ``solutions/`` folder left in ``out`` by an earlier build is removed first).
 
     Incremental (:mod:`kinlib.course.publish.incremental`): a section whose notebook, kinlib code, pins and options
     are those of the outputs already in ``out/`` is reused, not executed again (the log says "reused"); the site
@@ -625,6 +631,8 @@ def build(
     ['02_planar_robot_jacobian']
     """
     t0 = time.perf_counter()
+    if audience not in AUDIENCES:
+        raise ValueError(f"audience: expected one of {', '.join(AUDIENCES)}, got {audience!r}")
     notebooks, out = Path(notebooks), Path(out)
     links = tuple(k for k, on in (("pdf", pdfs), ("lite", site)) if on)
     all_paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
@@ -634,7 +642,10 @@ def build(
     if not paths:
         raise FileNotFoundError(f"no notebooks named NN_*.ipynb in {notebooks}")
     vendor = Path(vendor) if vendor else out.parent / "vendor"
-    log(f"kinlib handouts: {len(paths)} notebook(s) from {notebooks} -> {out}")
+    log(f"kinlib handouts: {len(paths)} notebook(s) from {notebooks} -> {out} (for {audience})")
+    if audience == "students":  # nothing of an earlier full build may stay behind
+        for stale in (out / "solutions", out / "pdf" / "solutions"):
+            shutil.rmtree(stale, ignore_errors=True)
     urls = build_assets(out / "assets", vendor)
     log(
         f"  assets: MathJax (jupyter-server-mathjax), require.js {REQUIREJS[1]}, "
@@ -643,50 +654,29 @@ def build(
     stamps = Stamps(out)
     if fresh:
         stamps.clear()
-    options = {"verify": verify, "links": list(links), "urls": urls}
+    options = {"verify": verify, "links": list(links), "urls": urls, "audience": audience}
     keys = {p: key(code_key(), p.read_bytes(), options) for p in all_paths}
-    entries: dict = {}
-    todo = []
-    for p in paths:
-        entries[p] = reused_section(p, out, keys[p], stamps)
-        if entries[p] is None:
-            todo.append(p)
-        else:
-            log(f"  {p.stem}: reused (notebook, kinlib and pins unchanged since it was built)")
-
-    def make(p):
-        stamps.forget(f"section-{p.stem}")
-        entry = build_one(p, out, urls, timeout, verify, log, links)
-        keep_section(entry, out, keys[p], stamps)
-        return entry
-
-    if jobs <= 1 or len(todo) <= 1:
-        for k, p in enumerate(todo, 1):
-            log(f"[{k}/{len(todo)}] {p.name} ...")
-            entries[p] = make(p)
-    else:
-        with ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = {p: pool.submit(make, p) for p in todo}
-            log(f"  running {len(todo)} notebooks, {jobs} at a time")
-            try:
-                for p, f in futures.items():
-                    entries[p] = f.result()
-            except BaseException:
-                for f in futures.values():
-                    f.cancel()
-                raise
-    others = [p for p in all_paths if p not in entries]  # --only: sections built before and still current
-    listed = {
-        p: entries.get(p) or stamps.current(f"section-{p.stem}", keys[p], section_files(out, p.stem)) for p in all_paths
-    }
-    write_index(out, [listed[p] for p in all_paths if listed[p] is not None], links)
-    if others:
-        log(f"  index: {sum(listed[p] is not None for p in others)} other section(s) kept from earlier builds")
+    entries, listed = build_sections(
+        out,
+        all_paths,
+        paths,
+        keys,
+        stamps,
+        lambda p: build_one(p, out, urls, timeout, verify, log, links, audience),
+        jobs=jobs,
+        audience=audience,
+        log=log,
+    )
+    sheet = notebooks / CHEATSHEET
+    if sheet.exists():
+        write_cheatsheet(sheet, out / "reference" / "cheatsheet.html", urls, links=links)
+    write_index(out, listed, links, audience=audience, cheatsheet=sheet.exists())
     if site:
-        build_site(out, paths, [keys[p] for p in paths], stamps, log)
+        build_site(out, paths if audience == "all" else [], [keys[p] for p in paths], stamps, log)
     if pdfs:
         print_changed_pdfs(out, stamps, log)
     log(
-        f"kinlib handouts: wrote {out / 'index.html'} and {3 * len(paths)} handouts in {time.perf_counter() - t0:.1f} s"
+        f"kinlib handouts: wrote {out / 'index.html'} and {(3 if audience == 'all' else 2) * len(paths)} handouts "
+        f"in {time.perf_counter() - t0:.1f} s"
     )
-    return [entries[p] for p in paths]
+    return entries

@@ -31,6 +31,7 @@ import hashlib
 import json
 import shutil
 from collections.abc import Iterable
+from concurrent.futures import ThreadPoolExecutor
 from functools import lru_cache
 from pathlib import Path
 
@@ -38,18 +39,7 @@ import nbformat
 
 import kinlib
 
-__all__ = [
-    "STAMP_DIR",
-    "Stamps",
-    "build_site",
-    "code_key",
-    "file_key",
-    "keep_section",
-    "key",
-    "print_changed_pdfs",
-    "reused_section",
-    "section_files",
-]
+__all__ = ["STAMP_DIR", "Stamps", "build_sections", "build_site", "code_key", "key", "print_changed_pdfs"]
 
 #: the folder of ``out/`` that holds the stamps (not linked from any page; a static host may serve it: it holds
 #: only hashes, stems, titles and section numbers)
@@ -73,16 +63,15 @@ def key(*parts) -> str:
     return h.hexdigest()
 
 
-def file_key(path: Path) -> str:
-    """SHA-256 of a file's bytes."""
-    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
-
-
 @lru_cache(maxsize=1)
 def code_key() -> str:
     """One key for the code the handouts are made with: every source file of the kinlib package, by relative
     path and bytes, and the pinned environment (``environment.txt`` beside the package in a checkout; the
-    installed package's version otherwise). Computed once per process."""
+    installed package's version otherwise). Computed once per process.
+
+    >>> len(code_key()), code_key() == code_key()
+    (64, True)
+    """
     pkg = Path(kinlib.__file__).resolve().parent
     files = sorted(
         p for p in pkg.rglob("*") if p.is_file() and p.suffix in _CODE_SUFFIXES and "__pycache__" not in p.parts
@@ -98,7 +87,18 @@ def code_key() -> str:
 class Stamps:
     """The stamps of one output folder: ``current(name, key, files)`` gives what was recorded for ``name`` when
     it was made with ``key`` and every file in ``files`` still exists, else None; ``record(name, key, data)``
-    writes it (call it after the output is complete); ``clear()`` forgets everything (``--fresh``)."""
+    writes it (call it after the output is complete); ``clear()`` forgets everything (``--fresh``).
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     stamps = Stamps(Path(d))
+    ...     stamps.record("site", "k1", {"notebooks": 6})
+    ...     kept = stamps.current("site", "k1", []), stamps.current("site", "k1", [Path(d) / "missing.json"])
+    ...     stamps.clear()
+    ...     gone = stamps.current("site", "k1", [])
+    >>> kept, gone
+    (({'notebooks': 6}, None), None)
+    """
 
     def __init__(self, out: Path):
         self.dir = Path(out) / STAMP_DIR
@@ -134,10 +134,11 @@ class Stamps:
 # the steps of kinlib.course.publish.handouts.build that reuse what is current
 
 
-def section_files(out: Path, stem: str) -> list:
+def _section_files(out: Path, stem: str, audience: str = "all") -> list:
+    """The files a built section leaves in ``out`` (for students, no solutions page)."""
     kept = out / STAMP_DIR / stem
     return [
-        out / "solutions" / f"{stem}.html",
+        *([out / "solutions" / f"{stem}.html"] if audience == "all" else []),
         out / "problems" / f"{stem}.html",
         out / "workbooks" / f"{stem}.ipynb",
         kept / "executed.ipynb",
@@ -145,10 +146,10 @@ def section_files(out: Path, stem: str) -> list:
     ]
 
 
-def reused_section(path: Path, out: Path, k: str, stamps: Stamps) -> dict | None:
+def _reused_section(path: Path, out: Path, k: str, stamps: Stamps, audience: str = "all") -> dict | None:
     """The index entry of a section whose outputs were made from the same inputs (key ``k``), else None."""
     stem = path.stem
-    data = stamps.current(f"section-{stem}", k, section_files(out, stem))
+    data = stamps.current(f"section-{stem}", k, _section_files(out, stem, audience))
     if data is None:
         return None
     kept = out / STAMP_DIR / stem
@@ -161,7 +162,57 @@ def reused_section(path: Path, out: Path, k: str, stamps: Stamps) -> dict | None
     }
 
 
-def keep_section(entry: dict, out: Path, k: str, stamps: Stamps) -> None:
+def build_sections(out: Path, all_paths, paths, keys: dict, stamps: Stamps, make, *, jobs=1, audience="all", log=print):
+    """Reuse each section of ``paths`` that is current (its key in ``keys``), make the others with
+    ``make(path) -> entry`` (``jobs`` at a time) and record them; return the entries of ``paths``, in order, and
+    the index entries of every section of ``all_paths`` that is current (with ``--only``, the others built before).
+
+    :func:`kinlib.course.publish.handouts.build` passes its per-notebook step as ``make``; a second call with the same
+    keys makes nothing (tests/test_handouts_incremental.py runs both with a stand-in step):
+
+    >>> entries, listed = build_sections(Path("build/handouts"), paths, paths, keys, Stamps(out), make)  # doctest: +SKIP
+    """
+    entries: dict = {}
+    todo = []
+    for p in paths:
+        entries[p] = _reused_section(p, out, keys[p], stamps, audience)
+        if entries[p] is None:
+            todo.append(p)
+        else:
+            log(f"  {p.stem}: reused (notebook, kinlib and pins unchanged since it was built)")
+
+    def make_and_keep(p):
+        stamps.forget(f"section-{p.stem}")
+        entry = make(p)
+        _keep_section(entry, out, keys[p], stamps)
+        return entry
+
+    if jobs <= 1 or len(todo) <= 1:
+        for k, p in enumerate(todo, 1):
+            log(f"[{k}/{len(todo)}] {p.name} ...")
+            entries[p] = make_and_keep(p)
+    else:
+        with ThreadPoolExecutor(max_workers=jobs) as pool:
+            futures = {p: pool.submit(make_and_keep, p) for p in todo}
+            log(f"  running {len(todo)} notebooks, {jobs} at a time")
+            try:
+                for p, f in futures.items():
+                    entries[p] = f.result()
+            except BaseException:
+                for f in futures.values():
+                    f.cancel()
+                raise
+    listed = []
+    for p in all_paths:
+        current = entries.get(p) or stamps.current(f"section-{p.stem}", keys[p], _section_files(out, p.stem, audience))
+        if current is not None:
+            listed.append(current)
+    if len(listed) > len(paths):
+        log(f"  index: {len(listed) - len(paths)} other section(s) kept from earlier builds")
+    return [entries[p] for p in paths], listed
+
+
+def _keep_section(entry: dict, out: Path, k: str, stamps: Stamps) -> None:
     kept = out / STAMP_DIR / entry["stem"]
     kept.mkdir(parents=True, exist_ok=True)
     nbformat.write(entry["executed"], kept / "executed.ipynb")
@@ -170,7 +221,11 @@ def keep_section(entry: dict, out: Path, k: str, stamps: Stamps) -> None:
 
 
 def build_site(out: Path, paths: list, section_keys: list, stamps: Stamps, log) -> None:
-    """The JupyterLite site, rebuilt only when a workbook, a solution notebook or kinlib changed."""
+    """The JupyterLite site, rebuilt only when a workbook, a solution notebook or kinlib changed.
+
+    >>> build_site(Path("build/handouts"), paths, section_keys, Stamps(out), print)  # doctest: +SKIP
+      lite: reused (no workbook, solution notebook or kinlib file changed)
+    """
     from .lite import build_lite  # the notebooks in the browser (JupyterLite, offline): out/lite/
 
     workbooks = sorted((out / "workbooks").glob("[0-9][0-9]_*.ipynb"))
@@ -184,10 +239,14 @@ def build_site(out: Path, paths: list, section_keys: list, stamps: Stamps, log) 
 
 
 def print_changed_pdfs(out: Path, stamps: Stamps, log) -> None:
-    """The PDFs of the pages, each printed again only when its page (or kinlib) changed."""
-    from .printing import print_pdfs  # the PDFs of the pages (chromium, offline): out/pdf/
+    """The PDFs of the pages, each printed again only when its page (or kinlib) changed.
 
-    pages = [p for kind in ("problems", "solutions") for p in sorted((out / kind).glob("*.html"))]
+    >>> print_changed_pdfs(Path("build/handouts"), Stamps(Path("build/handouts")), print)  # doctest: +SKIP
+      pdf: 13 of 13 reused (their pages did not change)
+    """
+    from .printing import PAGE_KINDS, print_pdfs  # the PDFs of the pages (chromium, offline): out/pdf/
+
+    pages = [p for kind in PAGE_KINDS for p in sorted((out / kind).glob("*.html"))]
     keys = {p: key(code_key(), p.read_bytes()) for p in pages}
     pdf = {p: out / "pdf" / p.parent.name / f"{p.stem}.pdf" for p in pages}
     name = {p: f"pdf-{p.parent.name}-{p.stem}" for p in pages}

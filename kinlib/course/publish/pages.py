@@ -14,6 +14,7 @@ import shutil
 import time
 from pathlib import Path
 
+from ..schema import CHECK, HINT, MISTAKE, PREDICT, PREDICT_ANSWER, cell_tags
 from .lite import lite_link
 from .npm import npm_pack
 
@@ -21,6 +22,7 @@ __all__ = [
     "build_assets",
     "npm_pack",
     "export_html",
+    "fold_cells",
     "write_index",
     "LINKS",
     "print_header",
@@ -149,6 +151,7 @@ def export_html(nb, dest: Path, urls: dict, *, title: str, problems: bool, links
         raise RuntimeError(f"nbconvert's lab template changed: no {_REQUIRE_TAG} in {dest.name}")
     body = body.replace(_REQUIRE_TAG, _REQUIRE_TAG + "\n" + _WIDGET_PATHS, 1)
     body = _print_and_links(body, nb, dest, title=title, problems=problems, links=links)
+    body = fold_cells(body, nb, problems=problems)
     dest.parent.mkdir(parents=True, exist_ok=True)
     dest.write_text(body, encoding="utf-8")
 
@@ -214,11 +217,14 @@ def print_header(stem: str, title: str, problems: bool) -> str:
 
     >>> print_header("05_singularities_planar", "Singularities: the planar robot (solutions)", False)
     'Problem Set 4 · 5 Singularities: the planar robot — solutions'
+    >>> print_header("cheatsheet", "Cheat sheet", False)
+    'Problem Set 4 · Cheat sheet'
     """
     kind = "problems" if problems else "solutions"
     base = re.sub(r"\s*\((?:problems|solutions)\)\s*$", "", title)
-    number = f"{int(stem[:2])} " if stem[:2].isdigit() else ""
-    return f"{COURSE} · {number}{base} — {kind}"
+    if not stem[:2].isdigit():  # a reference page (the cheat sheet): neither problems nor solutions
+        return f"{COURSE} · {base}"
+    return f"{COURSE} · {int(stem[:2])} {base} — {kind}"
 
 
 def _plain(text: str) -> str:
@@ -304,6 +310,115 @@ def _print_and_links(body: str, nb, dest: Path, *, title: str, problems: bool, l
     return "".join(pieces).replace(_NO_ALT, f'alt="{html.escape("Figure in " + header)}"')
 
 
+# ---------------------------------------------------------------------------------------------------
+# The reading aids on the pages (notebooks/README.md): checks, predict-answers and hints folded in <details>,
+# common mistakes as a callout box.
+
+_FOLD_CSS = """<style>/* kinlib: folded cells (checks, answers to predictions, hints) and callouts */
+details.kinlib-fold { margin: .4rem 0 .6rem; border-left: 3px solid #8a8a8a; padding: .1rem 0 .1rem .6rem; }
+details.kinlib-fold > summary { cursor: pointer; font: 600 14px/1.6 system-ui, sans-serif; color: #1f4f7a; }
+details.kinlib-predict-answer { border-left-color: #2e7d32; } details.kinlib-hint { border-left-color: #b26a00; }
+.kinlib-predict .jp-RenderedMarkdown { background: #eef6ee; border-radius: 4px; padding: .2rem .6rem; }
+.kinlib-mistake { border: 2px solid #b3261e; border-radius: 6px; background: #fdf1f0; margin: .5rem 0;
+  padding: .2rem .6rem; }
+</style>
+<script>
+/* Open every folded cell for printing (and when printed from the browser); typeset the maths of a folded
+   cell again when it is opened (MathJax 2 cannot measure what is hidden). */
+(function () {
+  function openAll() { document.querySelectorAll("details.kinlib-fold").forEach(function (d) { d.open = true; }); }
+  document.addEventListener("DOMContentLoaded", function () {
+    if (window.matchMedia && window.matchMedia("print").matches) { openAll(); }
+  });
+  window.addEventListener("beforeprint", openAll);
+  document.addEventListener("click", function (e) {  /* a reader's click (or Enter) on a summary, not the parser */
+    var s = e.target && e.target.closest ? e.target.closest("details.kinlib-fold > summary") : null;
+    if (!s) { return; }
+    setTimeout(function () {
+      var d = s.parentNode;
+      if (d.open && window.MathJax && MathJax.Hub) { MathJax.Hub.Queue(["Rerender", MathJax.Hub, d]); }
+    }, 0);
+  });
+})();
+</script>
+"""
+_CELL_START = re.compile(r'<div class="jp-Cell [^"]*" id="cell-id=([^"]*)">')
+_SUMMARIES = {
+    CHECK: "How we know this is right",
+    PREDICT_ANSWER: "Show the answer",
+    HINT: "Hint",
+}
+
+
+def fold_cells(body: str, nb, *, problems: bool) -> str:
+    """The page ``body`` with its reading aids laid out (cells found by their ``cell-id``): ``check`` cells
+    folded in ``<details><summary>How we know this is right</summary>``, ``predict-answer`` cells in
+    "Show the answer", ``hint`` cells in "Hint" (folded on problem pages, open on solution pages),
+    ``mistake`` cells in a "Common mistake" callout box, ``predict`` cells highlighted.
+
+    >>> import nbformat
+    >>> from nbconvert import HTMLExporter
+    >>> a = nbformat.v4.new_markdown_cell("It is $x$.", id="a")
+    >>> a.metadata["tags"] = ["predict-answer"]
+    >>> nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell("Guess?", id="q"), a])
+    >>> page = fold_cells(HTMLExporter(template_name="lab").from_notebook_node(nb)[0], nb, problems=True)
+    >>> "<summary>Show the answer</summary>" in page, page.index("Guess?") < page.index("<details") < page.index("It is")
+    (True, True)
+    """
+    kinds, titles = {}, {}
+    for c in nb.cells:
+        tags = set(cell_tags(c))
+        for tag in (CHECK, PREDICT_ANSWER, HINT, MISTAKE, PREDICT):
+            if tag in tags and c.get("id"):
+                kinds[c["id"]] = tag
+                bold = re.match(r"\s*\*\*(.+?)\*\*", c.get("source", "")) if c.get("cell_type") == "markdown" else None
+                if tag == HINT and bold:  # "Hint: Step 1: the screw axes", from the cell's bold lead
+                    titles[c["id"]] = "Hint: " + html.escape(bold.group(1).strip().rstrip(".:"))
+                break
+    if not kinds:
+        return body
+    main_end = body.rfind("</main>")
+    if main_end < 0:
+        raise RuntimeError("nbconvert's lab template changed: no </main>")
+    starts = [(m.start(), m.group(1)) for m in _CELL_START.finditer(body, 0, main_end)]
+    out, pos = [], 0
+    for k, (start, cid) in enumerate(starts):
+        end = starts[k + 1][0] if k + 1 < len(starts) else main_end
+        kind = kinds.get(html.unescape(cid))
+        if kind is None:
+            continue
+        cell = body[start:end].rstrip()
+        out.append(body[pos:start])
+        if kind in _SUMMARIES:
+            opened = " open" if kind == HINT and not problems else ""
+            out.append(
+                f'<details class="kinlib-fold kinlib-{kind}"{opened}>'
+                f"<summary>{titles.get(html.unescape(cid), _SUMMARIES[kind])}</summary>\n"
+                f"{cell}\n</details>\n"
+            )
+        else:
+            out.append(f'<div class="kinlib-{kind}" role="note">\n{cell}\n</div>\n')
+        pos = end
+    out.append(body[pos:])
+    body = "".join(out)
+    return body.replace("</head>", _FOLD_CSS + "</head>", 1)
+
+
+_INTRO_TAIL = """the <strong>workbook</strong>, a Jupyter notebook to fill
+in with self-checks, to download or to <strong>open in the browser</strong> (JupyterLite: Python runs in the
+browser tab, nothing to install; it needs this folder served over http, for example by <code>make site</code>
+or any static web host, and its first start takes a while).</p>"""
+_INTRO_ALL = (
+    """<p>For each notebook of the course: the <strong>problems</strong> (questions, no answers) and the worked
+<strong>solutions</strong>, as web pages and as PDFs; """
+    + _INTRO_TAIL
+)
+_INTRO_STUDENTS = (
+    """<p>For each notebook of the course: the <strong>problems</strong> (questions, no answers), as a web page
+and as a PDF; """
+    + _INTRO_TAIL
+)
+
 _INDEX = """<!DOCTYPE html>
 <html lang="en"><head><meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
@@ -320,11 +435,7 @@ ul.links {{ margin: .2rem 0; padding-left: 1.2rem; }} ul.links li {{ margin: .15
 </style></head><body>
 <header>
 <h1>{course}: Jacobians, singularities and manipulability</h1>
-<p>For each notebook of the course: the <strong>problems</strong> (questions, no answers) and the worked
-<strong>solutions</strong>, as web pages and as PDFs; the <strong>workbook</strong>, a Jupyter notebook to fill
-in with self-checks, to download or to <strong>open in the browser</strong> (JupyterLite: Python runs in the
-browser tab, nothing to install; it needs this folder served over http, for example by <code>make site</code>
-or any static web host, and its first start takes a while).</p>
+{intro}
 <p>These pages load nothing from the internet: every script, font and picture is in this folder.</p>
 </header>
 <main>
@@ -335,12 +446,53 @@ or any static web host, and its first start takes a while).</p>
 """
 
 
-def write_index(out: Path, entries: list, links=LINKS) -> None:
+CHEATSHEET = "cheatsheet.md"  # in the notebooks folder: the one-page cheat sheet, built to reference/cheatsheet.html
+
+
+def write_cheatsheet(src: Path, dest: Path, urls: dict, *, links=LINKS) -> None:
+    """The cheat sheet ``src`` (markdown with LaTeX maths) as a page ``dest`` (``reference/cheatsheet.html``),
+    with the same assets, print header and links bar as the handouts (its PDF: ``pdf/reference/``).
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = (Path(d) / "c.md").write_text("# Cheat sheet\\n\\n$J_b = J_s$")
+    ...     write_cheatsheet(Path(d) / "c.md", Path(d) / "reference" / "cheatsheet.html", {}, links=("pdf",))
+    ...     page = (Path(d) / "reference" / "cheatsheet.html").read_text()
+    >>> "<title>Cheat sheet</title>" in page, "../pdf/reference/cheatsheet.pdf" in page
+    (True, True)
+    """
+    import nbformat
+
+    text = Path(src).read_text(encoding="utf-8")
+    m = re.search(r"^#\s+(.+)$", text, re.M)
+    title = m.group(1).strip() if m else "Cheat sheet"
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_markdown_cell(text, id="cheatsheet")])
+    urls = {"require_js_url": "../assets/require.js", **urls}
+    export_html(nb, dest, urls, title=title, problems=False, links=tuple(k for k in links if k == "pdf"))
+    page = dest.read_text(encoding="utf-8")
+    dest.write_text(page.replace("</head>", _CHEATSHEET_PRINT + "</head>", 1), encoding="utf-8")
+
+
+# The cheat sheet prints on one A4 page: smaller type and tighter headings than a handout.
+_CHEATSHEET_PRINT = """<style>/* kinlib: the cheat sheet on one printed page */
+@media print {
+  .jp-RenderedHTMLCommon { font-size: 10.5px !important; line-height: 1.32 !important; }
+  .jp-RenderedHTMLCommon h1 { font-size: 17px !important; margin: 0 0 4px !important; }
+  .jp-RenderedHTMLCommon h2 { font-size: 13.5px !important; margin: 8px 0 3px !important; }
+  .jp-RenderedHTMLCommon p, .jp-RenderedHTMLCommon ul { margin-top: 2px !important; margin-bottom: 3px !important; }
+  .jp-RenderedHTMLCommon li { margin: 1px 0 !important; }
+}
+</style>
+"""
+
+
+def write_index(out: Path, entries: list, links=LINKS, *, audience: str = "all", cheatsheet: bool = False) -> None:
     """Write ``out/index.html``, the course front page: for each entry (a section of the course) its
     problems and solutions (web page and PDF), its workbook (download, and "open in the browser" with
     JupyterLite) and its solution notebook in the browser (``links``: which of ``("pdf", "lite")`` were built; the
     others are left out). Offline (no external URL), ``lang="en"``, one h1
-    then an h2 per section, link texts that name the section and the target.
+    then an h2 per section, link texts that name the section and the target. ``audience="students"``: no
+    solution links (the solutions are not built); ``cheatsheet``: a link to ``reference/cheatsheet.html``.
 
     >>> import tempfile
     >>> with tempfile.TemporaryDirectory() as d:
@@ -351,6 +503,19 @@ def write_index(out: Path, entries: list, links=LINKS) -> None:
     """
     rows = []
     pdf, lite = "pdf" in links, "lite" in links
+    solutions = audience != "students"
+    if cheatsheet:
+        rows.append(
+            '<section aria-labelledby="sref"><h2 id="sref">Cheat sheet</h2>\n<ul class="links">\n'
+            '<li><a href="reference/cheatsheet.html">Cheat sheet: J_s, J_b and J; singularities; manipulability '
+            "(web page)</a>"
+            + (
+                '<span class="sep" aria-hidden="true">·</span><a href="pdf/reference/cheatsheet.pdf">Cheat sheet (PDF)</a>'
+                if pdf
+                else ""
+            )
+            + "</li>\n</ul></section>"
+        )
     for e in entries:
         stem = e["stem"]
         num = str(int(stem[:2])) if stem[:2].isdigit() else stem
@@ -368,14 +533,18 @@ def write_index(out: Path, entries: list, links=LINKS) -> None:
             + f"<li>{a(f'problems/{stem}.html', f'Problems {num} (web page)')}"
             + (f"{sep}{a(f'pdf/problems/{stem}.pdf', f'Problems {num} (PDF)')}" if pdf else "")
             + "</li>\n"
-            + f"<li>{a(f'solutions/{stem}.html', f'Solutions {num} (web page)')}"
-            + (f"{sep}{a(f'pdf/solutions/{stem}.pdf', f'Solutions {num} (PDF)')}" if pdf else "")
             + (
-                f"{sep}{a(lite_link(f'solutions/{stem}.ipynb'), f'Solutions {num}: open the notebook in the browser')}"
-                if lite
+                f"<li>{a(f'solutions/{stem}.html', f'Solutions {num} (web page)')}"
+                + (f"{sep}{a(f'pdf/solutions/{stem}.pdf', f'Solutions {num} (PDF)')}" if pdf else "")
+                + (
+                    f"{sep}{a(lite_link(f'solutions/{stem}.ipynb'), f'Solutions {num}: open the notebook in the browser')}"
+                    if lite
+                    else ""
+                )
+                + "</li>\n"
+                if solutions
                 else ""
             )
-            + "</li>\n"
             + f"<li>{a(f'workbooks/{stem}.ipynb', f'Workbook {num} (download .ipynb)', ' download')}"
             + (
                 f"{sep}{a(lite_link(f'workbooks/{stem}.ipynb'), f'Workbook {num}: open in the browser')}"
@@ -385,7 +554,8 @@ def write_index(out: Path, entries: list, links=LINKS) -> None:
             + "</li>\n"
             "</ul></section>"
         )
+    intro = _INTRO_ALL if solutions else _INTRO_STUDENTS
     (out / "index.html").write_text(
-        _INDEX.format(rows="\n".join(rows), when=time.strftime("%Y-%m-%d"), course=html.escape(COURSE)),
+        _INDEX.format(rows="\n".join(rows), when=time.strftime("%Y-%m-%d"), course=html.escape(COURSE), intro=intro),
         encoding="utf-8",
     )
