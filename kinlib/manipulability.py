@@ -21,7 +21,15 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ._backend import as_vector, describe, exact_jacobian, is_symbolic, numeric_jacobian, numeric_vectors
+from ._backend import (
+    as_vector,
+    describe,
+    exact_jacobian,
+    is_symbolic,
+    nested_shape,
+    numeric_jacobian,
+    numeric_vectors,
+)
 from .exact import exact_det
 from .exactfield import decide_zero
 from .singularities import trig_simplify
@@ -194,10 +202,63 @@ def _sqrt_form(ring, p) -> sp.Expr:
     return outside * sp.sqrt(inside)
 
 
+def _extreme_singular_values(A: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(σ_max, σ_min) of a float J or batch, with σ_min = 0 exactly when, and only when, J is exactly singular.
+
+    LAPACK's σ_min of a rank-deficient J is rounding noise (≈ 1e-17 σ_max for [[1, 1], [1, 1]]), and a
+    nonsingular J may be ill-conditioned (diag(1e300, 1)): where σ_min ≤ k·eps·σ_max (numerically singular),
+    J's rank is decided exactly on its floats as the exact binary fractions they are (fraction-free
+    elimination): rank-deficient → σ_min = 0; otherwise LAPACK's σ_min stands (so κ agrees with
+    ``numpy.linalg.cond`` for every J that is not exactly singular; no hidden cut-off).
+    """
+    s = np.linalg.svd(A, compute_uv=False)
+    smax, smin = s[..., 0].copy(), s[..., -1].copy()
+    k = s.shape[-1]
+    suspect = np.flatnonzero(np.reshape(smin <= 4 * k * np.finfo(float).eps * smax, -1))
+    if suspect.size:
+        flat_min = smin.reshape(-1)
+        mats = A.reshape((-1,) + A.shape[-2:])
+        for i in suspect:
+            if _exact_rank(mats[i]) < k:
+                flat_min[i] = 0.0
+        smin = flat_min.reshape(smin.shape)
+    return smax, smin
+
+
+def _exact_rank(A: np.ndarray) -> int:
+    """The exact rank of a float matrix (its entries as exact binary fractions), by integer elimination."""
+    from fractions import Fraction
+
+    rows = [[Fraction(float(x)) for x in row] for row in A]
+    if not rows or not rows[0]:
+        return 0
+    scale = 1
+    for row in rows:
+        for x in row:
+            scale = max(scale, x.denominator)  # powers of two: the largest is a common denominator
+    M = [[int(x * scale) for x in row] for row in rows]
+    rank, ncols = 0, len(M[0])
+    for c in range(ncols):
+        piv = next((r for r in range(rank, len(M)) if M[r][c]), None)
+        if piv is None:
+            continue
+        M[rank], M[piv] = M[piv], M[rank]
+        p = M[rank]
+        for r in range(rank + 1, len(M)):
+            f = M[r][c]
+            if f:
+                M[r] = [p[c] * a - f * b for a, b in zip(M[r], p)]
+        rank += 1
+    return rank
+
+
 def condition_number(J: Any):
     """κ = σ_max / σ_min (≥ 1; ∞ at a singular configuration), over the k = min(m, n) singular values.
 
-    Numeric J (or a batch): floats. SymPy J: exact, from the k×k Gram matrix G = J Jᵀ (or Jᵀ J) with
+    Numeric J (or a batch): floats, σ_max/σ_min as ``numpy.linalg.cond`` with no cut-off (diag(1, 1e-12) →
+    1e12, diag(1e300, 1) → 1e300); ∞ exactly when J is exactly singular, i.e. its floats (as the exact binary
+    fractions they are) have rank < k ([[1, 1], [1, 1]], a zero column). A configuration singular only up to
+    rounding (θ2 = np.pi, where sin θ2 is 1.2e-16) gives a large finite κ (≈ 1e16), as NumPy does. SymPy J: exact, from the k×k Gram matrix G = J Jᵀ (or Jᵀ J) with
     eigenvalues λ = σ²: for k = 2, κ = √(λ₊/λ₋) = (t + √(t² − 4d)) / (2√d) with t = trace G, d = det G
     (trig-simplified; d = 0 exactly at the singular configurations, where κ = ∞ — SymPy gives zoo);
     k = 1 gives 1; with no free symbols the exact eigenvalues of the constant G; k ≥ 3 with free joint
@@ -211,10 +272,9 @@ def condition_number(J: Any):
     (Abs(cos(t)) + 1)/Abs(sin(t))
     """
     if not is_symbolic(J):
-        s = np.linalg.svd(numeric_jacobian(J), compute_uv=False)
-        smax, smin = s[..., 0], s[..., -1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            out = np.where(smin > 1e-12 * np.maximum(smax, 1e-300), smax / np.where(smin > 0, smin, 1), np.inf)
+        smax, smin = _extreme_singular_values(numeric_jacobian(J))
+        with np.errstate(divide="ignore", over="ignore"):
+            out = np.where(smin > 0, smax / np.where(smin > 0, smin, 1.0), np.inf)
         return float(out) if np.ndim(out) == 0 else out
     parts = _kappa_parts(J, "condition_number")
     if parts[0] == "one":
@@ -227,6 +287,9 @@ def condition_number(J: Any):
 def isotropy(J: Any):
     """1/κ = σ_min / σ_max ∈ [0, 1]: 1 when the velocity ellipsoid is a sphere (circle), 0 at a singularity.
 
+    Numeric J: σ_min/σ_max with no cut-off (diag(1, 1e-12) → 1e-12, diag(1e300, 1) → 1e-300); 0 exactly when J
+    is exactly singular (see :func:`condition_number`).
+
     SymPy J as for :func:`condition_number`: for k = 2, 2√d / (t + √(t² − 4d)) (0 where d = det G = 0).
 
     >>> import sympy as sp
@@ -234,11 +297,9 @@ def isotropy(J: Any):
     1/2
     """
     if not is_symbolic(J):
-        s = np.linalg.svd(numeric_jacobian(J), compute_uv=False)
-        smax, smin = s[..., 0], s[..., -1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ratio = smin / np.where(smax > 0, smax, 1)
-            out = np.where((smax > 0) & (ratio > 1e-12), ratio, 0.0)
+        smax, smin = _extreme_singular_values(numeric_jacobian(J))
+        with np.errstate(under="ignore"):
+            out = np.where(smin > 0, smin / np.where(smax > 0, smax, 1.0), 0.0)
         return float(out) if np.ndim(out) == 0 else out
     parts = _kappa_parts(J, "isotropy")
     if parts[0] == "one":
@@ -434,8 +495,9 @@ def strongest_joints(row: Any, tol: float = 1e-9):
     elif isinstance(row, (str, bytes)) or not hasattr(row, "__len__"):
         raise TypeError(f"row must be the n entries of one row of J, got {describe(row)}")
     else:
+        nested_shape(row, "row")  # a ragged list is named as such
         arr = np.asarray(row, dtype=object)
-        if arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
+        if arr.ndim == 0 or arr.ndim > 2 or (arr.ndim == 2 and 1 not in arr.shape):
             raise ValueError(f"row must be the n entries of one row of J, got {describe(row)}")
         vals = list(arr.reshape(-1))
     if not vals:

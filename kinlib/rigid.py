@@ -6,6 +6,7 @@ SymPy Matrix) or numeric input (a NumPy float array).
 
 from __future__ import annotations
 
+import math
 import random
 
 import numpy as np
@@ -87,7 +88,12 @@ def unskew(W):
     >>> unskew(skew([4.0, 5.0, 6.0])).tolist()
     [4.0, 5.0, 6.0]
     """
-    W = as_matrix(W, "W", (3, 3))
+    return skew_vector(W, "W")
+
+
+def skew_vector(W, name: str):
+    """:func:`unskew` with the argument's name for the messages (``unbracket`` passes "the upper-left 3×3 of X")."""
+    W = as_matrix(W, name, (3, 3))
     symbolic = isinstance(W, sp.MatrixBase)
     bad = (
         (not all(decide_zero(W[i, j] + W[j, i]) for i in range(3) for j in range(i, 3)))
@@ -95,7 +101,8 @@ def unskew(W):
         else not np.allclose(W, -W.T, atol=_TOL)
     )
     if bad:
-        raise ValueError(f"W must be skew-symmetric (W = -Wᵀ), got {W.tolist()}")
+        rel = f"{name} = -{name}ᵀ" if name.isidentifier() else "equal to minus its transpose"
+        raise ValueError(f"{name} must be skew-symmetric ({rel}), got {W.tolist()}")
     v = [W[2, 1], W[0, 2], W[1, 0]]
     return sp.Matrix(v) if symbolic else np.array(v, dtype=float)
 
@@ -142,6 +149,31 @@ def check_unit_vector(omega, name: str):
     return omega
 
 
+#: θ − sin θ = θ³/3! − θ⁵/5! + … (Horner, in θ²): the coefficients 1/3!, −1/5!, …, −1/17!; below |θ| = 1
+#: the first omitted term is under 1e-16 of the sum
+_T_SIN = [(-1) ** k / math.factorial(2 * k + 3) for k in range(8)]
+
+
+def rodrigues_coefficients(theta: float) -> tuple[float, float, float]:
+    """(sin θ, 1 − cos θ, θ − sin θ), each to a few ulps of itself: 1 − cos θ = 2 sin²(θ/2) and, for |θ| < 1,
+    θ − sin θ by its series (both differences cancel for small θ: at θ = 1e-8, 1 − cos θ in floats is 0, not
+    5e-17, which a screw's large v turns into a visible error).
+
+    >>> [f"{x:.15g}" for x in rodrigues_coefficients(1e-8)[1:]]
+    ['5e-17', '1.66666666666667e-25']
+    """
+    s = math.sin(theta)
+    h = math.sin(0.5 * theta)
+    if abs(theta) < 1.0:
+        t2, acc = theta * theta, 0.0
+        for c in reversed(_T_SIN):
+            acc = acc * t2 + c
+        t_s = acc * t2 * theta
+    else:
+        t_s = theta - s
+    return s, 2.0 * h * h, t_s
+
+
 def exp3(omega, theta):
     """Rodrigues: e^{[ω]θ} = I + sin θ [ω] + (1 − cos θ) [ω]², for a unit axis ω.
 
@@ -161,7 +193,8 @@ def exp3(omega, theta):
     W = skew(omega)
     if symbolic:
         return sp.eye(3) + sp.sin(theta) * W + (1 - sp.cos(theta)) * W * W
-    return np.eye(3) + np.sin(theta) * W + (1.0 - np.cos(theta)) * (W @ W)
+    s, one_c, _ = rodrigues_coefficients(theta)
+    return np.eye(3) + s * W + one_c * (W @ W)
 
 
 def rp_to_trans(R, p):
@@ -334,12 +367,15 @@ def _log3_numeric(A: np.ndarray):
         col = B[np.arange(len(k)), :, k]
         w = col / np.linalg.norm(col, axis=-1)[:, None]  # ω̂ up to sign, ω̂_k > 0
         d = np.einsum("ij,ij->i", w, ax[big])  # = sin θ (ω̂·ω̂) with the right sign
-        # at θ = π (to rounding) either sign is a logarithm: Modern Robotics' choice, the first of
+        # d's rounding error is below eps (each entry of A within eps/2 of the rotation's): its sign is
+        # the branch whenever |d| > 2 eps (so π − 1e-15 about −z gives −z). Below that, θ = π to rounding and
+        # either sign is a logarithm (|e^{[ω̂]θ} − R| ≤ 2|d|): Modern Robotics' choice, the first of
         # ω̂_3, ω̂_2, ω̂_1 with 1 + r_kk = 2ω̂_k² not near 0 (|·| ≥ 1e-6, its NearZero) is positive
         diag1 = 1.0 + np.diagonal(Ab, axis1=1, axis2=2)
         kk = np.where(diag1[:, 2] >= 1e-6, 2, np.where(diag1[:, 1] >= 1e-6, 1, 0))
         mr_sign = np.sign(w[np.arange(len(kk)), kk])
-        sign = np.where(d > 1e-14, 1.0, np.where(d < -1e-14, -1.0, np.where(mr_sign == 0, 1.0, mr_sign)))
+        tiny = 2 * np.finfo(float).eps
+        sign = np.where(d > tiny, 1.0, np.where(d < -tiny, -1.0, np.where(mr_sign == 0, 1.0, mr_sign)))
         vec[big] = (sign * theta[big])[:, None] * w
     axis = np.where((theta > 0)[:, None], vec / np.where(theta > 0, theta, 1.0)[:, None], [0.0, 0.0, 1.0])
     return vec, axis, theta

@@ -287,7 +287,9 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
     vector, the whole chain rational (no sin(314159/100000) inside every entry, which would make
     the symbolic work heavy), and its numbers equal the URDF's to rounding. The numbers are long
     (1.5708 is not π/2: nothing is guessed); for exact right angles give SymPy angles (``sp.pi/2``),
-    whose cosine and sine are used as they are; SymPy symbols in xyz make a symbolic chain.
+    whose cosine and sine are used as they are; SymPy symbols in xyz make a symbolic chain. The chain keeps the
+    placements (``SerialChain(placements=...)``): its generated numeric code multiplies the URDF's constant
+    placements, folded into floats, and rotations about the axes as typed, like Pinocchio.
 
     >>> arm = from_urdf_joints([("revolute", (0, 0, 0.1), (0, 0, 0), (0, 0, 1)),
     ...                         ("revolute", (0, 0, 0.2), (sp.pi / 2, 0, 0), (0, 0, 1))],
@@ -307,6 +309,7 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
         raise TypeError(f"joints must be a list of (type, xyz, rpy, axis) tuples, got {describe(joints)}")
     R, p = sp.eye(3), sp.zeros(3, 1)
     screws, points = [], []
+    C, axes, rel = [], [], sp.eye(4)  # the placements (SerialChain's ``placements``): C_i, â_i
     if tool is not None and (not isinstance(tool, (list, tuple)) or len(tool) != 2):
         raise ValueError(f"tool must be (xyz, rpy) or None, got {describe(tool)}")
     steps = list(enumerate(joints)) + ([(len(joints), ("fixed", tool[0], tool[1], None))] if tool is not None else [])
@@ -317,15 +320,22 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
         kind, xyz, rpy, axis = joint
         if kind not in _URDF_KINDS:
             raise ValueError(f"{where} type must be one of {sorted(_URDF_KINDS)}, got {kind!r}")
-        p = p + R * sp.Matrix(_urdf_triple(xyz, f"{where} xyz"))
-        R = R * _urdf_rotation(rpy, where)
+        step_p = sp.Matrix(_urdf_triple(xyz, f"{where} xyz"))
+        step_R = _urdf_rotation(rpy, where)
+        p = p + R * step_p
+        R = R * step_R
+        rel = rel * sp.Matrix.vstack(sp.Matrix.hstack(step_R, step_p), sp.Matrix([[0, 0, 0, 1]]))
         if _URDF_KINDS[kind] is None:
             continue
         a = sp.Matrix(_urdf_triple(axis, f"{where} axis"))
         n2 = (a.T * a)[0]
         if n2 == 0:
             raise ValueError(f"{where} axis must be a nonzero vector, got {list(a)}")
-        w = R * (a if n2 == 1 else a / sp.sqrt(n2))
+        a = a if n2 == 1 else a / sp.sqrt(n2)
+        w = R * a
+        C.append(rel)
+        axes.append(a)
+        rel = sp.eye(4)
         screws.append(list(w) + list(-w.cross(p)) if _URDF_KINDS[kind] == "R" else [0, 0, 0] + list(w))
         points.append(p)
     if not screws:
@@ -337,6 +347,7 @@ def from_urdf_joints(joints, tool=None, *, name: str = "urdf_chain", description
         name=name,
         joint_points=sp.Matrix.hstack(*points),
         description=description or f"{len(screws)}-joint arm from URDF joint placements",
+        placements=(C + [rel], axes),
     )
 
 

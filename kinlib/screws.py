@@ -12,7 +12,7 @@ import sympy as sp
 from ._backend import as_matrix, as_scalar, as_vector, check_real_finite, describe, exact_number, is_symbolic
 from .display import is_identically_zero
 from .exactfield import decide_zero
-from .rigid import check_se3, check_unit_vector, cross, log3, skew, unskew
+from .rigid import check_se3, check_unit_vector, cross, log3, rodrigues_coefficients, skew, skew_vector
 
 __all__ = [
     "screw_revolute",
@@ -97,7 +97,7 @@ def unbracket(X):
     Matrix([[0, 0, 1, 1, 2, 3]])
     """
     X = as_matrix(X, "X", (4, 4))
-    w = unskew(X[:3, :3])
+    w = skew_vector(X[:3, :3], "X's upper-left 3×3 block")
     if isinstance(X, sp.MatrixBase):
         if not all(decide_zero(e) for e in X[3, :]):
             raise ValueError(f"X must be in se(3) with last row 0, got last row {list(X[3, :])}")
@@ -176,9 +176,9 @@ def exp6_unchecked(S, theta, kind: str, symbolic: bool):
         return T
     W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
     W2 = W @ W
-    s, c = np.sin(theta), np.cos(theta)
-    T[:3, :3] += s * W + (1.0 - c) * W2
-    T[:3, 3] = (theta * v) + (1.0 - c) * (W @ v) + (theta - s) * (W2 @ v)
+    s, one_c, t_s = rodrigues_coefficients(float(theta))
+    T[:3, :3] += s * W + one_c * W2
+    T[:3, 3] = (theta * v) + one_c * (W @ v) + t_s * (W2 @ v)
     return T
 
 

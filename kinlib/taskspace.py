@@ -115,6 +115,10 @@ def task_row_indices(rows: Any, default: Any = None, m: int = 6) -> tuple[int, .
         if default is None:
             return tuple(range(m))
         return task_row_indices(default, None, m)
+    if isinstance(rows, np.ndarray) and rows.ndim == 0:
+        raise TypeError(
+            f"rows must be {_HINT}; got a 0-d array {rows!r}: pass the value itself ({rows.item()!r}) or a list"
+        )
     if isinstance(rows, str):
         key = rows.strip().lower()
         if key in PRESETS:
@@ -145,7 +149,7 @@ def task_rows(J: Any, rows: Any):
     numeric batch (N, m, n) (gives (N, k, n)). Names and presets need J with 6 rows ([ω; v] order).
 
     >>> import sympy as sp
-    >>> t = sp.Symbol("theta1")
+    >>> t = sp.Symbol("theta1", real=True)
     >>> J = sp.Matrix([0, 0, 1, -sp.sin(t), sp.cos(t), 0])
     >>> task_rows(J, "xy").T
     Matrix([[-sin(theta1), cos(theta1)]])

@@ -93,3 +93,20 @@ def to_mp(M):
 
 def max_abs(X):
     return max((abs(x) for x in X), default=mpmath.mpf(0))
+
+
+def exp6(S, th):
+    """e^{[S]θ} (4×4) at 60 digits for a screw S = [ω; v] (|ω| = 1 or ω = 0) of mpmath numbers or strings and θ
+    (an mpmath number or a string, e.g. "3.14159…" or mpmath.pi − δ), by Rodrigues' formula."""
+    with mpmath.workdps(DIGITS + 15):
+        return _exp6([mpmath.mpf(x) for x in S], mpmath.mpf(th))
+
+
+def fk(screws, M, q):
+    """T(θ) = e^{[S1]θ1}⋯e^{[Sn]θn} M at 60 digits (screws 6×n and M exact SymPy, q exact or floats)."""
+    with mpmath.workdps(DIGITS + 15):
+        n = screws.shape[1]
+        T = mpmath.eye(4)
+        for i in range(n):
+            T = T * _exp6([_mp(screws[r, i]) for r in range(6)], _mp(q[i]))
+        return T * to_mp(M)

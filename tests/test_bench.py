@@ -44,6 +44,8 @@ def test_bench_quick_writes_table(tmp_path):
         "| robot | quantity | call | kinlib (best) | modern-robotics",
         "## Symbolic",
         "UR5 J_s built",
+        "## Real arms from URDF (single call, geometric J)",
+        "kinlib.jacobian_space(S, q)",
         "## First numeric call of a 7-joint chain",
         "## Exact analysis at a configuration",
         "## Singular sets of a redundant arm",

@@ -70,8 +70,11 @@ def test_textbook_forms():
 
 
 def test_expression_and_errors():
-    x = sp.Symbol("x")
+    x = sp.Symbol("x", real=True)
     assert simplify_for_display(sp.sin(x) ** 2 + sp.cos(x) ** 2) == 1
+    # issue 25: symbols not declared real are refused here too (one check for every public function)
+    with pytest.raises(ValueError, match=r"M must be real: the symbol\(s\) y are not declared real"):
+        simplify_for_display(sp.sin(sp.Symbol("y")))
     assert simplify_for_display(sp.Integer(3)) == 3
     with pytest.raises(TypeError, match="M must be a SymPy Matrix or expression"):
         simplify_for_display("sin(x)")

@@ -53,6 +53,8 @@ BAD_PY = [
 BAD_SYM = [sp.I, 1 + 2 * sp.I, sp.nan, sp.oo, -sp.oo, sp.zoo, X_PLAIN, Z_COMPLEX, sp.sqrt(-2), sp.sin(X_PLAIN)]
 BAD_SCALARS = BAD_PY + BAD_SYM
 BAD_WHOLE = [None, "abc", "1.5", True, 1j, sp.I, math.nan, 3.5, sp.Symbol("t", real=True)]  # for matrices/vectors
+# issue 25: 0-d arrays (a number or a name wrapped by NumPy) and ragged lists, for every container argument
+BAD_WHOLE += [np.array(3.5), np.array(2), np.array("vx"), [[1.0, 2.0], [3.0]], [[0.5], 0.5]]
 
 t1, t2, t3 = sp.symbols("theta1:4", real=True)
 L = sp.Symbol("L", positive=True)
@@ -207,10 +209,11 @@ PCHAIN = robots.planar_offset_3r()
 Q2 = [[0.1], [0.1, 0.2, 0.3], np.zeros((2, 3)), np.zeros((2, 2, 2)), []]
 
 R_ROT = T_NUM[:3, :3]
-# Symbols not declared real are refused where they are joint symbols/values or parameters of screws and M;
-# generic matrices (a twist, a pose T, a Jacobian J, display input) may hold any symbols.
-GENERIC_OK = (X_PLAIN, Z_COMPLEX, BAD_SYM[-1])
-DISPLAY_OK = GENERIC_OK
+# Symbols not declared real are refused everywhere (issue 25: one check, kinlib._backend.check_real_finite, for
+# every public function): joint symbols and values, parameters of screws and M, and generic matrices too (a
+# twist, a pose T, a Jacobian J, display input).
+GENERIC_OK = ()
+DISPLAY_OK = ()
 
 
 def A(name, value, shapes=(), **kw):
@@ -544,6 +547,37 @@ def test_bad_input_is_refused(case, data):
     pytest.fail(f"{case.label} with {what} returned {str(out)[:200]} instead of raising")
 
 
+# issue 25: every case, every argument, deterministically: a symbol not declared real in its first entry, and
+# each 0-d array and ragged list in place of a container argument
+_SWEEP = [np.array(3.5), np.array(2), np.array("vx"), [[1.0, 2.0], [3.0]], [[0.5], 0.5]]
+
+
+def _refused_naming(case, values, k, what):
+    name = case.args[k].msg or case.args[k].name
+    try:
+        out = _call(case, values)
+    except (ValueError, TypeError) as err:
+        assert _named(str(err), name), f"{case.label} with {what}: the message does not name {name!r}: {err}"
+        return
+    pytest.fail(f"{case.label} with {what} returned {str(out)[:200]} instead of raising")
+
+
+@pytest.mark.parametrize("case", PARAMS)
+def test_non_real_symbols_zero_d_arrays_and_ragged_lists_are_refused(case):
+    for k, a in enumerate(case.args):
+        base = [copy.copy(x.value) for x in case.args]
+        if a.entries and not any(X_PLAIN is o for o in a.ok):
+            for bad in (X_PLAIN, sp.sin(X_PLAIN) + 1):
+                values = list(base)
+                values[k] = _set(a.value, _leaves(a.value)[0], bad)
+                _refused_naming(case, values, k, f"{a.name}'s first entry = {bad}")
+        if isinstance(a.value, (list, tuple, np.ndarray, sp.MatrixBase)) and a.whole:
+            for bad in _SWEEP:
+                values = list(base)
+                values[k] = bad
+                _refused_naming(case, values, k, f"{a.name} = {bad!r}")
+
+
 # ==========================================================================================================
 # Item 3: numbers typed by the student become exact when the chain is built
 # ==========================================================================================================
@@ -672,3 +706,37 @@ def test_numeric_fast_path_refuses_nan_and_keeps_batches():
     assert np.isfinite(c.fk(big)).all()
     np.testing.assert_allclose(c.jacobian_space([0.1, 0.2, 0.3]), ok)
     np.testing.assert_allclose(c.jacobian_space([[0.1, 0.2, 0.3]] * 2)[1], ok)
+
+
+_MIXED_SCRIPT = r"""
+import json, sympy as sp
+from kinlib import velocity_ellipsoid
+from kinlib.velocity import force_ellipsoid
+t = sp.Symbol("theta1", real=True)
+J = [[1.0, 0.5], [0.0, t]]
+out = {}
+for f in (velocity_ellipsoid, force_ellipsoid):
+    try:
+        lengths, axes = f(J)
+        out[f.__name__] = ["answered", len(lengths), str(axes.shape)]
+    except (ValueError, TypeError) as err:
+        out[f.__name__] = ["refused", type(err).__name__, str(err)]
+print(json.dumps(out))
+"""
+
+
+@pytest.mark.slow
+def test_ellipsoids_of_a_mixed_float_symbolic_J_answer_or_refuse_within_a_limit():
+    """A float J with one symbolic entry: each ellipsoid answers (2 lengths, 2×2 axes) or refuses clearly
+    (ValueError/TypeError naming J), in a subprocess with a generous limit that only guards against a hang."""
+    import json
+    import subprocess
+    import sys
+
+    p = subprocess.run([sys.executable, "-c", _MIXED_SCRIPT], capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr[-2000:]
+    for name, res in json.loads(p.stdout).items():
+        if res[0] == "answered":
+            assert res[1:] == [2, "(2, 2)"], (name, res)
+        else:
+            assert _named(res[2], "J"), (name, res)

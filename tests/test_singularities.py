@@ -36,7 +36,7 @@ def np_screws(chain):
 # task_rows
 # ------------------------------------------------------------------------------------------
 def test_task_rows_names_presets_indices():
-    J = sp.Matrix(6, 2, lambda i, j: sp.Symbol(f"a{i}{j}"))
+    J = sp.Matrix(6, 2, lambda i, j: sp.Symbol(f"a{i}{j}", real=True))
     assert task_rows(J, "planar") == J.extract([2, 3, 4], [0, 1])
     assert task_rows(J, ["vx", "vy"]) == J.extract([3, 4], [0, 1])
     assert task_rows(J, ("px", "wz")) == J.extract([3, 2], [0, 1])

@@ -41,7 +41,7 @@ def test_every_spelling_picks_the_same_rows(spec, n):
     J = rng.normal(size=(6, n))
     assert task_row_indices(spelled) == tuple(rows)
     np.testing.assert_array_equal(task_rows(J, spelled), J[rows, :])
-    S = sp.Matrix(6, n, lambda i, j: sp.Symbol(f"j{i}{j}"))
+    S = sp.Matrix(6, n, lambda i, j: sp.Symbol(f"j{i}{j}", real=True))
     assert task_rows(S, spelled) == sp.Matrix([[S[r, j] for j in range(n)] for r in rows])
     batch = rng.normal(size=(4, 6, n))
     np.testing.assert_array_equal(task_rows(batch, spelled), batch[:, rows, :])
