@@ -6,6 +6,10 @@ PIP    := $(PY) -m pip --disable-pip-version-check
 STAMP  := $(VENV)/.installed
 NOTEBOOKS := $(sort $(wildcard notebooks/[0-9][0-9]_*.ipynb))
 PYTEST_ARGS ?=
+# Parallel tests (pytest-xdist): `make test TEST_JOBS=2` runs 2 workers; the browser modules are one group that
+# one worker runs (--dist loadgroup; tests/conftest.py), the other tests are shared out one by one. 1: no xdist.
+TEST_JOBS ?= 1
+XDIST := $(if $(filter-out 1,$(TEST_JOBS)),-n $(TEST_JOBS) --dist loadgroup)
 
 .PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium poppler bubblewrap clean
 
@@ -61,11 +65,11 @@ bubblewrap:
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
 test: $(STAMP) lint chromium poppler bubblewrap
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
-	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider --durations=15 $(PYTEST_ARGS)
+	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider --durations=15 $(XDIST) $(PYTEST_ARGS)
 
 # Quick loop while developing: no browser, no notebooks, no slow tests, no lint (`make lint` for that).
 test-fast: $(STAMP) bubblewrap
-	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(PYTEST_ARGS)
+	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(XDIST) $(PYTEST_ARGS)
 
 # JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
 # The course notebooks are trusted first (JupyterLab draws saved widgets only in trusted notebooks; otherwise

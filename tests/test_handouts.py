@@ -124,11 +124,10 @@ def test_check_prints_a_line_per_answer(capsys):
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("handouts") / "handouts"
-    log = []
-    entries = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=log.append)
-    return out, entries[0], log
+def built(fixture_handouts):
+    """(folder, entry, log) of the fixture's handouts: built once per run (tests/conftest.py, shared with
+    tests/test_browser.py) with jobs=1, verify=False, site=False, pdfs=False."""
+    return fixture_handouts
 
 
 def _solution_cells(nb):
