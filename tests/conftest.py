@@ -85,7 +85,7 @@ def pytest_collection_modifyitems(session, config, items):
             item.add_marker(pytest.mark.xdist_group("browser"))
         else:
             item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
-    if config.getvalue("loadgroup") and hasattr(items[0] if items else None, "_id"):
+    if getattr(config.option, "loadgroup", False) and hasattr(items[0] if items else None, "_id"):
         # pytest-xdist 3.8 marks a group by appending "@group" to item._nodeid, which pytest 9 no longer reads
         # (Node.nodeid is str(item._id)): done here, as xdist would, so that --dist loadgroup groups
         for item in items:
