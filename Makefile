@@ -6,6 +6,10 @@ PIP    := $(PY) -m pip --disable-pip-version-check
 STAMP  := $(VENV)/.installed
 NOTEBOOKS := $(sort $(wildcard notebooks/[0-9][0-9]_*.ipynb))
 PYTEST_ARGS ?=
+# Parallel tests (pytest-xdist): `make test TEST_JOBS=2` runs 2 workers; the browser modules are one group that
+# one worker runs (--dist loadgroup; tests/conftest.py), the other tests are shared out one by one. 1: no xdist.
+TEST_JOBS ?= 1
+XDIST := $(if $(filter-out 1,$(TEST_JOBS)),-n $(TEST_JOBS) --dist loadgroup)
 
 .PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium webkit poppler bubblewrap clean
 
@@ -15,10 +19,14 @@ setup: $(STAMP)
 
 # The exact pins, then kinlib itself as an editable install without dependencies (that is what puts the
 # `kinlib` console script into .venv/bin). Re-run when the pins or pyproject.toml change.
+# pip prints one line per package (progress); its download bars are off (they flood a CI log).
 $(STAMP): environment.txt pyproject.toml
+	@echo "setup: .venv from environment.txt ($$(grep -c '==' environment.txt) pinned packages; about a minute with a warm pip cache)"
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PIP) install --quiet --upgrade pip
-	$(PIP) install --quiet -r environment.txt
+	@{ $(PIP) install --progress-bar off -r environment.txt; echo $$? > $(VENV)/.pip-status; } \
+	    | grep --line-buffered -E '^(Collecting|Installing collected|Successfully)' | cut -c1-100; \
+	    test "$$(cat $(VENV)/.pip-status)" = 0 || { echo "setup: pip could not install environment.txt (above)"; exit 1; }
 	$(PIP) install --quiet --no-deps --no-build-isolation -e .
 	@touch $@
 
@@ -65,11 +73,11 @@ bubblewrap:
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
 test: $(STAMP) lint chromium webkit poppler bubblewrap
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
-	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider $(PYTEST_ARGS)
+	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider --durations=15 $(XDIST) $(PYTEST_ARGS)
 
 # Quick loop while developing: no browser, no notebooks, no slow tests, no lint (`make lint` for that).
 test-fast: $(STAMP) bubblewrap
-	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(PYTEST_ARGS)
+	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(XDIST) $(PYTEST_ARGS)
 
 # JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
 # The course notebooks are trusted first (JupyterLab draws saved widgets only in trusted notebooks; otherwise
@@ -90,10 +98,14 @@ notebooks: $(STAMP)
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
 # make handouts AUDIENCE=students -> build/handouts-students/: the same without any solution (page, PDF or
 # notebook), the folder to publish to students; build/handouts/ is the instructors' (it has the solutions).
+# Incremental: a section, the site or a PDF whose inputs did not change is reused (the log says so).
+# `make handouts ONLY=05` builds one section (ONLY="02 05": several); `make handouts FRESH=1` builds everything again.
 AUDIENCE ?= all
+ONLY ?=
+FRESH ?=
 HANDOUTS_OUT := $(if $(filter students,$(AUDIENCE)),build/handouts-students,build/handouts)
 handouts: $(STAMP) chromium
-	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE)
+	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE) $(if $(ONLY),--only $(ONLY)) $(if $(FRESH),--fresh)
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
 # http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.

@@ -1,13 +1,27 @@
 """pytest configuration and fixtures. Shared test helpers live in tests/helpers.py (import them from there)."""
 
+import os
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+ROOT = Path(__file__).resolve().parents[1]
+
 # tests/fixtures holds input notebooks and scripts for the handouts and grading tests, not tests:
 # keep `pytest --nbval-lax tests` from collecting them.
 collect_ignore = ["fixtures"]
+
+
+def pytest_configure(config):
+    """``KINLIB_COUNT_EXPENSIVE=counts.json``: count the expensive work per test module (tests/expensive_counter.py)."""
+    if os.environ.get("KINLIB_COUNT_EXPENSIVE"):
+        from expensive_counter import ExpensiveCounter
+
+        counter = ExpensiveCounter(os.environ["KINLIB_COUNT_EXPENSIVE"])
+        counter.install()
+        config.pluginmanager.register(counter, "kinlib-expensive-counter")
 
 
 @pytest.fixture(autouse=True, scope="session")
@@ -25,6 +39,14 @@ def _grader_secret(tmp_path_factory):
         os.environ["KINLIB_GRADER_SECRET"] = old
 
 
+@pytest.fixture(scope="session")
+def grader_reference_cache(tmp_path_factory):
+    """One signed reference cache (kinlib.course.grader.refdata) for the run's grading tests: a solution notebook is
+    executed for its answer key once per run (per xdist worker), not once per module. Signed with the run's
+    secret (``_grader_secret``); a test of the cache itself (poisoned, another secret) uses a folder of its own."""
+    return tmp_path_factory.mktemp("grader-reference-cache")
+
+
 @pytest.fixture
 def rng():
     """A NumPy generator with a fixed seed (reproducible random configurations)."""
@@ -37,3 +59,154 @@ def _close_figures():
     yield
     if "matplotlib.pyplot" in sys.modules:
         sys.modules["matplotlib.pyplot"].close("all")
+
+
+# ---------------------------------------------------------------------------------------------------
+# Built once per run and shared (issue 24): the real handouts (pages, site, PDFs), the fixture's handouts, and
+# one chromium for every browser test.
+
+
+def _browser_module(item) -> bool:
+    return item.get_closest_marker("browser") is not None and "shared_browser" in item.fixturenames
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_collection_modifyitems(session, config, items):
+    """The modules that use the shared chromium run last, one after the other (a stable sort: each module's tests
+    keep their order), so that one playwright session serves them all and is stopped after the last one.
+
+    Under pytest-xdist (``make test TEST_JOBS=2``, ``--dist loadgroup``) every file is a group, run whole by one
+    worker (its module fixtures are built once; nbval's cells of one notebook share one kernel, in order), and
+    the browser modules are one group together (one chromium, one worker)."""
+    browser_modules = {item.module.__name__ for item in items if hasattr(item, "module") and _browser_module(item)}
+    _BROWSER_MODULES.update(browser_modules)
+    for item in items:
+        if hasattr(item, "module") and item.module.__name__ in browser_modules:
+            item.add_marker(pytest.mark.xdist_group("browser"))
+        else:
+            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
+    if getattr(config.option, "loadgroup", False) and hasattr(items[0] if items else None, "_id"):
+        # pytest-xdist 3.8 marks a group by appending "@group" to item._nodeid, which pytest 9 no longer reads
+        # (Node.nodeid is str(item._id)): done here, as xdist would, so that --dist loadgroup groups
+        for item in items:
+            group = item.get_closest_marker("xdist_group").args[0]
+            if not item.nodeid.endswith(f"@{group}"):
+                item._id = type(item._id).parse(f"{item.nodeid}@{group}")
+    items.sort(key=lambda item: hasattr(item, "module") and item.module.__name__ in browser_modules)
+
+
+class _SharedChromium:
+    """One playwright session and one chromium (Debian's) for all the browser modules. Playwright's sync API
+    allows one session per thread, and while it runs an event loop is running in this thread (asyncio.run fails
+    there): so it is started by the first test that asks for it and stopped as soon as the next test does not
+    belongs to another module (``pytest_runtest_teardown``), never left running under the other tests."""
+
+    def __init__(self):
+        self.playwright = self.browser = None
+
+    def get(self):
+        if self.browser is None:
+            import labdriver
+
+            if not Path(labdriver.CHROMIUM).exists():
+                pytest.fail(f"{labdriver.CHROMIUM} is missing: `make chromium` (apt-get install chromium) installs it")
+            from playwright.sync_api import sync_playwright
+
+            self.playwright = sync_playwright().start()
+            self.browser = self.playwright.chromium.launch(
+                executable_path=labdriver.CHROMIUM, args=labdriver.CHROMIUM_ARGS
+            )
+        return self.browser
+
+    def stop(self):
+        if self.playwright is not None:
+            try:
+                self.browser.close()
+            finally:
+                self.playwright.stop()
+                self.playwright = self.browser = None
+
+
+_CHROMIUM = _SharedChromium()
+
+
+@pytest.fixture
+def shared_browser():
+    """The run's chromium (playwright ``Browser``): give each test its own page or context, and close it."""
+    return _CHROMIUM.get()
+
+
+_BROWSER_MODULES: set = set()  # the modules that use it (pytest_collection_modifyitems)
+
+
+def pytest_runtest_teardown(item, nextitem):
+    if nextitem is None or getattr(getattr(nextitem, "module", None), "__name__", None) not in _BROWSER_MODULES:
+        _CHROMIUM.stop()
+
+
+def _lock(path: Path):
+    """An exclusive lock on ``path`` (a file; fcntl), held until the returned file is closed: two pytest-xdist
+    workers never build into one folder at once."""
+    import fcntl
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    f = open(path, "a+")
+    fcntl.flock(f, fcntl.LOCK_EX)
+    return f
+
+
+@pytest.fixture(autouse=True, scope="session")
+def _vendor_once(tmp_path_factory):
+    """Under pytest-xdist: the npm packages of the pages (build/vendor, fetched once: kinlib.course.publish.npm)
+    are fetched and unpacked by one worker at a time, before any test, so that two workers never unpack into one
+    folder. (A serial run needs nothing: the first build fetches them.)"""
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        from kinlib.course.publish.pages import build_assets
+
+        with _lock(ROOT / "build" / ".vendor.lock"):
+            build_assets(tmp_path_factory.mktemp("assets"), ROOT / "build" / "vendor")
+
+
+@pytest.fixture(scope="session")
+def real_handouts() -> Path:
+    """The handouts of notebooks/ with the in-browser site and the PDFs, built once per run into build/handouts by
+    ``make handouts``'s own code and options (so a ``make handouts`` just before is reused, section by section:
+    kinlib.course.publish.incremental; and what the tests built is what ``make handouts`` would publish). With
+    ``verify`` on, as ``make handouts``: every workbook is run top to bottom too. Under pytest-xdist the first
+    worker builds (a file lock) and the others read that build. ``KINLIB_HANDOUTS_DIR`` tests an existing build
+    instead. Raises the build's error (NotebookFailed names the notebook and cell)."""
+    if os.environ.get("KINLIB_HANDOUTS_DIR"):
+        return Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
+    from kinlib.course.publish import handouts
+
+    out = ROOT / "build" / "handouts"
+    run = os.environ.get("PYTEST_XDIST_TESTRUNUID", "")
+    done = out.parent / ".handouts-built-by"
+    with _lock(out.parent / ".handouts.lock"):
+        if not (run and done.is_file() and done.read_text() == run):
+            done.unlink(missing_ok=True)
+            handouts.build(ROOT / "notebooks", out, vendor=ROOT / "build" / "vendor", jobs=2, log=lambda s: None)
+            if run:
+                done.write_text(run)
+    return out
+
+
+@pytest.fixture(scope="session")
+def fixture_handouts(tmp_path_factory):
+    """The handouts of tests/fixtures/handouts (no site, no PDFs, workbooks not run), built once per run (per
+    xdist worker): (folder, the notebook's index entry, the build's log lines)."""
+    from kinlib.course.publish import handouts
+
+    out = tmp_path_factory.mktemp("fixture-handouts") / "handouts"
+    log: list = []
+    entries = handouts.build(
+        ROOT / "tests" / "fixtures" / "handouts",
+        out,
+        vendor=ROOT / "build" / "vendor",
+        jobs=1,
+        verify=False,
+        site=False,
+        pdfs=False,
+        log=log.append,
+    )
+    return out, entries[0], log

@@ -56,45 +56,29 @@ def _page_id(p):
 # fixtures
 
 
-@pytest.fixture(scope="module")  # closed with the module: a later module may start playwright (one per thread)
-def browser():
-    if not Path(CHROMIUM).exists():
-        pytest.fail(f"{CHROMIUM} is missing: `make chromium` (or apt-get install chromium) installs Debian's")
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
+@pytest.fixture
+def browser(shared_browser):
+    """The run's one chromium (tests/conftest.py: one playwright session for every browser module)."""
+    return shared_browser
 
 
 @pytest.fixture(scope="session")
-def sites(tmp_path_factory):
-    """The handouts of the real notebooks and of the fixture, built once (what `make handouts` does).
+def sites(request, fixture_handouts):
+    """The handouts of the real notebooks and of the fixture, each built once per run (tests/conftest.py:
+    ``real_handouts``, what `make handouts` does, into build/handouts; ``fixture_handouts``, shared with
+    tests/test_handouts.py).
 
     ``KINLIB_HANDOUTS_DIR=build/handouts`` tests an existing build of the real notebooks instead (a quick
     loop after ``make handouts``). A failing real notebook fails its pages' tests, not the fixture's.
     """
     from kinlib.course.publish import handouts
 
-    base = tmp_path_factory.mktemp("browser")
-    out = {}
-    handouts.build(
-        FIXTURES, base / "fixture", vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=lambda s: None
-    )
-    out["fixture"] = base / "fixture"
-    if os.environ.get("KINLIB_HANDOUTS_DIR"):
-        out["handouts"] = Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
-    elif REAL:
-        built = ROOT / "build" / "handouts"
-        if labdriver.handouts_are_fresh(built, REAL):  # `make handouts` just ran: test what it made
-            out["handouts"] = built
-        else:
-            try:
-                handouts.build(NOTEBOOKS, built, vendor=VENDOR, jobs=2, verify=False, log=lambda s: None)
-                out["handouts"] = built
-            except handouts.NotebookFailed as e:
-                out["handouts"] = e
+    out = {"fixture": fixture_handouts[0]}
+    if REAL:
+        try:
+            out["handouts"] = request.getfixturevalue("real_handouts")
+        except handouts.NotebookFailed as e:
+            out["handouts"] = e
     return out
 
 

@@ -101,7 +101,7 @@ CHEAT = (
 
 
 @pytest.fixture(scope="module")
-def batch(tmp_path_factory):
+def batch(tmp_path_factory, grader_reference_cache):
     d = tmp_path_factory.mktemp("subs")
     shutil.copy(REF, d / "alice_solution.ipynb")  # the solution notebook itself
     shutil.copy(WB, d / "untouched.ipynb")
@@ -137,13 +137,13 @@ def batch(tmp_path_factory):
         timeout=60,
         cell_timeout=CELL_TIMEOUT,
         notebooks=FIX / "notebooks",
-        cache=out / "cache",
+        cache=grader_reference_cache,
         log=None,
     )
     rows = {}
     for r in summary["rows"]:
         rows.setdefault(Path(r["submission"]).stem, {})[r["part"]] = r
-    return {"summary": summary, "rows": rows, "out": out}
+    return {"summary": summary, "rows": rows, "out": out, "cache": grader_reference_cache}
 
 
 def _status(batch, sub):
@@ -277,7 +277,7 @@ def test_points_come_from_the_question_cells(batch):
 
 @pytest.mark.slow
 def test_reruns_are_reproducible(batch):
-    refs = grade.load_references(FIX / "notebooks", batch["out"] / "cache", secret=load_secret())
+    refs = grade.load_references(FIX / "notebooks", batch["cache"], secret=load_secret())
     sub = next(p for p in (batch["out"].parent).glob("subs*/dan_transposed.ipynb"))
     again = grade.grade_submission(sub, refs, cell_timeout=CELL_TIMEOUT, display_name=str(sub))
     first = batch["rows"]["dan_transposed"]

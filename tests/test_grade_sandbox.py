@@ -233,9 +233,9 @@ def test_no_writes_outside_the_scratch_folder(attacked):
 
 
 @pytest.mark.slow
-def test_control_without_the_sandbox_reading_the_solutions_passes(tmp_path):
+def test_control_without_the_sandbox_reading_the_solutions_passes(tmp_path, grader_reference_cache):
     """The solution-reading attack is real: without the sandbox it scores everything (and the result says so)."""
-    refs = grade.load_references(FIX / "notebooks", tmp_path / "cache", secret=load_secret())
+    refs = grade.load_references(FIX / "notebooks", grader_reference_cache, secret=load_secret())
     sub = tmp_path / "read_solutions.ipynb"
     sub.write_text(json.dumps(_workbook(end=[_attack("read_solutions")])))
     res = grade.grade_submission(sub, refs, cell_timeout=60, sandbox=False)

@@ -465,7 +465,7 @@ def _workbook(overrides: dict) -> dict:
 
 
 @pytest.mark.slow
-def test_end_to_end_verdicts_and_a_notebook_without_metadata(tmp_path):
+def test_end_to_end_verdicts_and_a_notebook_without_metadata(tmp_path, grader_reference_cache):
     from kinlib.course.grader import grade
 
     subs = tmp_path / "subs"
@@ -489,7 +489,7 @@ def test_end_to_end_verdicts_and_a_notebook_without_metadata(tmp_path):
         timeout=120,
         cell_timeout=60,
         notebooks=FIX / "notebooks",
-        cache=tmp_path / "cache",
+        cache=grader_reference_cache,
         log=None,
     )
     rows = {(Path(r["submission"]).stem, r["part"]): r for r in summary["rows"]}

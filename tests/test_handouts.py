@@ -124,11 +124,10 @@ def test_check_prints_a_line_per_answer(capsys):
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    out = tmp_path_factory.mktemp("handouts") / "handouts"
-    log = []
-    entries = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=log.append)
-    return out, entries[0], log
+def built(fixture_handouts):
+    """(folder, entry, log) of the fixture's handouts: built once per run (tests/conftest.py, shared with
+    tests/test_browser.py) with jobs=1, verify=False, site=False, pdfs=False."""
+    return fixture_handouts
 
 
 def _solution_cells(nb):
@@ -438,11 +437,13 @@ def test_real_notebooks_have_the_structure(path):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("stem", [p.stem for p in sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))])
-def test_real_workbook_with_the_solutions_passes(stem, tmp_path):
-    """The real workbook, with the notebook's solution cells pasted back, passes every self-check."""
+def test_real_workbook_with_the_solutions_passes(stem, tmp_path, real_handouts):
+    """The real workbook, with the notebook's solution cells pasted back, passes every self-check. The workbook is
+    the one the run's handouts build made (tests/conftest.py ``real_handouts``: handouts.make_workbook from the
+    notebook executed there), so the notebook is not executed again here."""
     source = nbformat.read(ROOT / "notebooks" / f"{stem}.ipynb", as_version=4)
-    executed, groups, fps = handouts.execute_notebook(ROOT / "notebooks" / f"{stem}.ipynb")
-    wb = handouts.make_workbook(source, groups, fps)
+    groups = schema.answer_groups(source)
+    wb = nbformat.read(real_handouts / "workbooks" / f"{stem}.ipynb", as_version=4)
     nbformat.validate(wb)
     p = tmp_path / f"{stem}.ipynb"
     nbformat.write(_paste_solutions(wb, source), p)
@@ -451,3 +452,22 @@ def test_real_workbook_with_the_solutions_passes(stem, tmp_path):
     assert len(lines) == n_answers
     bad = [ln for ln in lines if "✓ correct" not in ln and "no automatic self-check" not in ln]
     assert not bad, bad
+
+
+def test_a_second_build_executes_nothing_and_changes_no_file(built, monkeypatch):
+    """`make handouts` twice in a row: the second build reuses the section (kinlib.course.publish.incremental)."""
+    out, first, _log = built
+    pages = sorted(p for p in out.rglob("*") if p.is_file() and p.name != "index.html" and "assets" not in p.parts)
+    before = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in pages}
+
+    def no_kernel(*a, **k):
+        raise AssertionError("a reused section must not be executed")
+
+    monkeypatch.setattr(handouts, "execute_notebook", no_kernel)
+    log: list = []
+    again = handouts.build(FIXTURES, out, vendor=VENDOR, jobs=1, verify=False, site=False, pdfs=False, log=log.append)
+    assert any(f"{STEM}: reused" in line for line in log)
+    assert {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in pages} == before
+    assert again[0]["title"] == first["title"] and again[0]["sections"] == first["sections"]
+    assert again[0]["executed"].cells == first["executed"].cells
+    assert again[0]["problems"].cells == first["problems"].cells

@@ -12,8 +12,8 @@ import hashlib
 import json
 import re
 import shutil
-import time
 import urllib.request
+from contextlib import nullcontext
 from pathlib import Path
 
 import pytest
@@ -367,27 +367,37 @@ def labdriver_explorer_text() -> str:
 
 
 @pytest.fixture(scope="module")
-def handouts_site(tmp_path_factory):
-    """Handouts of notebook 05 with the site, built as ``make handouts`` builds them (a download the first
-    time, into the cache; offline after), with the app reachable from the test."""
-    from kinlib.course.publish import handouts
-    from kinlib.course.publish.pages import build_assets
-
+def handouts_site(real_handouts, tmp_path_factory):
+    """The handouts with the site, as ``make handouts`` builds them (tests/conftest.py ``real_handouts``: built
+    once per run), served from a hard-linked copy whose ``jupyter-lite.json`` (a new file, never written through
+    the link into the real build) lets the test reach the app."""
     out = tmp_path_factory.mktemp("lite") / "handouts"
-    t0 = time.perf_counter()
-    nb = NOTEBOOKS / "05_singularities_planar.ipynb"
-    urls = build_assets(out / "assets", VENDOR)
-    handouts.build_one(nb, out, urls, 300, False, log=lambda s: None)  # the workbook, as handouts.build makes it
-    solutions = sorted(NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
-    lite.build_lite(out, solutions, log=print)  # what handouts.build then calls
-    print(f"\nhandouts 05 + lite site built in {time.perf_counter() - t0:.1f} s")
+    _linked_copy(real_handouts, out)
     expose_app(out)
     return out
 
 
+def _linked_copy(src: Path, dest: Path) -> None:
+    """``src`` copied to ``dest`` as hard links where the file system allows (else copies), its
+    ``lite/jupyter-lite.json`` a file of its own."""
+    import os
+
+    def link(a, b):
+        try:
+            os.link(a, b)
+        except OSError:
+            shutil.copy2(a, b)
+
+    shutil.copytree(Path(src), dest, copy_function=link, ignore=shutil.ignore_patterns(".kinlib-build"))
+    cfg = dest / "lite" / "jupyter-lite.json"
+    text = cfg.read_text()
+    cfg.unlink()
+    cfg.write_text(text)
+
+
 @pytest.mark.browser
 @pytest.mark.slow
-def test_workbook_05_runs_offline_in_jupyterlite(handouts_site):
+def test_workbook_05_runs_offline_in_jupyterlite(handouts_site, shared_browser):
     import labdriver
 
     site = handouts_site
@@ -396,7 +406,7 @@ def test_workbook_05_runs_offline_in_jupyterlite(handouts_site):
     server = lite.serve(site, 0, block=False)
     base = f"http://127.0.0.1:{server.server_address[1]}/"
     try:
-        with labdriver.chromium() as browser:
+        with nullcontext(shared_browser) as browser:  # the run's one chromium (tests/conftest.py)
             context, page, blocker, ready = open_workbook(browser, base)
             errors = []
             page.on("pageerror", lambda e: errors.append(str(e)))
@@ -469,7 +479,7 @@ def test_workbook_05_runs_offline_in_jupyterlite(handouts_site):
 @pytest.mark.browser
 @pytest.mark.slow
 @pytest.mark.parametrize("stem", sorted(p.stem for p in NOTEBOOKS.glob("[0-9][0-9]_*.ipynb")))
-def test_solution_notebook_runs_in_the_browser(handouts_site, stem):
+def test_solution_notebook_runs_in_the_browser(handouts_site, shared_browser, stem):
     """Every solution notebook runs top to bottom in the site, its check cells included: kinlib works on the
     browser's numpy and matplotlib (lite.SUPPORTED: numpy 2.0.2, matplotlib 3.8.4), nothing fetched outside."""
     import labdriver
@@ -477,7 +487,7 @@ def test_solution_notebook_runs_in_the_browser(handouts_site, stem):
     server = lite.serve(handouts_site, 0, block=False)
     base = f"http://127.0.0.1:{server.server_address[1]}/"
     try:
-        with labdriver.chromium() as browser:
+        with nullcontext(shared_browser) as browser:  # the run's one chromium (tests/conftest.py)
             context, page, blocker, ready = open_workbook(browser, base, f"solutions/{stem}.ipynb")
             try:
                 seconds = labdriver.run_all(page, timeout=400)
@@ -490,20 +500,10 @@ def test_solution_notebook_runs_in_the_browser(handouts_site, stem):
         server.server_close()
 
 
-def _cached() -> bool:
-    c = lite.cache_dir()
-    npm = c / "npm" / lite.PYODIDE_NPM.filename
-    return npm.is_file() and all((c / "pypi" / p.filename).is_file() for p in lite.SOURCES if p.registry == "pypi")
-
-
 @pytest.fixture(scope="module")
-def built_site(tmp_path_factory):
-    """A site holding solution notebook 05 only, built offline from the cache (skipped when nothing is cached)."""
-    if not _cached():
-        pytest.skip(f"the pinned downloads are not cached in {lite.cache_dir()} (make handouts fetches them once)")
-    out = tmp_path_factory.mktemp("site") / "handouts"
-    lite.build_lite(out, [NOTEBOOKS / "05_singularities_planar.ipynb"], log=lambda s: None)
-    return out / "lite"
+def built_site(real_handouts):
+    """The site of the real handouts (tests/conftest.py ``real_handouts``: built once per run), read only."""
+    return real_handouts / "lite"
 
 
 @pytest.mark.slow

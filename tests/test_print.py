@@ -22,15 +22,13 @@ from __future__ import annotations
 
 import html
 import json
-import os
 import re
 import subprocess
 from pathlib import Path
 
 import pytest
 
-import labdriver
-from kinlib.course.publish import handouts, pages, printing
+from kinlib.course.publish import pages, printing
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOKS = ROOT / "notebooks"
@@ -55,29 +53,21 @@ def _id(spec):
 
 
 @pytest.fixture(scope="session")
-def built(tmp_path_factory) -> Path:
-    """The real handouts with their PDFs: ``make handouts``'s own code (handouts.build prints the PDFs)."""
+def built(real_handouts) -> Path:
+    """The real handouts with their PDFs: ``make handouts``'s own code (handouts.build prints the PDFs), built once
+    per run (tests/conftest.py ``real_handouts``; ``KINLIB_HANDOUTS_DIR`` tests an existing build)."""
     for tool in ("pdftotext", "pdfinfo"):
         if subprocess.run(["which", tool], capture_output=True).returncode:
             pytest.fail(f"{tool} is missing: `make poppler` (apt-get install poppler-utils) installs it")
     if not Path(printing.CHROMIUM).exists():
         pytest.fail(f"{printing.CHROMIUM} is missing: `make chromium` installs Debian's chromium")
-    if os.environ.get("KINLIB_HANDOUTS_DIR"):
-        return Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
-    out = ROOT / "build" / "handouts"
-    if not labdriver.handouts_are_fresh(out, REAL, pdf=True):
-        handouts.build(NOTEBOOKS, out, vendor=VENDOR, jobs=2, verify=False, log=lambda s: None)
-    return out
+    return real_handouts
 
 
-@pytest.fixture(scope="module")  # closed with the module: a later module may start playwright (one per thread)
-def browser():
-    from playwright.sync_api import sync_playwright
-
-    with sync_playwright() as p:
-        b = p.chromium.launch(executable_path=printing.CHROMIUM, args=printing.launch_args())
-        yield b
-        b.close()
+@pytest.fixture
+def browser(shared_browser):
+    """The run's one chromium (tests/conftest.py: one playwright session for every browser module)."""
+    return shared_browser
 
 
 @pytest.fixture(scope="session")

@@ -1,6 +1,6 @@
 """The ``kinlib`` command: ``kinlib handouts ...``, ``kinlib grade ...``, ``kinlib --version``.
 
-    kinlib handouts notebooks --out build/handouts [--jobs 2] [--timeout 120] [--no-verify] [--only 05]
+    kinlib handouts notebooks --out build/handouts [--jobs 2] [--timeout 120] [--no-verify] [--only 05] [--fresh]
     kinlib execute notebooks [--timeout 600]      (run notebooks in place, saving widget state: make notebooks)
     kinlib grade SUBMISSIONS... --out build/grades [--jobs 2] [--timeout 300] [--cell-timeout 60]
                  [--id-pattern REGEX] [--root DIR] [--overrides FILE] [--fresh]
@@ -114,6 +114,11 @@ def build_parser() -> argparse.ArgumentParser:
         "--no-site", dest="site", action="store_false", help="do not build the in-browser site (OUT/lite, JupyterLite)"
     )
     h.add_argument("--no-pdf", dest="pdfs", action="store_false", help="do not print the PDFs (OUT/pdf, chromium)")
+    h.add_argument(
+        "--fresh",
+        action="store_true",
+        help="build everything again (default: reuse each section, the site and each PDF whose inputs did not change)",
+    )
     h.add_argument("--serve", action="store_true", help="then serve OUT on http://127.0.0.1:PORT/ (Ctrl-C stops)")
     h.add_argument("--port", type=int, default=8000, help="port for --serve (default 8000; loopback only)")
     h.set_defaults(run=_handouts, parser=h)
@@ -361,6 +366,7 @@ def _handouts(args) -> int:
             only=args.only,
             site=args.site,
             pdfs=args.pdfs,
+            fresh=args.fresh,
             audience=args.audience,
             log=lambda s: print(s, flush=True),
         )

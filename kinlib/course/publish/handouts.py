@@ -70,6 +70,7 @@ from ..schema import (
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
 from .aids import stub, student_reading_aid
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
+from .incremental import Stamps, build_sections, build_site, code_key, key, print_changed_pdfs
 from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
 
 __all__ = [
@@ -594,6 +595,7 @@ def build(
     only: list | None = None,
     site: bool = True,
     pdfs: bool = True,
+    fresh: bool = False,
     audience: str = "all",
     log=print,
 ) -> list:
@@ -606,6 +608,11 @@ def build(
     ``audience="students"`` leaves out every solution: no ``solutions/`` pages or PDFs, no solution notebooks
     in the in-browser site, no link to them in the index (what a course publishes to its students; a
     ``solutions/`` folder left in ``out`` by an earlier build is removed first).
+
+    Incremental (:mod:`kinlib.course.publish.incremental`): a section whose notebook, kinlib code, pins and options
+    are those of the outputs already in ``out/`` is reused, not executed again (the log says "reused"); the site
+    and each PDF likewise. ``fresh`` forgets what was built and makes everything again. With ``only``, the other
+    sections already built and still current stay on the index.
 
     A folder without ``NN_*.ipynb`` notebooks is refused before anything is written:
 
@@ -628,9 +635,10 @@ def build(
         raise ValueError(f"audience: expected one of {', '.join(AUDIENCES)}, got {audience!r}")
     notebooks, out = Path(notebooks), Path(out)
     links = tuple(k for k, on in (("pdf", pdfs), ("lite", site)) if on)
-    paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
+    all_paths = sorted(p for p in notebooks.glob("[0-9][0-9]_*.ipynb"))
+    paths = all_paths
     if only:
-        paths = [p for p in paths if any(p.stem.startswith(o) for o in only)]
+        paths = [p for p in all_paths if any(p.stem.startswith(o) for o in only)]
     if not paths:
         raise FileNotFoundError(f"no notebooks named NN_*.ipynb in {notebooks}")
     vendor = Path(vendor) if vendor else out.parent / "vendor"
@@ -643,36 +651,32 @@ def build(
         f"  assets: MathJax (jupyter-server-mathjax), require.js {REQUIREJS[1]}, "
         f"{HTML_MANAGER[0]} {HTML_MANAGER[1]} ({time.perf_counter() - t0:.1f} s)"
     )
-    entries: dict = {}
-    if jobs <= 1:
-        for k, p in enumerate(paths, 1):
-            log(f"[{k}/{len(paths)}] {p.name} ...")
-            entries[p] = build_one(p, out, urls, timeout, verify, log, links, audience)
-    else:
-        with ThreadPoolExecutor(max_workers=jobs) as pool:
-            futures = {p: pool.submit(build_one, p, out, urls, timeout, verify, log, links, audience) for p in paths}
-            log(f"  running {len(paths)} notebooks, {jobs} at a time")
-            try:
-                for p, f in futures.items():
-                    entries[p] = f.result()
-            except BaseException:
-                for f in futures.values():
-                    f.cancel()
-                raise
+    stamps = Stamps(out)
+    if fresh:
+        stamps.clear()
+    options = {"verify": verify, "links": list(links), "urls": urls, "audience": audience}
+    keys = {p: key(code_key(), p.read_bytes(), options) for p in all_paths}
+    entries, listed = build_sections(
+        out,
+        all_paths,
+        paths,
+        keys,
+        stamps,
+        lambda p: build_one(p, out, urls, timeout, verify, log, links, audience),
+        jobs=jobs,
+        audience=audience,
+        log=log,
+    )
     sheet = notebooks / CHEATSHEET
     if sheet.exists():
         write_cheatsheet(sheet, out / "reference" / "cheatsheet.html", urls, links=links)
-    write_index(out, [entries[p] for p in paths], links, audience=audience, cheatsheet=sheet.exists())
+    write_index(out, listed, links, audience=audience, cheatsheet=sheet.exists())
     if site:
-        from .lite import build_lite  # the notebooks in the browser (JupyterLite, offline): out/lite/
-
-        build_lite(out, paths if audience == "all" else [], log=log)
+        build_site(out, paths if audience == "all" else [], [keys[p] for p in paths], stamps, log)
     if pdfs:
-        from .printing import print_pdfs  # the PDFs of the pages (chromium, offline): out/pdf/
-
-        print_pdfs(out, log=log)
+        print_changed_pdfs(out, stamps, log)
     log(
         f"kinlib handouts: wrote {out / 'index.html'} and {(3 if audience == 'all' else 2) * len(paths)} handouts "
         f"in {time.perf_counter() - t0:.1f} s"
     )
-    return [entries[p] for p in paths]
+    return entries

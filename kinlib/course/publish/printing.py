@@ -40,6 +40,8 @@ __all__ = [
 CHROMIUM = "/usr/bin/chromium"  # Debian's chromium (`make chromium`)
 PAPER = ("A4", 210.0, 297.0)  # format name for page.pdf, width and height in mm
 MARGINS_MM = {"top": 16.0, "right": 15.0, "bottom": 14.0, "left": 15.0}
+#: the folders of pages printed to out/pdf/<kind>/ (the cheat sheet is in reference/)
+PAGE_KINDS = ("problems", "solutions", "reference")
 HEADER_META = "kinlib-print-header"
 _LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1", "[::1]")
 _TIMEOUT_MS = 180_000  # a generous limit for one page to finish (a hung page fails; nothing is timed)
@@ -282,9 +284,9 @@ def _print_all(jobs: list, log) -> list[Path]:
     return done
 
 
-def print_pdfs(out: Path, *, log=print) -> list[Path]:
+def print_pdfs(out: Path, *, pages=None, log=print) -> list[Path]:
     """Print every ``out/problems/*.html``, ``out/solutions/*.html`` and ``out/reference/*.html`` (the cheat
-    sheet) to ``out/pdf/<kind>/<stem>.pdf``
+    sheet), or only ``pages`` (a list of those files), to ``out/pdf/<kind>/<stem>.pdf``
     (A4, margins :data:`MARGINS_MM`, content :func:`printable_width_px` CSS pixels wide); return the PDFs.
 
     One chromium (Debian's, :data:`CHROMIUM`) prints them all, offline. A folder with no pages gives no
@@ -302,11 +304,9 @@ def print_pdfs(out: Path, *, log=print) -> list[Path]:
     'pdf/problems/01_properties_of_jacobians.pdf'
     """
     out = Path(out)
-    jobs = [
-        (src, out / "pdf" / kind / f"{src.stem}.pdf")
-        for kind in ("problems", "solutions", "reference")
-        for src in sorted((out / kind).glob("*.html"))
-    ]
+    if pages is None:
+        pages = [src for kind in PAGE_KINDS for src in sorted((out / kind).glob("*.html"))]
+    jobs = [(Path(src), out / "pdf" / Path(src).parent.name / f"{Path(src).stem}.pdf") for src in pages]
     if not jobs:
         return []
     if not Path(CHROMIUM).exists():
