@@ -353,6 +353,7 @@ def test_config_picker_problem_4_1():
     assert "tie between joints 1 and 2" in cp.table.value
     cp.select(names[0])
     assert cp.buttons.value == names[0] and "joint 2" in cp.table.value
+    assert cp.buttons.style.button_width == "auto"  # buttons as wide as their labels (a fixed width cut them)
 
 
 def test_config_picker_bad_input():

@@ -90,7 +90,10 @@ class ConfigPicker(W.VBox):
         top = max(float(np.max(np.abs(v))) for v in vals) or 1.0
         self.ax_bar.set_ylim(-1.2 * top, 1.2 * top)
         self.fig.tight_layout()
-        self.buttons = W.ToggleButtons(options=list(self.configs), value=name0, description="configuration")
+        # each button as wide as its label (ipywidgets' fixed 148 px cut "(a) θ = (−π/8, π/4, π/8)" short)
+        self.buttons = W.ToggleButtons(
+            options=list(self.configs), value=name0, description="configuration", style={"button_width": "auto"}
+        )
         self.table = W.HTML()
         self.picture = b""  # the PNG; the widget shows it as a data URL
         self.image = W.Image(format="url", layout=W.Layout(width=f"{int(figsize[0] * dpi)}px"))
