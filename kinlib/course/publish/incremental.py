@@ -10,9 +10,11 @@ outputs already in ``out/`` were made from the same inputs:
 * the **site** (``out/lite``) from the keys of the sections and the solution notebooks it holds;
 * each **PDF** from the bytes of the page it prints and :func:`code_key`.
 
-A key is a SHA-256 hex digest. The stamps live in ``out/.kinlib-build/`` (one JSON file per output, written
-only after the output is complete, so a build that stops half way is redone next time); ``--fresh`` removes
-them. Nothing here looks at modification times: a ``git checkout`` that restores a file restores its key.
+A key is a SHA-256 hex digest. The stamps, and the executed notebooks a reused section needs, live *beside*
+``out``, in ``<out's parent>/.kinlib-build/<out's name>/`` (:func:`stamp_dir`), never inside it: ``out`` is what
+gets published, and an executed notebook holds the solutions (a students' build must hold none). One JSON file
+per output, written only after the output is complete, so a build that stops half way is redone next time;
+``--fresh`` removes them. Nothing here looks at modification times: a ``git checkout`` that restores a file restores its key.
 
 >>> import tempfile
 >>> with tempfile.TemporaryDirectory() as d:
@@ -39,11 +41,21 @@ import nbformat
 
 import kinlib
 
-__all__ = ["STAMP_DIR", "Stamps", "build_sections", "build_site", "code_key", "key", "print_changed_pdfs"]
+__all__ = ["STAMP_DIR", "Stamps", "build_sections", "build_site", "code_key", "key", "print_changed_pdfs", "stamp_dir"]
 
-#: the folder of ``out/`` that holds the stamps (not linked from any page; a static host may serve it: it holds
-#: only hashes, stems, titles and section numbers)
+#: the folder beside ``out`` (in its parent) that holds the stamps of every output folder there
 STAMP_DIR = ".kinlib-build"
+
+
+def stamp_dir(out: Path) -> Path:
+    """Where the stamps of the output folder ``out`` live: beside it, never inside (``out`` is published).
+
+    >>> stamp_dir(Path("build/handouts-students")).as_posix()
+    'build/.kinlib-build/handouts-students'
+    """
+    out = Path(out)
+    return out.parent / STAMP_DIR / out.name
+
 
 #: the files of the package whose bytes make up :func:`code_key` (code, and the assets the pages embed)
 _CODE_SUFFIXES = (".py", ".js", ".css", ".html", ".json", ".txt")
@@ -101,7 +113,7 @@ class Stamps:
     """
 
     def __init__(self, out: Path):
-        self.dir = Path(out) / STAMP_DIR
+        self.dir = stamp_dir(out)
 
     def _path(self, name: str) -> Path:
         return self.dir / f"{name}.json"
@@ -136,7 +148,7 @@ class Stamps:
 
 def _section_files(out: Path, stem: str, audience: str = "all") -> list:
     """The files a built section leaves in ``out`` (for students, no solutions page)."""
-    kept = out / STAMP_DIR / stem
+    kept = stamp_dir(out) / stem
     return [
         *([out / "solutions" / f"{stem}.html"] if audience == "all" else []),
         out / "problems" / f"{stem}.html",
@@ -152,7 +164,7 @@ def _reused_section(path: Path, out: Path, k: str, stamps: Stamps, audience: str
     data = stamps.current(f"section-{stem}", k, _section_files(out, stem, audience))
     if data is None:
         return None
-    kept = out / STAMP_DIR / stem
+    kept = stamp_dir(out) / stem
     return {
         **data,
         "executed": nbformat.read(kept / "executed.ipynb", as_version=4),
@@ -213,7 +225,7 @@ def build_sections(out: Path, all_paths, paths, keys: dict, stamps: Stamps, make
 
 
 def _keep_section(entry: dict, out: Path, k: str, stamps: Stamps) -> None:
-    kept = out / STAMP_DIR / entry["stem"]
+    kept = stamp_dir(out) / entry["stem"]
     kept.mkdir(parents=True, exist_ok=True)
     nbformat.write(entry["executed"], kept / "executed.ipynb")
     nbformat.write(entry["problems"], kept / "problems.ipynb")
