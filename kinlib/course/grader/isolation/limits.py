@@ -178,20 +178,25 @@ def release(pid: int | None = None) -> list[int]:
         subs = [c for c in base.iterdir() if c.is_dir()] if base.is_dir() else []
         for c in subs:
             left += kill_cgroup([c])
-            for _ in range(50):
-                try:
-                    c.rmdir()
-                    break
-                except FileNotFoundError:
-                    break
-                except OSError:
-                    time.sleep(0.02)
+            _rmdir_cgroup(c)
         try:
             base.rmdir()
         except OSError:
             pass
     _remove_folders(pid)
     return left
+
+
+def _rmdir_cgroup(folder: Path, tries: int = 50) -> None:
+    """Remove an emptied cgroup folder, retrying while the kernel still counts its last processes (EBUSY)."""
+    for _ in range(tries):
+        try:
+            folder.rmdir()
+            return
+        except FileNotFoundError:
+            return
+        except OSError:
+            time.sleep(0.02)
 
 
 def _remove_folders(pid: int) -> None:
@@ -413,14 +418,7 @@ class Enclosure:
 
     def _remove_cgroups(self) -> None:
         for c in self.cgroups:
-            for _ in range(50):
-                try:
-                    c.rmdir()
-                    break
-                except FileNotFoundError:
-                    break
-                except OSError:
-                    time.sleep(0.02)
+            _rmdir_cgroup(c)
 
     def close(self) -> None:
         """Kill what is left, remove the cgroup, unmount and delete the folder."""
