@@ -9,6 +9,9 @@ PYTEST_ARGS ?=
 # Parallel tests (pytest-xdist): `make test TEST_JOBS=2` runs 2 workers; the browser modules are one group that
 # one worker runs (--dist loadgroup; tests/conftest.py), the other tests are shared out one by one. 1: no xdist.
 TEST_JOBS ?= 1
+# Which tests test-fast runs: the folder of the layer you changed (tests/core, tests/pictures, tests/course,
+# tests/notebooks, tests/project), e.g. `make test-fast TESTS=tests/core`. Default: all of them.
+TESTS ?= tests
 XDIST := $(if $(filter-out 1,$(TEST_JOBS)),-n $(TEST_JOBS) --dist loadgroup)
 
 .PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium webkit poppler bubblewrap clean
@@ -48,14 +51,14 @@ chromium:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq chromium >/dev/null; }
 
 # The second browser engine of the browser tests: Debian's WebKitGTK, driven from Debian's python3 (GObject
-# introspection) under Xvfb (tests/webkit_run.py, tests/test_second_engine.py).
+# introspection) under Xvfb (tests/webkit_run.py, tests/course/test_second_engine.py).
 webkit:
 	@{ command -v xvfb-run >/dev/null 2>&1 && /usr/bin/python3 -c "import gi; gi.require_version('WebKit2', '4.1')" 2>/dev/null; } || { \
 	  echo "installing Debian's WebKitGTK, python3-gi and xvfb for the second-engine tests"; \
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq gir1.2-webkit2-4.1 python3-gi xvfb >/dev/null; }
 
-# Debian's poppler-utils (pdftotext, pdfinfo, pdftoppm): tests/test_print.py reads the handout PDFs with them.
+# Debian's poppler-utils (pdftotext, pdfinfo, pdftoppm): tests/course/test_print.py reads the handout PDFs with them.
 poppler:
 	@command -v pdftotext >/dev/null 2>&1 || { \
 	  echo "installing Debian's poppler-utils for the PDF tests"; \
@@ -77,7 +80,7 @@ test: $(STAMP) lint chromium webkit poppler bubblewrap
 
 # Quick loop while developing: no browser, no notebooks, no slow tests, no lint (`make lint` for that).
 test-fast: $(STAMP) bubblewrap
-	$(PY) -m pytest tests -m "not browser and not slow" -p no:cacheprovider $(XDIST) $(PYTEST_ARGS)
+	$(PY) -m pytest $(TESTS) -m "not browser and not slow" -p no:cacheprovider $(XDIST) $(PYTEST_ARGS)
 
 # JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
 # The course notebooks are trusted first (JupyterLab draws saved widgets only in trusted notebooks; otherwise

@@ -964,7 +964,7 @@ T_GRADE_200 = 8 * 60.0  # 200 workbooks, 2 cores, sandbox on
 
 def _browser_driver():
     """(tests/labdriver.py, None) when playwright and Debian's chromium are there, else (None, why not)."""
-    sys.path.insert(0, str(ROOT / "tests"))
+    sys.path[:0] = [str(ROOT / "tests"), str(ROOT / "tests" / "course")]  # labdriver; test_lite (time to first result)
     try:
         import playwright  # noqa: F401
 
@@ -1030,7 +1030,7 @@ def browser_section(args, targets: Targets) -> list[str]:
 def lite_section(args, targets: Targets) -> list[str]:
     """The in-browser site (JupyterLite on Pyodide, `make handouts` → build/handouts/lite): workbook 05 opened in
     Debian's chromium from a loopback server with every other request blocked, Run All as soon as the kernel is
-    ready, until its first picture (page clock from the page load; tests/test_lite.py time_to_first_result)."""
+    ready, until its first picture (page clock from the page load; tests/course/test_lite.py time_to_first_result)."""
     lines = [
         "## In the browser with nothing installed (JupyterLite site of `make handouts`)",
         "",
@@ -1045,6 +1045,7 @@ def lite_section(args, targets: Targets) -> list[str]:
     labdriver, missing = _browser_driver()
     try:
         import test_lite
+
         from kinlib.course.publish import handouts, lite
         from kinlib.course.publish.pages import build_assets
     except ImportError as exc:

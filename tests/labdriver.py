@@ -1,4 +1,4 @@
-"""Drive JupyterLab in Debian's chromium (playwright) the way a student does, for tests/test_browser.py and the
+"""Drive JupyterLab in Debian's chromium (playwright) the way a student does, for tests/pictures/test_browser.py and the
 browser section of ``make bench`` (bench/bench.py imports this module).
 
 * :func:`jupyterlab` starts JupyterLab on a copy of ``notebooks/`` as ``make lab`` does: the notebooks trusted

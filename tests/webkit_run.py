@@ -6,7 +6,7 @@ introspection, run by Debian's own ``/usr/bin/python3`` (``python3-gi``) under X
 Loads URL in a WebKit2.WebView, then calls the JavaScript function body in the file SCENARIO_JS (it may
 ``await``; what it returns is the result) and prints one JSON line: {"result": …, "requests": [every URI the
 page asked for], "error": null | "…"}. The engine version is in "engine". Nothing here is kinlib's: the tests
-(tests/test_second_engine.py) give the scenario and judge the result.
+(tests/course/test_second_engine.py) give the scenario and judge the result.
 """
 
 import json

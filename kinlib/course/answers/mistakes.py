@@ -19,7 +19,7 @@ Angle sets (:data:`SET_MISTAKES`) undo a mistake point by point (:func:`map_set`
 *What it tells the student.* A self-check that says "your matrix is the transpose of the answer" tells
 only that the transpose of what they typed is right; the student could have typed the transpose and
 asked the plain self-check the same question. So the named mistakes add no information beyond saving
-tries, and the messages hold no numbers of the answer (tests/test_selfcheck.py checks this).
+tries, and the messages hold no numbers of the answer (tests/course/test_selfcheck.py checks this).
 
 >>> import numpy as np
 >>> R = np.arange(6.0).reshape(1, 2, 3)       # one sample point, a 2×3 matrix

@@ -205,7 +205,7 @@ def grade_submission(
     >>> [(r["part"], r["status"], r["message"].split(" (")[0]) for r in res["rows"]]
     [('-', 'error', 'not a notebook: the file is not JSON')]
 
-    A real submission runs in a Jupyter kernel (seconds; tests/test_grade.py exercises it), hence not run here:
+    A real submission runs in a Jupyter kernel (seconds; tests/course/test_grade.py exercises it), hence not run here:
 
     >>> refs = load_references(default_notebooks(), cache=None)  # doctest: +SKIP
     >>> res = grade_submission("ann/02_planar.ipynb", refs)  # doctest: +SKIP
@@ -442,7 +442,7 @@ def grade_batch(
     (and every process a submission started) is gone.
 
     It runs the solution notebooks and every submission in Jupyter kernels (seconds to minutes;
-    tests/test_grade.py exercises it), hence not run here:
+    tests/course/test_grade.py exercises it), hence not run here:
 
     >>> summary = grade_batch(["submissions/"], "build/grades", jobs=2, log=None)  # doctest: +SKIP
     >>> summary["n"], sorted({r["status"] for r in summary["rows"]})  # submissions, statuses seen  # doctest: +SKIP

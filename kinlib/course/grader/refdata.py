@@ -157,7 +157,7 @@ def build_reference(
     """Execute the solution notebook ``path`` and read its answers (cached by content hash when ``cache`` and
     ``secret`` are given; a cache file whose HMAC tag does not verify is rebuilt, never used).
 
-    It runs the notebook in a Jupyter kernel (seconds; tests/test_grade.py exercises it), hence not run here:
+    It runs the notebook in a Jupyter kernel (seconds; tests/course/test_grade.py exercises it), hence not run here:
 
     >>> ref = build_reference(Path("notebooks/02_planar_robot_jacobian.ipynb"), cache=None)  # doctest: +SKIP
     >>> ref.notebook, ref.error  # doctest: +SKIP

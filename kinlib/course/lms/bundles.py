@@ -466,7 +466,7 @@ def run_platform(platform: str, root=None, bundle=None) -> dict:
     ``/autograder``) or "prairielearn" (``ROOT/student`` → ``ROOT/results/results.json``, ROOT ``/grade``).
     Without bubblewrap the student's kernels run as the bundle's unprivileged user (root's files locked away from
     it first), and every process of that user is ended before the results are written.
-    tests/test_grade_lms.py runs it in a simulated container; a platform it does not know:
+    tests/course/test_grade_lms.py runs it in a simulated container; a platform it does not know:
 
     >>> run_platform("moodle")
     Traceback (most recent call last):

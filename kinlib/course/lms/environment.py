@@ -119,7 +119,7 @@ def _norm(name: str) -> str:
 def requirements(notebooks, constraints: Path | None = None) -> tuple[list[str], list[str]]:
     """(requirement lines ``name==version``, module names to check) for grading ``notebooks`` (paths).
 
-    A module no installed distribution provides raises ValueError naming who imports it (tests/test_grade_lms.py);
+    A module no installed distribution provides raises ValueError naming who imports it (tests/course/test_grade_lms.py);
     the lesson notebooks need modern_robotics (their independent check) and the grader's kernel:
 
     >>> nbs = sorted(Path(__file__).resolve().parents[3].joinpath("notebooks").glob("0*.ipynb"))

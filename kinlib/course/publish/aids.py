@@ -56,7 +56,7 @@ def student_reading_aid(cell) -> None:
 
 
 # How to write the answer forms a student may not have met (shown under the stubs of those answers);
-# tests/test_notebook_structure.py checks that each example is accepted by the self-check's comparers.
+# tests/notebooks/test_notebook_structure.py checks that each example is accepted by the self-check's comparers.
 ANSWER_FORM_EXAMPLES = {
     "set": (
         "How to write a set of angles (SymPy sets; n is an integer symbol):",

@@ -173,7 +173,7 @@ async def _execute(nb, path: Path, timeout: int, capture_after: dict) -> dict:
 def execute_notebook(path: Path, timeout: int = 120):
     """Execute ``path``; return (executed notebook, groups, {(cell index, name): fingerprint}).
 
-    It runs the notebook in a Jupyter kernel (seconds; tests/test_handouts.py exercises it), hence not run here:
+    It runs the notebook in a Jupyter kernel (seconds; tests/course/test_handouts.py exercises it), hence not run here:
 
     >>> nb, groups, fps = execute_notebook(Path("notebooks/02_planar_robot_jacobian.ipynb"))  # doctest: +SKIP
     >>> sorted(name for _, name in fps)  # doctest: +SKIP
@@ -487,7 +487,7 @@ def _selfcheck_cell(group: Group, fps: dict, original):
 def run_workbook(path: Path, timeout: int = 120):
     """Run a workbook top to bottom (it must not raise); return the executed notebook.
 
-    It runs the workbook in a Jupyter kernel (seconds; tests/test_handouts.py exercises it), hence not run
+    It runs the workbook in a Jupyter kernel (seconds; tests/course/test_handouts.py exercises it), hence not run
     here:
 
     >>> nb = run_workbook(Path("build/handouts/workbooks/02_planar_robot_jacobian.ipynb"))  # doctest: +SKIP
@@ -529,7 +529,7 @@ def build_one(
     """Execute one notebook and write its three handouts; return its index entry.
 
     It runs the notebook (and, with ``verify``, the workbook) in a Jupyter kernel (seconds;
-    tests/test_handouts.py exercises it through :func:`build`), hence not run here:
+    tests/course/test_handouts.py exercises it through :func:`build`), hence not run here:
 
     >>> out = Path("build/handouts")
     >>> urls = build_assets(out / "assets", Path("build/vendor"))  # doctest: +SKIP
@@ -623,7 +623,7 @@ def build(
         ...
     FileNotFoundError: no notebooks named NN_*.ipynb in ...
 
-    A real build executes every notebook in a Jupyter kernel (minutes; tests/test_handouts.py exercises
+    A real build executes every notebook in a Jupyter kernel (minutes; tests/course/test_handouts.py exercises
     it), hence not run here:
 
     >>> entries = build(Path("notebooks"), Path("build/handouts"), jobs=2, only=["02"])  # doctest: +SKIP

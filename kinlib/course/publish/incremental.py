@@ -180,7 +180,7 @@ def build_sections(out: Path, all_paths, paths, keys: dict, stamps: Stamps, make
     the index entries of every section of ``all_paths`` that is current (with ``--only``, the others built before).
 
     :func:`kinlib.course.publish.handouts.build` passes its per-notebook step as ``make``; a second call with the same
-    keys makes nothing (tests/test_handouts_incremental.py runs both with a stand-in step):
+    keys makes nothing (tests/course/test_handouts_incremental.py runs both with a stand-in step):
 
     >>> entries, listed = build_sections(Path("build/handouts"), paths, paths, keys, Stamps(out), make)  # doctest: +SKIP
     """

@@ -26,7 +26,7 @@ The site's ``pyodide-lock.json`` is the official one cut down to the packages sh
 sha256) for the PyPI wheels and kinlib, so that ``import kinlib`` loads everything it needs from the site.
 Downloads are cached in ``$KINLIB_CACHE/lite`` (default ``~/.cache/kinlib/lite``): a second build is offline.
 
-Supported in the browser (tests/test_lite.py compares :data:`SUPPORTED` with the lock): Python 3.12.7,
+Supported in the browser (tests/course/test_lite.py compares :data:`SUPPORTED` with the lock): Python 3.12.7,
 numpy 2.0.2, matplotlib 3.8.4, sympy 1.14.0, mpmath 1.3.0, ipywidgets 8.1.9. Why 0.27.7 and not the 0.8 line of
 JupyterLite: its Pyodide needs wasm wheels of numpy/matplotlib that PyPI does not carry, and
 ``jupyterlite-pyodide-kernel`` 0.8.7 needs a ``jupyterlite-core`` 0.8.7 that the registry does not have.
@@ -142,7 +142,7 @@ EXTRA_LOCK = {
 }
 #: loaded when the kernel starts (so ``%load_ext kinlib.course.workbook.needs`` works in a workbook's first cell)
 PRELOAD = ["micropip", "ssl", "sqlite3", "jedi", "ipython", "comm", "kinlib"]
-#: what kinlib runs on in the browser (tests/test_lite.py checks these against the site's lock)
+#: what kinlib runs on in the browser (tests/course/test_lite.py checks these against the site's lock)
 SUPPORTED = {
     "pyodide": PYODIDE_VERSION,
     "python": "3.12.7",
@@ -454,7 +454,7 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
     """Build the JupyterLite site ``out/lite`` from ``out/workbooks/*.ipynb`` and the solution notebooks
     ``notebooks`` (a folder of executed ``NN_*.ipynb``, or a list of them); return ``out/lite``.
 
-    A download the first time (about 100 MB, cached; 10–30 s), hence not run here (tests/test_lite.py
+    A download the first time (about 100 MB, cached; 10–30 s), hence not run here (tests/course/test_lite.py
     builds and opens the site in Chromium):
 
     >>> site = build_lite(Path("build/handouts"))  # doctest: +SKIP

@@ -16,7 +16,7 @@ def npm_pack(name: str, version: str, vendor: Path) -> Path:
     """The unpacked npm package ``name@version`` under ``vendor`` (``npm pack`` from the registry once;
     the ``.tgz`` stays in ``vendor`` beside the unpacked ``package/`` folder).
 
-    A download the first time, hence not run here (tests/test_handouts.py and tests/test_lite.py use it):
+    A download the first time, hence not run here (tests/course/test_handouts.py and tests/course/test_lite.py use it):
 
     >>> npm_pack("requirejs", "2.3.8", Path("build/vendor")).name  # doctest: +SKIP
     'package'

@@ -83,7 +83,7 @@ def build_assets(assets: Path, vendor: Path) -> dict:
     (the keyword arguments of nbconvert's HTMLExporter used by :func:`export_html`).
 
     It copies MathJax and may run ``npm pack`` (a download, the first time), hence not run here;
-    tests/test_handouts.py exercises it:
+    tests/course/test_handouts.py exercises it:
 
     >>> urls = build_assets(Path("build/handouts/assets"), Path("build/vendor"))  # doctest: +SKIP
     >>> urls["require_js_url"]  # doctest: +SKIP

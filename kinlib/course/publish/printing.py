@@ -297,7 +297,7 @@ def print_pdfs(out: Path, *, pages=None, log=print) -> list[Path]:
     ...     print_pdfs(Path(d), log=lambda s: None)
     []
 
-    Printing real pages takes seconds each (tests/test_print.py does it), hence not run here:
+    Printing real pages takes seconds each (tests/course/test_print.py does it), hence not run here:
 
     >>> pdfs = print_pdfs(Path("build/handouts"))  # doctest: +SKIP
     >>> pdfs[0].relative_to("build/handouts").as_posix()  # doctest: +SKIP

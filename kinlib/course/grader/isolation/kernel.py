@@ -139,7 +139,7 @@ class Kernel:
     ...     k.alive(), k.run("1 + 1", timeout=5).summary()
     (False, 'the kernel was not running')
 
-    ``start`` launches an IPython kernel (seconds; tests/test_grade.py exercises it), hence not run here:
+    ``start`` launches an IPython kernel (seconds; tests/course/test_grade.py exercises it), hence not run here:
 
     >>> k = Kernel(cwd=".", conn_dir="/tmp")  # doctest: +SKIP
     >>> k.start()  # doctest: +SKIP
@@ -439,7 +439,7 @@ class NotebookRun:
     (None, 'the kernel was not running')
 
     ``execute`` starts a kernel (and a fresh one past a cell that kills it; seconds, exercised by
-    tests/test_grade.py), hence not run here:
+    tests/course/test_grade.py), hence not run here:
 
     >>> cells = [{"cell_type": "code", "source": "J = 2 * 3"},
     ...          {"cell_type": "code", "source": "import os; os._exit(1)"}]

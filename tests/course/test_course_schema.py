@@ -32,7 +32,7 @@ from kinlib.course.schema import (
     stash_points,
 )
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 GRADE_REF = ROOT / "tests" / "fixtures" / "grade" / "notebooks" / "90_grade_fixture.ipynb"
 HANDOUTS_REF = ROOT / "tests" / "fixtures" / "handouts" / "01_fixture_jacobians.ipynb"
 

@@ -17,7 +17,7 @@ from kinlib import manipulability as manip
 from kinlib import robots
 from kinlib.velocity import damped_least_squares
 
-SHEET = (Path(__file__).resolve().parents[1] / "notebooks" / "cheatsheet.md").read_text(encoding="utf-8")
+SHEET = (Path(__file__).resolve().parents[2] / "notebooks" / "cheatsheet.md").read_text(encoding="utf-8")
 RNG = np.random.default_rng(2121)
 
 

@@ -21,10 +21,10 @@ from kinlib.course.cli import main
 from kinlib.course.grader import grade
 from kinlib.course.grader.secret import load_secret
 
-FIX = Path(__file__).parent / "fixtures" / "grade"
+FIX = Path(__file__).resolve().parents[1] / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
 WB = FIX / "workbooks" / "90_grade_fixture.ipynb"
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 PARTS = ["1.1", "1.2", "1.3", "1.4", "1.5"]
 CELL_TIMEOUT = 3
 

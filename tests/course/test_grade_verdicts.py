@@ -32,7 +32,7 @@ from kinlib.course.grader.in_kernel.export import export
 from kinlib.singularities import task_rows
 
 pi = sp.pi
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 TH = [sp.Symbol(f"theta{i}", real=True) for i in (1, 2, 3)]
 POINTS = [{"theta1": 0.3, "theta2": -1.1, "theta3": 2.0, "L": 1.3}, {"theta1": -2.0, "theta2": 0.7, "L": 0.8}]
 

@@ -23,7 +23,7 @@ from kinlib.course.grader import batch, grade, intake, report
 from kinlib.course.grader.isolation import limits
 from kinlib.course.lms.bundles import canvas_csv
 
-FIX = Path(__file__).parent / "fixtures" / "grade"
+FIX = Path(__file__).resolve().parents[1] / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
 WB = FIX / "workbooks" / "90_grade_fixture.ipynb"
 PARTS = ["1.1", "1.2", "1.3", "1.4", "1.5"]

@@ -33,7 +33,7 @@ import sympy as sp  # noqa: E402
 import kinlib  # noqa: E402
 from helpers import assert_sym_equal  # noqa: E402
 
-NB_DIR = pathlib.Path(__file__).resolve().parents[1] / "notebooks"
+NB_DIR = pathlib.Path(__file__).resolve().parents[2] / "notebooks"
 NOTEBOOKS = {
     "01_properties_of_jacobians": ["1.1", "1.2", "1.3"],
     "02_planar_robot_jacobian": ["2.1", "2.2", "2.3", "2.4"],

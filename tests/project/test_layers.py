@@ -27,7 +27,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PKG = "kinlib"
 PKG_DIR = ROOT / PKG
 MAX_LINES = 700
@@ -655,7 +655,7 @@ def test_public_api_has_examples():
     total = sum(map(len, missing.values()))
     assert not missing, (
         f"{total} public functions/classes have no `>>>` example in their docstring "
-        "(tests/test_doctests.py runs them):\n  "
+        "(tests/project/test_doctests.py runs them):\n  "
         + "\n  ".join(f"{m} ({len(v)}): {', '.join(v)}" for m, v in missing.items())
     )
 

@@ -27,7 +27,7 @@ from kinlib.course.grader.in_kernel.export import export
 from kinlib.course.workbook.selfcheck import fingerprint
 from kinlib.course.workbook.selfcheck import verdict as sc_verdict
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NB = ROOT / "notebooks" / "07_going_further.ipynb"
 pi = sp.pi
 t1, t2, t3, t4 = sp.symbols("theta1:5", real=True)

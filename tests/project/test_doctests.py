@@ -10,7 +10,7 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE_DIR = Path(__file__).resolve().parents[1] / "kinlib"
+PACKAGE_DIR = Path(__file__).resolve().parents[2] / "kinlib"
 
 
 def _module_names() -> list[str]:

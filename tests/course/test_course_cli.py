@@ -17,7 +17,7 @@ import pytest
 import kinlib
 from kinlib.course.cli import main
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 HANDOUTS_FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 GRADE_FIXTURES = ROOT / "tests" / "fixtures" / "grade"
 VENDOR = ROOT / "build" / "vendor"

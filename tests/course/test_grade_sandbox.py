@@ -31,13 +31,13 @@ from kinlib.course.grader.isolation.kernel import Kernel
 from kinlib.course.grader.refdata import reference_description
 from kinlib.course.grader.secret import evaluation_seed, load_secret, sign
 
-FIX = Path(__file__).parent / "fixtures" / "grade"
+FIX = Path(__file__).resolve().parents[1] / "fixtures" / "grade"
 REF = FIX / "notebooks" / "90_grade_fixture.ipynb"
 WB = FIX / "workbooks" / "90_grade_fixture.ipynb"
 ATTACKS = FIX / "attacks"
 PARTS = ["1.1", "1.2", "1.3", "1.4", "1.5"]
 MARK = "g1" + os.urandom(6).hex()
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _load(p):

@@ -280,11 +280,11 @@ if found:  # whatever it found, as its answers
 @pytest.fixture(scope="module")
 def kernel_attacks(tmp_path_factory):
     from jupyter_client.session import Session
+    from test_grade import FIX, WB, completed
 
     from kinlib.course.grader import grade
     from kinlib.course.grader.isolation import sandbox
     from kinlib.course.grader.secret import evaluation_seed
-    from test_grade import FIX, WB, completed
 
     ok, why = sandbox.check()
     assert ok, f"the grader's sandbox does not work here: {why}"

@@ -262,7 +262,7 @@ def test_canvas_csv_points_possible_pending_and_roster(tmp_path):
 # configuration) are cached in PIP_CACHE_DIR (default ~/.cache/pip) across runs. The bundles are built without
 # the sandbox (Docker's default seccomp blocks bubblewrap), so the student's kernels run as the unprivileged user.
 
-NOTEBOOKS = Path(__file__).resolve().parent.parent / "notebooks"
+NOTEBOOKS = Path(__file__).resolve().parents[2] / "notebooks"
 STUDENT = "kinlib-student"
 SIM_PATH = "/usr/local/sbin:/usr/local/bin:/usr/sbin:/usr/bin:/sbin:/bin"
 

@@ -23,7 +23,7 @@ from kinlib import robots
 from kinlib.manipulability import NEAR_SINGULAR, peak_manipulability, singularity_state
 from kinlib.taskspace import task_rows
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 # a number given to or compared with a "near" name, or σ_min/σ_max ("inverse_condition", "ratio") compared with a
 # literal: each would be a second rule

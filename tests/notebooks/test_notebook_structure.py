@@ -27,7 +27,7 @@ from kinlib.course import schema
 from kinlib.course.publish import aids, handouts
 from kinlib.course.workbook.selfcheck import fingerprint
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 VENDOR = ROOT / "build" / "vendor"
@@ -191,7 +191,7 @@ def students(tmp_path_factory, monkeypatch_module):
     (out / "solutions" / "01_fixture_jacobians.html").write_text("left by an earlier full build")
     seen = {}
 
-    def fake_build_lite(out_, notebooks, log=print):  # the site itself is tests/test_lite.py's business
+    def fake_build_lite(out_, notebooks, log=print):  # the site itself is tests/course/test_lite.py's business
         seen["solutions"] = list(notebooks)
         seen["workbooks"] = sorted(p.name for p in (Path(out_) / "workbooks").glob("*.ipynb"))
 

@@ -27,7 +27,7 @@ import pytest
 
 import labdriver
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 VENDOR = ROOT / "build" / "vendor"
@@ -66,7 +66,7 @@ def browser(shared_browser):
 def sites(request, fixture_handouts):
     """The handouts of the real notebooks and of the fixture, each built once per run (tests/conftest.py:
     ``real_handouts``, what `make handouts` does, into build/handouts; ``fixture_handouts``, shared with
-    tests/test_handouts.py).
+    tests/course/test_handouts.py).
 
     ``KINLIB_HANDOUTS_DIR=build/handouts`` tests an existing build of the real notebooks instead (a quick
     loop after ``make handouts``). A failing real notebook fails its pages' tests, not the fixture's.

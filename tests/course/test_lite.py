@@ -20,7 +20,7 @@ import pytest
 
 from kinlib.course.publish import lite
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"
 VENDOR = ROOT / "build" / "vendor"
 SCREENSHOTS = ROOT / "build" / "screenshots"

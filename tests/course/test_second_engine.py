@@ -21,10 +21,9 @@ import subprocess
 from pathlib import Path
 
 import pytest
-
 from test_lite import handouts_site  # noqa: F401  (the site of notebook 05, built as make handouts does)
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DRIVER = ROOT / "tests" / "webkit_run.py"
 SCREENSHOTS = ROOT / "build" / "screenshots"
 

@@ -26,7 +26,7 @@ from kinlib.course.publish.analysis import cell_names
 from kinlib.course.workbook import selfcheck
 from kinlib.course.workbook.selfcheck import fingerprint, verdict
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FIXTURES = ROOT / "tests" / "fixtures" / "handouts"
 VENDOR = ROOT / "build" / "vendor"
 STEM = "01_fixture_jacobians"
@@ -126,7 +126,7 @@ def test_check_prints_a_line_per_answer(capsys):
 @pytest.fixture(scope="module")
 def built(fixture_handouts):
     """(folder, entry, log) of the fixture's handouts: built once per run (tests/conftest.py, shared with
-    tests/test_browser.py) with jobs=1, verify=False, site=False, pdfs=False."""
+    tests/pictures/test_browser.py) with jobs=1, verify=False, site=False, pdfs=False."""
     return fixture_handouts
 
 

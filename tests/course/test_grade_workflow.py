@@ -20,7 +20,7 @@ from kinlib.course import schema
 from kinlib.course.cli import main
 from kinlib.course.grader import credit, intake, report
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = sorted((ROOT / "notebooks").glob("[0-9][0-9]_*.ipynb"))
 
 

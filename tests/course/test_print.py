@@ -30,7 +30,7 @@ import pytest
 
 from kinlib.course.publish import pages, printing
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 NOTEBOOKS = ROOT / "notebooks"
 VENDOR = ROOT / "build" / "vendor"
 AXE = ("axe-core", "4.10.3")

@@ -1,7 +1,7 @@
 """Incremental handouts (kinlib.course.publish.incremental): what is reused, what is made again.
 
 The orchestration is tested with a stand-in for the per-notebook step (no kernel: milliseconds); the real
-second build of the fixture notebook (it executes nothing and changes no file) is in tests/test_handouts.py,
+second build of the fixture notebook (it executes nothing and changes no file) is in tests/course/test_handouts.py,
 which builds that notebook once for all its tests.
 """
 
