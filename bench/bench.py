@@ -911,10 +911,11 @@ def static_section(args, targets: Targets) -> list[str]:
     """The explorer of notebook 05's solutions page (as `make handouts` writes it), opened from disk: no kernel,
     network blocked; 20 key presses on θ1, key → the frame that shows the redrawn picture (page clock)."""
     lines = [
-        "## On a static page (solutions 05 as `make handouts` writes it, opened from disk: no kernel)",
+        "## On a static page (solutions 05 and 04 as `make handouts` writes them, opened from disk: no kernel)",
         "",
         f"Slider: a key press on the focused θ1 slider, {args.moves} moves (→ ← alternating), from the keydown to the "
-        "animation frame that paints the redrawn SVG, page clock.",
+        "animation frame that paints the redrawn SVG, page clock; the same for the 05 animation's step slider and "
+        "the 04 picker's buttons (arrow keys between them).",
         "",
     ]
     if args.quick:
@@ -944,8 +945,27 @@ def static_section(args, targets: Targets) -> list[str]:
                 status = targets.upper(f"slider 05 explorer {i + 1} (static page)", med, T_SLIDER)
                 rows.append([f"05 explorer {i + 1}", fmt_t(min(ms) / 1000), fmt_t(med), fmt_t(max(ms) / 1000)])
                 rows[-1] += ["≤ 16 ms", status]
+            # the animation's step slider (05) and the picker's buttons (04): the same key → painted frame
+            anim = page.locator(".jp-OutputArea-output").filter(has=page.locator(".kinlib-animation")).first
+            rows.append(_key_row(labdriver, targets, "05 animation step", anim, "input.kinlib-step", args.moves))
+            nb4 = ROOT / "notebooks" / "04_interpreting_the_jacobian.ipynb"
+            handouts.build_one(nb4, out, urls, 300, False, log=lambda s: None)
+            page.goto((out / "solutions" / f"{nb4.stem}.html").as_uri())
+            page.wait_for_selector(".kinlib-picker .kinlib-arm")
+            pick = page.locator(".jp-OutputArea-output").filter(has=page.locator(".kinlib-picker")).first
+            rows.append(_key_row(labdriver, targets, "04 picker button", pick, "button[aria-pressed=true]", args.moves))
             page.close()
     return lines + table(["explorer", "min", "median", "max", "target (median)", "status"], rows)
+
+
+def _key_row(labdriver, targets, what: str, area, control: str, moves: int) -> list[str]:
+    """``moves`` key presses (→ ← alternating) on ``control`` in ``area``, key → the frame that paints it."""
+    labdriver.wait_picture(area)
+    handle = area.locator(control)
+    ms = [labdriver.move_slider(area, handle, ("ArrowRight", "ArrowLeft")[k % 2]) for k in range(moves)]
+    med = statistics.median(ms) / 1000
+    status = targets.upper(f"{what} (static page)", med, T_SLIDER)
+    return [what, fmt_t(min(ms) / 1000), fmt_t(med), fmt_t(max(ms) / 1000), "≤ 16 ms", status]
 
 
 _GRADE_RUN = """

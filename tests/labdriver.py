@@ -256,13 +256,13 @@ def run_all(page, timeout: float = 300, details: bool = False):
     return (wall, run["kernel"]) if details else wall
 
 
-_MARK_WIDGET_CELLS = """() => {
+_MARK_WIDGET_CELLS = r"""() => {
   const w = window.jupyterapp.shell.currentWidget;
   const found = [];
   w.content.widgets.forEach((c, i) => {
     if (c.model.type !== 'code') return;
     if (c.model.outputs.toJSON().some(o => o.data && (o.data['application/vnd.jupyter.widget-view+json']
-        || String(o.data['application/javascript'] || '').includes('kinlibExplorer')))) {
+        || /window\.kinlib(Explorer|Animation|Picker)\(host, S\)/.test(String(o.data['application/javascript'] || ''))))) {
       c.node.setAttribute('data-kinlib-cell', String(i));
       found.push(i);
     }
@@ -272,8 +272,8 @@ _MARK_WIDGET_CELLS = """() => {
 
 
 def widget_cells(page):
-    """The output areas of the code cells whose output is a Jupyter widget or a kinlib explorer (its
-    ``application/javascript``), in notebook order."""
+    """The output areas of the code cells whose output is a Jupyter widget or a kinlib explorer, animation or
+    picker (its ``application/javascript``), in notebook order."""
     return [page.locator(f"[data-kinlib-cell='{i}'] .jp-OutputArea").first for i in page.evaluate(_MARK_WIDGET_CELLS)]
 
 
@@ -297,15 +297,15 @@ def explorers(page, timeout: float = 60):
     found = []
     for area in widget_cells(page):
         scroll_to(area, timeout)
-        area.locator(".jupyter-widgets, .kinlib-explorer").first.wait_for(state="attached", timeout=timeout * 1000)
+        area.locator(".jupyter-widgets, .kinlib-ui").first.wait_for(state="attached", timeout=timeout * 1000)
         if EXPLORER_TEXT in area.text_content():
             found.append(area)
     return found
 
 
 def animations(page):
-    """The outputs that hold a matplotlib ``to_jshtml`` animation."""
-    return page.locator(".jp-OutputArea-output").filter(has=page.locator("img[id^='_anim_img']"))
+    """The outputs that hold a kinlib animation (``kinlib.widgets.animate_singularity``)."""
+    return page.locator(".jp-OutputArea-output").filter(has=page.locator(".kinlib-animation"))
 
 
 _PICTURE = """(root) => Array.from(root.querySelectorAll('img')).some(

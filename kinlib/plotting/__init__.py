@@ -38,9 +38,8 @@ Functions (each returns an object to update or inspect):
 * ``plot_singularity_cost(chain, joint, q_singular, V, *, offsets=None, damping=0.05)`` → :class:`CostPlot`
   (what a singularity costs: ‖J⁻¹V‖ beside damped least squares and its velocity error, log scales);
 * ``legend_beside(ax, where="right")``: a legend outside the axes (never over the drawing);
-* ``sweep(chain, joint, values, q_fixed=None)`` and ``animate_singularity(chain, path)`` → a FuncAnimation
-  (``.to_jshtml()`` plays in a static page and shows frame 0 at once; as a cell's value it also carries a
-  static image/png of frame 0).
+* ``sweep(chain, joint, values, q_fixed=None)``: a path through the joint space (the animation of such a path
+  plays in the browser: :func:`kinlib.widgets.animate_singularity`).
 
 Joints are numbered as in the book, 1…n (``joint=2`` is θ2).  Task rows are those of
 :mod:`kinlib.taskspace`: names ``'wx','wy','wz','vx','vy','vz'`` (indices 0…5 of [ω_s; ṗ]) and presets
@@ -51,7 +50,7 @@ Modules: :mod:`~kinlib.plotting.common` (input checks, colours), :mod:`~kinlib.p
 fitting, label placement), :mod:`~kinlib.plotting.primitives` (movable arrows, lines, text),
 :mod:`~kinlib.plotting.artists` (the artist classes), :mod:`~kinlib.plotting.drawing` (the ``draw_*``
 functions), :mod:`~kinlib.plotting.plots` (bar charts, directions, manipulability curve and map, sweeps),
-:mod:`~kinlib.plotting.cost`, :mod:`~kinlib.plotting.animation`.
+:mod:`~kinlib.plotting.cost`.
 
 >>> import kinlib.plotting as P
 >>> from kinlib.robots import planar_offset_3r
@@ -63,7 +62,6 @@ from __future__ import annotations
 
 from ..manipulability import manipulability_values
 from ..taskspace import ROW_LABELS, ROW_NAMES, ROW_TEX, is_planar, task_row_indices
-from .animation import animate_singularity
 from .artists import ChainArtist, EllipseArtist, JointVelocitiesArtist, VelocityArtist
 from .common import FRAME_COLORS, JOINT_COLORS, default_ranges
 from .cost import CostPlot, plot_singularity_cost
@@ -116,7 +114,6 @@ __all__ = [
     "CurvePlot",
     "MapPlot",
     "sweep",
-    "animate_singularity",
     "new_axes",
     "legend_beside",
     "pi_ticks",

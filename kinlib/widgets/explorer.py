@@ -7,7 +7,7 @@ How it is built (one implementation, every place a notebook is shown):
   expressions its NumPy code is generated from (:meth:`kinlib.chains.SerialChain.numeric_code`,
   :meth:`kinlib.codegen.CompiledMatrix.javascript`): ``skel(q)`` (base, joint points, tool) and ``jg(q)``, the
   **geometric Jacobian** J = blockdiag(R, R) J_b, rows [ω_s; ṗ]. From them the front end
-  (``explorer.js`` beside this file) computes σ's (Jacobi eigenvalues of J_r J_rᵀ), det J, the manipulability,
+  (``core.js`` and ``explorer.js`` beside this file, :mod:`kinlib.widgets.frontend`) computes σ's (Jacobi eigenvalues of J_r J_rᵀ), det J, the manipulability,
   the ṗ ellipse with the task's orientation rows held and with every joint free, and the direction the tool
   cannot move; the closed-form singular set (:func:`kinlib.singularities.singular_configurations`) is sent as
   families (θ_i = offset + k·period, or listed values) and as generated JavaScript for conditions in several
@@ -50,9 +50,7 @@ from __future__ import annotations
 
 import base64
 import io
-import json
 import math
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
@@ -64,17 +62,13 @@ from ..manipulability import NEAR_SINGULAR, SINGULAR_RTOL, peak_manipulability, 
 from ..plotting.common import as_configuration, checked_numeric, default_ranges, reach
 from ..singularities import singular_configurations
 from ..taskspace import default_task_rows, is_planar, task_row_indices, task_rows
+from .frontend import script, square_view
 
 __all__ = ["explorer", "Explorer", "classify_families", "FRONT_END"]
 
-#: the front end's source (the same file for every explorer)
+#: the explorer's part of the front end (beside it: core.js, the part every picture shares)
 FRONT_END = Path(__file__).with_name("explorer.js")
 _ROUNDING = 1e-9  # a slider value "is" a family member within this (relative): the rounding of lo + k·step
-
-
-@lru_cache(maxsize=1)
-def _front_end() -> str:
-    return FRONT_END.read_text(encoding="utf-8")
 
 
 def _families(cond, thetas) -> list[dict] | None:
@@ -246,34 +240,15 @@ class Explorer:
         J = self.chain.jacobian_geometric(Q)[:, list(self.ellipse_rows), :]
         smax = float(np.max(np.linalg.svd(J, compute_uv=False)[:, 0])) * vscale
         pts = np.concatenate([sk.transpose(1, 0, 2).reshape(3, -1), np.zeros((3, 1))], axis=1)
-        lo, hi = pts.min(axis=1) - smax, pts.max(axis=1) + smax  # room for the largest ellipse at any point
-        if self.planar:
-            c = 0.5 * (lo + hi)
-            half = 0.5 * float(max(hi[0] - lo[0], hi[1] - lo[1])) * 1.08 + 1e-9
-            span = 2 * half
-            raw = span / 6
-            mag = 10 ** math.floor(math.log10(raw))
-            tick = min((m * mag for m in (1, 2, 2.5, 5, 10) if m * mag >= raw), default=10 * mag)
-            return {"x0": c[0] - half, "x1": c[0] + half, "y0": c[1] - half, "y1": c[1] + half, "tick": tick}
-        c = 0.5 * (lo + hi)
-        c[2] = max(c[2], 0.0)
-        r = float(np.max(np.linalg.norm(pts - c[:, None], axis=0))) + smax
-        return {"c": c.tolist(), "r": r, "az": 0.6, "el": 0.45}
+        return square_view(pts, self.planar, smax)  # room for the largest ellipse at any point
+
+    #: the picture's part of the front end (:data:`kinlib.widgets.frontend.ENTRIES`)
+    entry = "explorer"
 
     @property
     def javascript(self) -> str:
         """The output: the front end, the generated functions and the spec, self-contained."""
-        spec = json.dumps(self.spec, ensure_ascii=False, separators=(",", ":")).replace("<", "\\u003c")
-        fns = ",".join(f"c{k}" for k in range(len(self._exprs)))
-        return (
-            _front_end()
-            + "\n(function () {\n"
-            + "\n".join(self._funcs)
-            + f"\nvar S = {spec};\nS.skel = skel; S.jg = jg; S.condFns = [{fns}];\n"
-            + "window.__kinlibN = (window.__kinlibN || 0) + 1; S.id = 'kinlib-explorer-' + window.__kinlibN;\n"
-            + "var host = (typeof element !== 'undefined' && element) ? (element.jquery ? element[0] : element) : document.currentScript.parentNode;\n"
-            + "window.kinlibExplorer(host, S);\n})();\n"
-        )
+        return script(self.entry, self._funcs, self.spec, len(self._exprs))
 
     # -- the same rules in Python (scripts, tests, the text/plain line) ------------------------------
     def update(self, q=None, qdot=None):

@@ -5,7 +5,7 @@ downloaded browser, with the network blocked.
    notebooks and from the fixture notebook) loads from disk with no request leaving the machine, no
    page error and no failed request, shows typeset math (MathJax output, no raw TeX) and its figures
    (every image decoded), and the saved widgets; a screenshot of each goes to build/screenshots/.
-   An animation (matplotlib ``to_jshtml``) plays in the static page.
+   The animation (5.2) steps and plays, and the picker (4.1) changes configuration, in the static pages.
 2. JupyterLab as ``make lab`` starts it (tests/labdriver.py: notebooks trusted, notebooks/.lab-settings/), on a free
    loopback port: every notebook opened fresh shows its widgets' and animation's pictures before running,
    runs all cells (the time is printed, not asserted), and a slider of each explorer (a button of a picker)
@@ -184,46 +184,64 @@ def _has_tex(html: str) -> bool:
     return bool(re.search(r"\$|\\\(|\\\[|\\begin\{", text))
 
 
-def _animation_pages(sites):
+def _pages_with(sites, needle):
     pages = []
     for site, root in sites.items():
         if isinstance(root, Exception):
             continue
         for p in sorted((root / "solutions").glob("*.html")):
-            if "anim_step_forward" in p.read_text(encoding="utf-8") or "_anim_img" in p.read_text(encoding="utf-8"):
+            if needle in p.read_text(encoding="utf-8"):
                 pages.append((site, p))
     return pages
 
 
-def test_an_animation_plays_without_a_kernel(sites, browser):
-    pages = _animation_pages(sites)
+def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser):
+    """kinlib.widgets' animation (5.2) and configuration picker (4.1) on the static solutions pages (files, no
+    kernel, network blocked): the step slider's arrow key and the play button step the arm, a picker button draws
+    another configuration (tests/pictures/test_widgets.py checks what is drawn)."""
+    pages = _pages_with(sites, "window.kinlibAnimation(host, S);")
     assert any(site == "fixture" for site, _ in pages)
     for _kind, path in pages:
         page, watch = _open(browser, path)
         try:
-            img = page.locator("img[id^='_anim_img']").first
-            img.scroll_into_view_if_needed()
-            first = img.get_attribute("src")
-            # the "next frame" button, then play: the frame changes with no kernel and no network
-            page.locator("button[onclick*='next_frame']").first.click()
-            page.wait_for_timeout(150)
-            second = img.get_attribute("src")
-            assert second != first, f"{path.name}: the animation did not step"
-            page.locator("button[onclick*='play_animation']").first.click()
-            seen = set()
-            for _ in range(12):
-                page.wait_for_timeout(40)
-                seen.add(img.get_attribute("src"))
-            assert len(seen) >= 2, f"{path.name}: the animation did not play"
+            root = page.locator(".kinlib-animation").first
+            root.locator(".kinlib-arm").wait_for(timeout=15000)
+            root.scroll_into_view_if_needed()
+            arm = root.locator(".kinlib-arm")
+            first = arm.get_attribute("d")
+            root.locator("input.kinlib-step").focus()
+            page.keyboard.press("ArrowRight")
+            assert root.get_attribute("data-step") == "1" and arm.get_attribute("d") != first, path.name
+            root.locator("button.kinlib-play").click()
+            page.wait_for_function(
+                "(r) => +r.getAttribute('data-step') >= 3", arg=root.element_handle(), timeout=15000, polling=20
+            )
+            root.locator("button.kinlib-play").click()  # pause
             watch.assert_clean(path.name)
         finally:
             page.close()
     assert "05_singularities_planar" in REAL, "notebooks/05_singularities_planar.ipynb is missing"
     _site(sites, "handouts")
-    assert any(site == "handouts" for site, _ in pages), (
-        "no real handout carries an animation: notebook 05 should show "
-        "kinlib.plotting.animate_singularity(...) as HTML(anim.to_jshtml())"
+    assert any(site == "handouts" and p.stem.startswith("05") for site, p in pages), (
+        "notebook 05's solutions page has no animation: it should show kinlib.widgets.animate_singularity(...)"
     )
+    pickers = [p for site, p in _pages_with(sites, "window.kinlibPicker(host, S);") if site == "handouts"]
+    assert [p.stem[:2] for p in pickers] == ["04"], pickers
+    page, watch = _open(browser, pickers[0])
+    try:
+        root = page.locator(".kinlib-picker").first
+        root.locator(".kinlib-arm").wait_for(timeout=15000)
+        root.scroll_into_view_if_needed()
+        before = root.locator(".kinlib-arm").get_attribute("d")
+        second = root.locator("button.kinlib-config").nth(1)
+        second.focus()
+        page.keyboard.press("Enter")
+        assert (
+            second.get_attribute("aria-pressed") == "true" and root.locator(".kinlib-arm").get_attribute("d") != before
+        )
+        watch.assert_clean(pickers[0].name)
+    finally:
+        page.close()
 
 
 def _explorer_on_static_page(sites, browser, stem, index=-1):

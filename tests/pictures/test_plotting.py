@@ -522,18 +522,18 @@ def test_rpp_is_never_singular():
     assert not m.singular
 
 
-# --- animation -----------------------------------------------------------------------------------
-def test_animate_singularity_plays_in_a_static_page():
+# --- the path of an animation (the animation itself plays in the browser: tests/pictures/test_widgets.py) ------
+def test_sweep_and_the_animation_of_it():
+    from kinlib import widgets
+
     chain = robots.planar_offset_3r(1)
     path = P.sweep(chain, 2, np.linspace(0, -math.pi / 2, 5), q_fixed=[0.3, 0, 0.2])
     assert path.shape == (5, 3) and np.all(path[:, 0] == 0.3)
-    anim = P.animate_singularity(chain, path)
+    anim = widgets.animate_singularity(chain, path)
     np.testing.assert_allclose(anim.values, _mr_planar_manipulability(chain, path), atol=1e-9)
-    assert anim.values[2] < 1e-9  # θ2 = −π/4: singular
-    html = anim.to_jshtml()
-    assert "<img" in html or "frames[" in html
+    assert anim.values[2] < 1e-9 and anim.states[2] == "singular"  # θ2 = −π/4
     with pytest.raises(ValueError, match="path"):
-        P.animate_singularity(chain, np.zeros((5, 2)))
+        widgets.animate_singularity(chain, np.zeros((5, 2)))
 
 
 def test_ellipse_outline_matches_an_independent_svd():
@@ -635,29 +635,3 @@ def test_plot_joint_contributions_marks_ties():
     assert [b.get_linewidth() for b in bars][:2] == [2.5, 2.5] and bars[2].get_linewidth() != 2.5
     with pytest.raises(TypeError, match="values"):
         P.plot_joint_contributions(ax, ["a"])
-
-
-def test_animation_shows_frame_0_at_once_and_carries_a_static_picture():
-    """After run-all the player must not be blank: its <img> starts with frame 0 (and its size), the player
-    starts only once its <img> is in the page, and the display bundle has frame 0 as image/png."""
-    import base64
-    import io
-    import re
-
-    from PIL import Image
-
-    chain = robots.planar_offset_3r(1)
-    path = P.sweep(chain, 2, [-1.0, -np.pi / 4, 0.5], q_fixed=[np.pi / 4, 0, np.pi / 4])
-    anim = P.animate_singularity(chain, path, dpi=50)
-    html = anim.to_jshtml()
-    frame0 = re.search(r'frames\[0\] = "([^"]*)"', html, re.S).group(1).replace("\\\n", "")
-    img = re.search(r'<img id="_anim_img\w+"([^>]*)>', html).group(1)
-    assert f'src="{frame0}"' in img
-    png = base64.b64decode(frame0.split(",", 1)[1])
-    w, h = Image.open(io.BytesIO(png)).size
-    assert f'width="{w}" height="{h}"' in img and w > 100 and h > 100
-    assert "setTimeout(function() {\n        anim" not in html and "document.getElementById(img_id)" in html
-    bundle = anim._repr_mimebundle_()
-    assert base64.b64decode(bundle["image/png"]) == png
-    assert "font-awesome" not in bundle["text/html"] and "FuncAnimation" not in bundle["text/plain"]
-    plt.close(anim._fig)

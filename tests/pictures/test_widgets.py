@@ -1,8 +1,9 @@
 """kinlib.widgets: the explorer computed in the browser (kinlib/widgets/explorer.js with the functions kinlib
 generates) draws the arm where the forward kinematics puts it and says the right thing about singular
 configurations — checked against independent computation (modern_robotics, NumPy SVD, the closed-form
-singular set), numerically with Node (when installed) and drawn in Chromium (``browser`` mark); the
-configuration picker (problem 4.1) reacts to its buttons."""
+singular set), numerically with Node (when installed) and drawn in Chromium (``browser`` mark); the animation
+of a path (5.2) draws the arm where fk puts it and says what the near rule says at every step; the configuration
+picker (problem 4.1) draws the configuration each button names."""
 
 import json
 import math
@@ -19,7 +20,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 import sympy as sp  # noqa: E402
 
-from kinlib import robots, widgets  # noqa: E402
+from kinlib import plotting, robots, widgets  # noqa: E402
 from kinlib.manipulability import NEAR_SINGULAR, peak_manipulability, singularity_state  # noqa: E402
 from kinlib.taskspace import task_rows  # noqa: E402
 
@@ -115,16 +116,45 @@ def test_bad_input(r3):
         widgets.explorer(r3, colour="red")
 
 
-def test_display_bundle_carries_the_front_end_and_a_static_picture(r3):
-    import base64
+def _path_05(chain, n=6):
+    """Notebook 05's sweep: θ1 = θ3 = π/4, θ2 through −π/4, 2n + 1 steps denser near the middle."""
+    steps = np.arange(-n, n + 1)
+    return plotting.sweep(
+        chain, 2, -np.pi / 4 + 0.78 * np.sign(steps) * (steps / n) ** 2, q_fixed=[np.pi / 4, 0, np.pi / 4]
+    )
 
-    b = widgets.explorer(r3)._repr_mimebundle_()
+
+CONFIGS_4_1 = {  # problem 4.1 (its rows: ṗ_x, ṗ_x, ṗ_y)
+    "θ = (−π/8, π/4, π/8)": ([-math.pi / 8, math.pi / 4, math.pi / 8], "vx"),
+    "θ = (3π/4, −π/4, 0)": ([3 * math.pi / 4, -math.pi / 4, 0], "vx"),
+    "θ = (π/2, −π/8, −π/2)": ([math.pi / 2, -math.pi / 8, -math.pi / 2], "vy"),
+}
+
+
+def _picker_4_1():
+    return widgets.config_picker(robots.planar_3r(1, 1, 1), {k: q for k, (q, _) in CONFIGS_4_1.items()},
+                                 rows={k: r for k, (_, r) in CONFIGS_4_1.items()})  # fmt: skip
+
+
+@pytest.mark.parametrize("what", ["explorer", "animation", "picker"])
+def test_display_bundle_carries_the_front_end_and_a_static_picture(r3, what):
+    import base64
+    import io
+
+    from PIL import Image
+
+    obj = {"explorer": lambda: widgets.explorer(r3), "animation": lambda: widgets.animate_singularity(r3, _path_05(r3)),
+           "picker": _picker_4_1}[what]()  # fmt: skip
+    b = obj._repr_mimebundle_()
     assert set(b) == {"application/javascript", "image/png", "text/plain"}
-    assert base64.b64decode(b["image/png"]).startswith(PNG)
+    png = base64.b64decode(b["image/png"])
+    assert png.startswith(PNG) and min(Image.open(io.BytesIO(png)).size) > 150
     js = b["application/javascript"]
-    assert "function skel(q)" in js and "function jg(q)" in js and "kinlibExplorer" in js
+    entry = {"explorer": "kinlibExplorer", "animation": "kinlibAnimation", "picker": "kinlibPicker"}[what]
+    assert "function skel(q)" in js and "function jg(q)" in js and f"window.{entry}(host, S);" in js
     assert "</script" not in js.lower()  # safe inside a page's <script>
-    assert "explorer of planar_offset_3r" in b["text/plain"]
+    assert {"explorer": "explorer of planar_offset_3r", "animation": "1 singular, 4 near",
+            "picker": "configuration picker for planar_3r"}[what] in b["text/plain"]  # fmt: skip
 
 
 def test_output_is_deterministic(r3):
@@ -134,7 +164,8 @@ def test_output_is_deterministic(r3):
 def test_importing_widgets_leaves_pyplot_figures_alone(r3):
     n = len(plt.get_fignums())
     widgets.explorer(r3)._repr_mimebundle_()
-    widgets.config_picker(robots.planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]})
+    widgets.config_picker(robots.planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]})._repr_mimebundle_()
+    widgets.animate_singularity(r3, [[0, 0, 0], [0, 0.1, 0]])._repr_mimebundle_()
     assert len(plt.get_fignums()) == n
 
 
@@ -327,33 +358,144 @@ def test_keyboard_moves_a_slider_and_the_live_text_says_so(chromium, r3, tmp_pat
         page.close()
 
 
+# --- the animation of a path (5.2), in Chromium: fk at every step, the rule's banner, the keyboard --------------
+_READ_STEP = """() => {
+  const root = document.querySelector('.kinlib-animation'), X = root.kinlib;
+  const pick = sel => Array.from(root.querySelectorAll(sel)).map(e => [+e.getAttribute('data-x'), +e.getAttribute('data-y'),
+    +e.getAttribute('data-z'), e.tagName === 'circle' ? +e.getAttribute('cx') : +e.getAttribute('x') + 6,
+    e.tagName === 'circle' ? +e.getAttribute('cy') : +e.getAttribute('y') + 6]);
+  const tool = root.querySelector('.kinlib-tool'), d = tool.getAttribute('d').match(/[-0-9.]+/g).map(Number);
+  return {step: +root.getAttribute('data-step'), input: +root.querySelector('.kinlib-step').value,
+          cursor: +root.querySelector('.kinlib-cursor').getAttribute('data-step'),
+          joints: pick('.kinlib-joint'), tool: [+tool.getAttribute('data-x'), +tool.getAttribute('data-y'),
+          +tool.getAttribute('data-z'), d[2], d[1]], state: root.querySelector('.kinlib-status').getAttribute('data-state'),
+          banner: root.querySelector('.kinlib-status').textContent, held: root.querySelector('.kinlib-held').textContent,
+          blocked: root.querySelectorAll('.kinlib-blocked').length, live: root.querySelector('.kinlib-live').textContent,
+          view: X.S.view, k: X.S.k, px0: X.S.px0, py0: X.S.py0, states: X.states};
+}"""
+
+
+@pytest.mark.browser
+def test_animation_draws_fk_and_the_rule_at_every_step(chromium, r3, tmp_path):
+    """Notebook 05's path, stepped with the keyboard only (the step slider's arrow keys): at every step the drawn
+    joints and tool (read back from the SVG) are the skeleton and modern_robotics' FKinSpace, at pixels under one
+    scale; the banner is what kinlib.nearsingular says (w < NEAR_SINGULAR · w_max, w_max = √2 L² exactly), the
+    singular step shows the collapsed held ellipse and the blocked direction, the aria-live sentence names the step
+    and the state; the buttons step (back from the first wraps to the last) and play/pause."""
+    path = _path_05(r3)
+    anim = widgets.animate_singularity(r3, path, velocity_scale=0.35)
+    rule = list(singularity_state(task_rows(r3.jacobian_geometric(path), "planar"), math.sqrt(2)))
+    assert rule.count("singular") == 1 and rule.count("near") == 4 and anim.states == rule
+    page, errors = page_with(chromium, [anim], tmp_path)
+    try:
+        page.locator("input.kinlib-step").focus()
+        for k, q in enumerate(path):
+            if k:
+                page.keyboard.press("ArrowRight")
+            got = page.evaluate(_READ_STEP)
+            assert got["step"] == got["input"] == got["cursor"] == k
+            assert got["states"] == rule
+            world = np.array([j[:3] for j in got["joints"]]).T
+            np.testing.assert_allclose(world, r3.skeleton(q)[:, 1:-1], atol=1e-9)
+            np.testing.assert_allclose(got["tool"][:3], tool_position(r3, q), atol=1e-9)
+            v, s = got["view"], got["k"]
+            for p in got["joints"] + [got["tool"]]:
+                assert abs(p[3] - (got["px0"] + (p[0] - v["x0"]) * s)) < 0.01
+                assert abs(p[4] - (got["py0"] - (p[1] - v["y0"]) * s)) < 0.01
+            assert got["state"] == rule[k], (k, got["state"], rule[k])
+            assert got["live"].startswith(f"Step {k + 1} of {len(path)}")
+            held = [float(x) for x in got["held"].split(",")]
+            if rule[k] == "singular":
+                assert min(held) == 0 < max(held) and got["blocked"] == 1
+                assert "SINGULAR" in got["banner"] and "Singular configuration" in got["live"]
+                assert "cannot move along" in got["live"]
+            else:
+                assert min(held) > 0 and ("Near a singular" in got["live"]) == (rule[k] == "near")
+        page.keyboard.press("Home")
+        assert page.evaluate(_READ_STEP)["step"] == 0
+        page.locator("button.kinlib-prev").click()  # back from the first: the last
+        assert page.evaluate(_READ_STEP)["step"] == len(path) - 1
+        page.locator("button.kinlib-next").click()
+        assert page.evaluate(_READ_STEP)["step"] == 0
+        play = page.locator("button.kinlib-play")
+        play.click()
+        assert play.get_attribute("aria-pressed") == "true"
+        page.wait_for_function("() => +document.querySelector('.kinlib-animation').getAttribute('data-step') >= 2",
+                               timeout=30000)  # fmt: skip
+        play.press("Enter")  # pause, from the keyboard
+        assert play.get_attribute("aria-pressed") == "false"
+        at = page.evaluate(_READ_STEP)["step"]
+        page.wait_for_timeout(3 * anim.interval)
+        assert page.evaluate(_READ_STEP)["step"] == at, "still playing after pause"
+        assert not errors, errors
+    finally:
+        page.close()
+
+
 # --- the configuration picker (problem 4.1) -----------------------------------------------------------
-CONFIGS = {
-    "θ = (−π/8, π/4, π/8)": [-math.pi / 8, math.pi / 4, math.pi / 8],
-    "θ = (3π/4, −π/4, 0)": [3 * math.pi / 4, -math.pi / 4, 0],
-    "θ = (π/2, −π/8, −π/2)": [math.pi / 2, -math.pi / 8, -math.pi / 2],
-}
+_READ_PICK = """() => {
+  const root = document.querySelector('.kinlib-picker'), X = root.kinlib;
+  const attrs = (sel, names) => Array.from(root.querySelectorAll(sel)).map(e => names.map(n => +e.getAttribute(n)));
+  return {name: root.getAttribute('data-config'),
+          pressed: Array.from(root.querySelectorAll('button.kinlib-config')).filter(b => b.getAttribute('aria-pressed') === 'true').map(b => b.getAttribute('data-name')),
+          focused: document.activeElement.getAttribute('data-name'),
+          joints: attrs('.kinlib-joint', ['data-x', 'data-y', 'data-z']), tool: attrs('.kinlib-tool', ['data-x', 'data-y', 'data-z'])[0],
+          arrows: attrs('.kinlib-jvel', ['data-x', 'data-y']), bars: attrs('.kinlib-bar', ['data-value']).map(b => b[0]),
+          best: root.querySelector('.kinlib-best').textContent, live: root.querySelector('.kinlib-live').textContent};
+}"""
+
+
+@pytest.mark.browser
+def test_picker_buttons_draw_the_configurations_they_name(chromium, tmp_path):
+    """Problem 4.1 in Chromium, from the keyboard (Tab to the buttons, arrow keys between them) and the mouse: each
+    button shows the configuration it names — joints and tool (read back from the SVG) at the skeleton and fk,
+    each joint's arrow the column of J_ṗ (finite differences of modern_robotics' FKinSpace), the bars the chosen
+    row, the largest named as problem 4.1 says (a tie between joints 1 and 2 in (c))."""
+    chain = robots.planar_3r(1, 1, 1)
+    cp = _picker_4_1()
+    names = list(CONFIGS_4_1)
+    best = ["largest |ṗ_x|: joint 2", "largest |ṗ_x|: joint 1", "largest |ṗ_y|: a tie between joints 1 and 2"]
+    page, errors = page_with(chromium, [cp], tmp_path)
+    h = 1e-6
+    try:
+        page.keyboard.press("Tab")  # the first control of the page: the first configuration's button
+        for k, name in enumerate(names):
+            if k:
+                page.keyboard.press("ArrowRight")
+            got = page.evaluate(_READ_PICK)
+            assert got["name"] == name and got["pressed"] == [name] and got["focused"] == name
+            q, row = np.array(CONFIGS_4_1[name][0]), CONFIGS_4_1[name][1]
+            np.testing.assert_allclose(np.array(got["joints"]).T, chain.skeleton(q)[:, 1:-1], atol=1e-9)
+            np.testing.assert_allclose(got["tool"], tool_position(chain, q), atol=1e-9)
+            fd = np.array(
+                [(tool_position(chain, q + h * e) - tool_position(chain, q - h * e)) / (2 * h) for e in np.eye(3)]
+            )
+            np.testing.assert_allclose(got["arrows"], fd[:, :2], atol=1e-6)
+            np.testing.assert_allclose(got["bars"], fd[:, 0 if row == "vx" else 1], atol=1e-6)
+            assert got["best"] == best[k] and name in got["live"]
+            assert cp.select(name).best == {0: (2,), 1: (1,), 2: (1, 2)}[k]  # the kernel's copy agrees
+        page.locator("button.kinlib-config").first.click()
+        assert page.evaluate(_READ_PICK)["name"] == names[0]
+        assert not errors, errors
+    finally:
+        page.close()
 
 
 def test_config_picker_problem_4_1():
+    """The kernel's copy: contributions are the row of J_ṗ (finite differences of FKinSpace), the largest named."""
     chain = robots.planar_3r(1, 1, 1)
-    names = list(CONFIGS)
-    cp = widgets.config_picker(chain, CONFIGS, rows={names[0]: "vx", names[1]: "vx", names[2]: "vy"})
-    expected_best = {names[0]: (2,), names[1]: (1,), names[2]: (1, 2)}  # problem 4.1 (a tie in the third)
+    cp = _picker_4_1()
+    expected_best = dict(zip(CONFIGS_4_1, [(2,), (1,), (1, 2)]))  # problem 4.1 (a tie in the third)
     h = 1e-6
-    for name in names:
-        cp.buttons.value = name  # as a click does
-        q = np.array(CONFIGS[name])
-        row = 0 if cp.rows[name] == 3 else 1
-        fd = [(tool_position(chain, q + h * e) - tool_position(chain, q - h * e))[row] / (2 * h) for e in np.eye(3)]
+    for name, (q, row) in CONFIGS_4_1.items():
+        cp.select(name)
+        q = np.array(q)
+        r = 0 if row == "vx" else 1
+        fd = [(tool_position(chain, q + h * e) - tool_position(chain, q - h * e))[r] / (2 * h) for e in np.eye(3)]
         np.testing.assert_allclose(cp.contributions, fd, atol=1e-6)
-        np.testing.assert_allclose([b.get_height() for b in cp.bars], fd, atol=1e-6)
-        assert cp.best == expected_best[name]
-        assert cp.name == name and bytes(cp.picture).startswith(PNG)
-    assert "tie between joints 1 and 2" in cp.table.value
-    cp.select(names[0])
-    assert cp.buttons.value == names[0] and "joint 2" in cp.table.value
-    assert cp.buttons.style.button_width == "auto"  # buttons as wide as their labels (a fixed width cut them)
+        assert cp.best == expected_best[name] and cp.name == name
+    assert "tie between joints 1 and 2" in cp.table
+    assert cp.spec["start"] == 2 and "joint 2" in cp.select(list(CONFIGS_4_1)[0]).table
 
 
 def test_config_picker_bad_input():
@@ -366,6 +508,21 @@ def test_config_picker_bad_input():
         widgets.config_picker(chain, {"a": [0, 0, 0], "b": [1, 1, 1]}, rows={"a": "vx"})
     with pytest.raises(ValueError, match="one row"):
         widgets.config_picker(chain, {"a": [0, 0, 0]}, rows=("vx", "vy"))
+    with pytest.raises(ValueError, match="scale"):
+        widgets.config_picker(chain, {"a": [0, 0, 0]}, scale=-1)
+    with pytest.raises(TypeError, match="unexpected"):
+        widgets.config_picker(chain, {"a": [0, 0, 0]}, colour="red")
     cp = widgets.config_picker(chain, {"a": [0, 0, 0]})
     with pytest.raises(ValueError, match="unknown configuration"):
         cp.select("b")
+
+
+def test_animation_bad_input(r3):
+    with pytest.raises(ValueError, match="path"):
+        widgets.animate_singularity(r3, [[0, 0, 0]])
+    with pytest.raises(ValueError, match="path"):
+        widgets.animate_singularity(r3, [["a", 0, 0], [0, 0, 0]])
+    with pytest.raises(ValueError, match="path"):
+        widgets.animate_singularity(r3, [[np.nan, 0, 0], [0, 0, 0]])
+    with pytest.raises(ValueError, match="interval"):
+        widgets.animate_singularity(r3, np.zeros((2, 3)), interval=0)
