@@ -105,8 +105,8 @@
       bars(X, c, cf.row, cf.name);
       X.buttons.forEach(function (b, j) { b.setAttribute("aria-pressed", String(j === k)); b.classList.toggle("mod-active", j === k); });
       var who = best.length === 1 ? "joint " + best[0] : "a tie between joints " + best.join(" and ");
-      X.table.innerHTML = "<table><tr><th>" + lab + " per unit rate</th>" + c.map(function (_, i) { return "<th>θ̇" + (i + 1) + "</th>"; }).join("") +
-        "</tr><tr><td>θ = (" + cf.q.map(function (x) { return x.toFixed(4); }).join(", ") + ")</td>" +
+      X.table.innerHTML = "<div>θ = (" + cf.q.map(function (x) { return x.toFixed(4); }).join(", ") + ")</div><table><tr><th></th>" +
+        c.map(function (_, i) { return "<th>θ̇" + (i + 1) + "</th>"; }).join("") + "</tr><tr><th>" + lab + " per unit rate</th>" +
         c.map(function (v, i) { var s = sign(v); return "<td>" + (best.indexOf(i + 1) >= 0 ? "<b>" + s + "</b>" : s) + "</td>"; }).join("") +
         "</tr></table><div class='kinlib-best'>largest |" + lab + "|: " + who + "</div>";
       X.live.textContent = "Configuration " + cf.name + ": " + lab + " per unit joint rate " +

@@ -126,8 +126,8 @@ class ConfigPicker:
             else "a tie between joints " + " and ".join(map(str, self.best))
         )
         self.table = (
-            f"<table><tr><th>{lab} per unit rate</th>{heads}</tr>"
-            f"<tr><td>θ = ({', '.join(f'{x:.4f}' for x in q)})</td>{cells}</tr></table>"
+            f"<div>θ = ({', '.join(f'{x:.4f}' for x in q)})</div><table><tr><th></th>{heads}</tr>"
+            f"<tr><th>{lab} per unit rate</th>{cells}</tr></table>"
             f"<div class='kinlib-best'>largest |{lab}|: {who}</div>"
         )
         self.spec["start"] = list(self.configs).index(name)
