@@ -765,7 +765,7 @@ def urdf_section(args, targets: Targets) -> list[str]:
         tb_r = once(lambda: _loop(ra.geometric, Ql, (6, chain.n)), 3) / len(Ql) if ra is not None else None
         brows.append(
             [
-                f"{name} (n={chain.n})",
+                f"{name}, n={chain.n}",
                 fmt_t(tb_k),
                 fmt_t(tb_p) if tb_p else NA,
                 fmt_t(tb_r) if tb_r else NA,

@@ -573,7 +573,7 @@ class CompiledMatrix:
         ns_single = dict(_MATH, _empty=np.empty, _pack=struct.Struct(f"{size}d").pack_into)
         exec(compile(self._single_source, f"<kinlib {name} single>", "exec"), ns_single)
         # the compiled C of the same pieces (kinlib.native): after HOT_CALLS single calls, or compile_native()
-        self._native = native.NativeSingle(repl, reduced, self.n, self.shape, name)
+        self._native = native.NativeSingle(repl, reduced, self.n, self.shape, name, self._single_source)
         self._fast = None  # its single(q) once loaded: a plain joint vector in, the array out (else None)
         self._single = self._native.counting(ns_single["_single"], self, lambda: self.compile_native(wait=False))
 

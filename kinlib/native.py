@@ -352,25 +352,30 @@ class NativeSingle:
     True
     """
 
-    def __init__(self, repl, reduced, n: int, shape: tuple[int, int], name: str = "matrix"):
+    def __init__(self, repl, reduced, n: int, shape: tuple[int, int], name: str = "matrix", key_text: str = ""):
         self._pieces = (list(repl), list(reduced), n, tuple(shape), name)
+        self._key_text = key_text  # the Python code of the same pieces, if known: the key without printing C
         self.shape = tuple(shape)
         self.fn = None
         self.status = "Python (not compiled yet)"
-        self._key = None
+        self._module = None
 
     def _prepare(self):
-        """(compiler argv, source, module name, file path), or raise ValueError with the reason."""
+        """(compiler argv, module name, file path), or raise ValueError with the reason. The key hashes the Python
+        code printed from the same pieces (the C is printed from them by fixed rules: printing it costs as much,
+        so a cache hit skips it) or else the C source, with the generator's version and the toolchain's identity."""
         argv, about = toolchain()
         if argv is None:
             raise ValueError(about)
-        if self._key is None:
-            src = c_source(*self._pieces)
-            key = hashlib.sha256("\0".join([_GENERATOR, src, about]).encode()).hexdigest()
-            module = f"_kinlib_{key[:32]}"
-            self._key = (key, src.replace("@MODULE@", module), module)
-        key, src, module = self._key
-        return argv, src, module, _cache_dir() / (module + _ext_suffix())
+        if self._module is None:
+            text = self._key_text or c_source(*self._pieces)
+            self._module = "_kinlib_" + hashlib.sha256("\0".join([_GENERATOR, text, about]).encode()).hexdigest()[:32]
+        return argv, self._module, _cache_dir() / (self._module + _ext_suffix())
+
+    def source(self) -> str:
+        """The C source of the extension module (its name filled in when a toolchain is found)."""
+        src = c_source(*self._pieces)
+        return src.replace("@MODULE@", self._module) if self._module else src
 
     def build(self, wait: bool = True, on_ready=None) -> bool:
         """Load or compile; True once ``fn`` is the compiled code (with ``wait=False``, False while the background
@@ -378,7 +383,7 @@ class NativeSingle:
         if self.fn is not None:
             return True
         try:
-            argv, src, module, path = self._prepare()
+            argv, module, path = self._prepare()
         except ValueError as e:
             self.status = f"Python: {e}"
             return False
@@ -400,7 +405,7 @@ class NativeSingle:
             with _compile_lock:
                 fn = _loaded.get(module)
                 if fn is None:
-                    _compile(argv, src, path)
+                    _compile(argv, self.source(), path)
                     with _lock:
                         fn = _loaded[module] = _load(path, module, self.shape)
                     self.status = f"C (compiled into {path})"

@@ -119,7 +119,8 @@ def test_the_c_and_python_printers_print_the_same_operations():
     """Equal expressions, token for token (C's 1.0/x is Python's 1/x): the reason the floats agree."""
     chain = ARMS[-3]  # the iiwa14
     c = chain.numeric_code("jg")
-    src = native.c_source(c._repl, c._reduced, c.n, c.shape)
+    src = c._native.source()
+    assert f"PyInit_{c._native._prepare()[1]}(void)" in src
     body = src[src.index("static void kernel") : src.index("/* 1:")]
     c_lines = [ln.split(" = ", 1)[1].rstrip(";") for ln in body.splitlines() if "const double _x" in ln]
     py_lines = [ln.split(" = ", 1)[1] for ln in c._single_source.splitlines() if ln.lstrip().startswith("_x")]
@@ -163,7 +164,7 @@ def test_cache_is_shared_and_written_atomically(private_cache):
     pieces = ([(x0, sp.sin(q0))], [x0, 3 * x0 + 1], 1, (1, 2), "cache test")
     first = native.NativeSingle(*pieces)
     assert first.build() and "compiled into" in first.status
-    _, _, module, path = first._prepare()
+    _, module, path = first._prepare()
     assert path.parent == private_cache / "compiled" and path.is_file()
     # another process (simulated: this process forgets the module) loads the file instead of compiling
     native._loaded.pop(module)
@@ -171,7 +172,7 @@ def test_cache_is_shared_and_written_atomically(private_cache):
     assert again.build() and again.status.startswith("C (loaded from")
     # processes compiling the same key at once: each writes a temporary name and os.replace-s it into place
     argv, _ = native.toolchain()
-    src = again._prepare()[1]
+    src = again.source()
     errors = []
 
     def compile_once():
