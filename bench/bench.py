@@ -709,7 +709,8 @@ def urdf_section(args, targets: Targets) -> list[str]:
         "np.allclose at 20 random configurations). "
         + ("" if have_pin else '**Pinocchio (`pin`) is not installed: its columns say "not available"**. ')
         + ("" if have_rtb else '**The Robotics Toolbox is not installed: its columns say "not available"**. ')
-        + "All timed in this run (medians; kinlib's fastest run in parentheses); ratios of medians, < 1: kinlib is "
+        + "All timed in this run (medians; the fastest run in parentheses); ratios of medians (and of fastest runs), "
+        "< 1: kinlib is "
         f"faster. Batched: kinlib's batch call on N = {args.batch:,} configurations against Python loops over "
         f"{args.pin_batch:,} (Pinocchio, RTB), per configuration.",
         "",
@@ -739,8 +740,8 @@ def urdf_section(args, targets: Targets) -> list[str]:
         q = Q[0].copy()
         t_py = per_call(lambda: python_single(q.tolist()), args.reps)
         t_k, t_best = per_call(lambda: chain.jacobian_geometric(q), args.reps, best=True)
-        t_p = per_call(lambda: pa.geometric(q), args.reps) if pa is not None else None
-        t_r = per_call(lambda: ra.geometric(q), args.reps) if ra is not None else None
+        t_p, p_best = per_call(lambda: pa.geometric(q), args.reps, best=True) if pa is not None else (None, None)
+        t_r, r_best = per_call(lambda: ra.geometric(q), args.reps, best=True) if ra is not None else (None, None)
         rp = t_k / t_p if t_p else None
         rr = t_k / t_r if t_r else None
         rows.append(
@@ -749,10 +750,10 @@ def urdf_section(args, targets: Targets) -> list[str]:
                 source,
                 f"{fmt_t(t_k)} ({fmt_t(t_best)})",
                 fmt_t(t_py),
-                fmt_t(t_p) if t_p else NA,
-                fmt_t(t_r) if t_r else NA,
-                fmt_x(rp) if rp else NA,
-                fmt_x(rr) if rr else NA,
+                f"{fmt_t(t_p)} ({fmt_t(p_best)})" if t_p else NA,
+                f"{fmt_t(t_r)} ({fmt_t(r_best)})" if t_r else NA,
+                f"{fmt_x(rp)} ({fmt_x(t_best / p_best)})" if rp else NA,
+                f"{fmt_x(rr)} ({fmt_x(t_best / r_best)})" if rr else NA,
                 targets.upper(f"{name} URDF geometric J ÷ Pinocchio's", rp, T_URDF_VS_PIN, fmt=fmt_x),
                 targets.upper(f"{name} URDF geometric J ÷ RTB's", rr, T_URDF_VS_RTB, fmt=fmt_x),
             ]
@@ -779,10 +780,10 @@ def urdf_section(args, targets: Targets) -> list[str]:
             "URDF",
             "kinlib C (best)",
             "kinlib Python code",
-            "Pinocchio",
-            "RTB",
-            "kinlib ÷ Pinocchio",
-            "kinlib ÷ RTB",
+            "Pinocchio (best)",
+            "RTB (best)",
+            "kinlib ÷ Pinocchio (best ÷ best)",
+            "kinlib ÷ RTB (best ÷ best)",
             "≤ 2× Pinocchio",
             "< 1× RTB",
         ],

@@ -27,7 +27,8 @@ float literals, ``c - a*b`` rather than ``-a*b + c``, ``(x*x)`` rather than ``x*
 numbers agree with the expression to rounding.
 ``CompiledMatrix.source`` holds the generated code; :meth:`CompiledMatrix.javascript` prints the same
 temporaries and entries as a JavaScript function (SymPy's JavaScript printer), for the explorers that compute
-in the browser (:mod:`kinlib.widgets`).
+in the browser (:mod:`kinlib.widgets`); :meth:`CompiledMatrix.compile_native` the same as C (:mod:`kinlib.native`: the
+single call compiled after 1000 calls, in the background, with the same floats).
 """
 
 from __future__ import annotations

@@ -25,11 +25,13 @@ Pyodide, Windows, or** ``KINLIB_COMPILE=0``: the Python code, with the reason in
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import math
 import os
 import sys
 import threading
+import time
 from pathlib import Path
 
 import numpy as np
@@ -324,6 +326,11 @@ def _compile(argv: list[str], source: str, path: Path) -> None:
     import tempfile
 
     path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+    now = time.time()
+    for old in path.parent.glob(".build-*"):  # left by a process that ended while compiling (a daemon thread)
+        with contextlib.suppress(OSError):
+            if now - old.stat().st_mtime > 3600:
+                shutil.rmtree(old, ignore_errors=True)
     tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=path.parent))
     try:
         (tmp / "m.c").write_text(source, encoding="utf-8")

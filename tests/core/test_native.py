@@ -173,6 +173,9 @@ def test_cache_is_shared_and_written_atomically(private_cache):
     # processes compiling the same key at once: each writes a temporary name and os.replace-s it into place
     argv, _ = native.toolchain()
     src = again.source()
+    stale = path.parent / ".build-stale"  # left by a process that ended while compiling: removed after an hour
+    stale.mkdir()
+    os.utime(stale, (0, 0))
     errors = []
 
     def compile_once():
