@@ -14,7 +14,7 @@ TEST_JOBS ?= 1
 TESTS ?= tests
 XDIST := $(if $(filter-out 1,$(TEST_JOBS)),-n $(TEST_JOBS) --dist loadgroup)
 
-.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium webkit poppler bubblewrap clean
+.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium webkit poppler bubblewrap compiler clean
 
 all: test
 
@@ -73,13 +73,24 @@ bubblewrap:
 	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq bubblewrap >/dev/null; }
 
+# A C compiler for kinlib's compiled single calls (kinlib/native.py; without one kinlib runs its Python code) and
+# their tests (tests/core/test_native.py): Debian's gcc where no cc is found. Python.h comes with pyenv's Python
+# (a Debian python3 would need python3-dev).
+compiler:
+	@command -v cc >/dev/null 2>&1 || command -v gcc >/dev/null 2>&1 || { \
+	  echo "installing Debian's gcc for kinlib's compiled code"; \
+	  if [ "$$(id -u)" = 0 ]; then SUDO=; else SUDO=sudo; fi; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq gcc libc6-dev >/dev/null; }
+	@$(PYTHON) -c "import sysconfig, os, sys; h = os.path.join(sysconfig.get_paths()['include'], 'Python.h'); sys.exit(0 if os.path.isfile(h) else 1)" \
+	  || echo "note: no Python.h for $(PYTHON): kinlib's compiled path is off (install the Python headers, e.g. python3-dev)"
+
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
-test: $(STAMP) lint chromium webkit poppler bubblewrap
+test: $(STAMP) lint chromium webkit poppler bubblewrap compiler
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
 	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider --durations=15 $(XDIST) $(PYTEST_ARGS)
 
 # Quick loop while developing: no browser, no notebooks, no slow tests, no lint (`make lint` for that).
-test-fast: $(STAMP) bubblewrap
+test-fast: $(STAMP) bubblewrap compiler
 	$(PY) -m pytest $(TESTS) -m "not browser and not slow" -p no:cacheprovider $(XDIST) $(PYTEST_ARGS)
 
 # JupyterLab on notebooks/ (as root, e.g. in a container, it needs --allow-root). Extra options: make lab LAB_ARGS=--no-browser
@@ -126,12 +137,14 @@ JOBS ?= 2
 grade: $(STAMP) bubblewrap
 	$(VENV)/bin/kinlib grade $(SUBMISSIONS) --out $(OUT) --jobs $(JOBS)
 
-# Benchmark against modern-robotics (and Pinocchio with example-robot-data's URDFs, installed here as an optional extra).
-bench: $(STAMP) bubblewrap chromium
-	@$(PY) -c "import pinocchio, importlib.metadata as m; m.distribution('example-robot-data')" 2>/dev/null \
+# Benchmark against modern-robotics (and Pinocchio, example-robot-data's URDFs and the Robotics Toolbox, installed here as
+# the optional bench extra). One section: make bench BENCH_ARGS='--only urdf' (names: python bench/bench.py --help).
+BENCH_ARGS ?=
+bench: $(STAMP) bubblewrap chromium compiler
+	@$(PY) -c "import pinocchio, roboticstoolbox, importlib.metadata as m; m.distribution('example-robot-data')" 2>/dev/null \
 	    || $(PIP) install --quiet -e '.[bench]' \
-	    || echo "pin (Pinocchio) or example-robot-data could not be installed: the table will say so"
-	$(PY) bench/bench.py --out build/bench.md
+	    || echo "pin (Pinocchio), example-robot-data or roboticstoolbox-python could not be installed: the table will say so"
+	$(PY) bench/bench.py --out build/bench.md $(BENCH_ARGS)
 
 # Regenerate environment.txt from pyproject.toml: a clean temporary venv, pip install -e '.[dev]'
 # (every extra but bench), pip freeze. Today's pins are kept (-c environment.txt) so notebook outputs do

@@ -313,12 +313,14 @@ def numeric_section(args, targets: Targets) -> list[str]:
         f"may be shared, the median is what the targets are checked against). modern-robotics 1.1.1: `FKinSpace`, `JacobianSpace`, `JacobianBody` (geometric: "
         f"blockdiag(R, R)·J_b), a Python loop for a batch. {pin_note} Times per configuration; "
         f"× = how many times faster kinlib is. Checked first: kinlib = modern-robotics = Pinocchio "
-        f"(np.allclose, 20 random configurations, and batch = single calls).",
+        f"(np.allclose, 20 random configurations, and batch = single calls). kinlib's single calls run the "
+        f"compiled C of `kinlib.native` (compiled before timing with `compile_native()`; otherwise after 1000 calls).",
         "",
     ]
     rows = []
     for chain in numeric_robots():
         n = chain.n
+        native = compile_chain(chain)  # the single call's compiled C, as after a chain's first 1000 calls
         mrr = MR(chain)
         pinr = Pin(chain) if have_pin else None
         Qcheck = rng.uniform(-np.pi, np.pi, (20, n))
@@ -405,7 +407,7 @@ def numeric_section(args, targets: Targets) -> list[str]:
     lines += [
         "",
         f"Batched reference loops ran over the first {args.mr_batch:,} (modern-robotics) and "
-        f"{args.pin_batch:,} (Pinocchio) configurations of the same batch.",
+        f"{args.pin_batch:,} (Pinocchio) configurations of the same batch. kinlib's single call ran: {native}.",
     ]
     return lines
 
@@ -577,15 +579,111 @@ def first_call_section(args, targets: Targets) -> list[str]:
                 targets.upper(f"first numeric call, 7-joint arm, {label}", t, T_FIRST_CALL),
             ]
         )
+    rows += _compile_rows()
     return lines + table(["what", "CPU time (median)", "target", "status"], rows)
 
 
+_LOAD_SCRIPT = r"""
+import json, sys, time
+sys.path.insert(0, sys.argv[1])
+from bench import BAXTER_LEFT_ARM, BAXTER_TOOL
+from kinlib import robots
+c = robots.from_urdf_joints(BAXTER_LEFT_ARM, BAXTER_TOOL, name="baxter_left").numeric_code("jg")
+t = time.perf_counter()
+ok = c.compile_native()
+print(json.dumps({"seconds": time.perf_counter() - t, "ok": ok, "status": c.native_status}))
+"""
+
+
+def _compile_rows() -> list[list[str]]:
+    """The compiled C (kinlib.native) of the Baxter arm's geometric J: compiled in an empty cache (wall time and the
+    compiler's CPU time: it runs in a subprocess), then loaded from that cache by a new process."""
+    old = os.environ.get("KINLIB_CACHE")
+    with tempfile.TemporaryDirectory() as d:
+        os.environ["KINLIB_CACHE"] = d
+        try:
+            c = robots.from_urdf_joints(BAXTER_LEFT_ARM, BAXTER_TOOL, name="baxter_left").numeric_code("jg")
+            t0, c0 = time.perf_counter(), os.times()
+            ok = c.compile_native()
+            wall, c1 = time.perf_counter() - t0, os.times()
+            cc = c1.children_user + c1.children_system - c0.children_user - c0.children_system
+            p = subprocess.run(
+                [sys.executable, "-c", _LOAD_SCRIPT, str(ROOT / "bench")], capture_output=True, text=True, cwd=ROOT
+            )
+            load = json.loads(p.stdout.strip().splitlines()[-1]) if p.returncode == 0 and p.stdout.strip() else None
+        finally:
+            if old is None:
+                os.environ.pop("KINLIB_CACHE", None)
+            else:
+                os.environ["KINLIB_CACHE"] = old
+    status = "" if ok else f" ({c.native_status})"
+    return [
+        [
+            f"Baxter geometric J compiled to C, empty cache{status} (wall time; the C compiler's CPU time)",
+            f"{fmt_t(wall)} wall; cc {fmt_t(cc)}",
+            "— (background, after 1000 calls)",
+            "—",
+        ],
+        [
+            "the same loaded from the cache by a new process (wall time)",
+            fmt_t(load["seconds"]) if load else f"error: {p.stderr.strip()[-200:]}",
+            "—",
+            load["status"][:60] if load else NA,
+        ],
+    ]
+
+
+def _rtb_own_models(args) -> str:
+    """One sentence: the Robotics Toolbox's own Panda and iiwa14 models (rtb-data), ets.jacob0 timed in this run."""
+    import contextlib
+    import io
+
+    import roboticstoolbox as rtb
+
+    q = np.random.default_rng(3).uniform(-np.pi, np.pi, 7)
+    parts = []
+    for label, make, end in (
+        ("Panda (`models.Panda`, to panda_hand)", rtb.models.Panda, "panda_hand"),
+        ("LBR iiwa 14 R820 (`models.LBR`, to tool0)", rtb.models.LBR, "tool0"),
+    ):
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):
+                ets = make().ets(end=end)
+            assert ets.n == 7 and np.asarray(ets.jacob0(q)).shape == (6, 7)
+            parts.append(f"{label} {fmt_t(per_call(lambda: ets.jacob0(q), args.reps))}")
+        except Exception as e:  # a model RTB cannot build here is reported, not skipped silently
+            parts.append(f"{label}: {NA} ({type(e).__name__})")
+    return (
+        "The Robotics Toolbox's own models of these arms (from rtb-data; timing only, their frames differ from the "
+        "URDFs above), `ets.jacob0(q)` in this run: " + "; ".join(parts) + ". Its UR5 (`models.UR5`) fetches "
+        "example-robot-data from GitHub at run time (no network here): not timed; the same-file rows above are the "
+        "like-for-like comparison."
+    )
+
+
 T_URDF_VS_PIN = 2.0  # a URDF arm's single-call geometric J: at most 2× Pinocchio's time (issue 25)
+T_URDF_VS_RTB = 1.0  # ... and ahead of the Robotics Toolbox's compiled ETS (kinlib ÷ RTB < 1)
+
+
+def compile_chain(chain, whats=("fk", "js", "jb", "jg")) -> str:
+    """Compile the chain's generated code to C now (``compile_native``; otherwise it happens in the background
+    after 1000 calls, in the middle of a measurement); its status, e.g. 'C (...)' or 'Python: <why>'."""
+    status = ""
+    for w in whats:
+        c = chain.numeric_code(w)
+        c.compile_native()
+        status = c.native_status
+    return status
+
+
+def _ratio_cell(a, b):
+    return fmt_x(a / b) if a and b else NA
 
 
 def urdf_section(args, targets: Targets) -> list[str]:
-    """Real arms from their URDFs (bench/urdf_arms.py): single-call geometric J, kinlib against Pinocchio."""
-    from urdf_arms import ARMS, PinArm, kinlib_chain  # bench/ is this script's folder, first on sys.path
+    """Real arms from their URDFs (bench/urdf_arms.py): geometric J, kinlib against Pinocchio and the Robotics
+    Toolbox, single call and batched."""
+    from urdf_arms import ARMS, PinArm, RtbArm, kinlib_chain  # bench/ is this script's folder, first on sys.path
 
     try:
         import pinocchio  # noqa: F401
@@ -593,52 +691,109 @@ def urdf_section(args, targets: Targets) -> list[str]:
         have_pin = True
     except ImportError:
         have_pin = False
+    try:
+        import roboticstoolbox  # noqa: F401
+
+        have_rtb = True
+    except ImportError:
+        have_rtb = False
     lines = [
-        "## Real arms from URDF (single call, geometric J)",
+        "## Real arms from URDF (geometric J: single call and batched)",
         "",
-        "Each arm's URDF read by both libraries (`bench/urdf_arms.py`): kinlib through `robots.from_urdf_joints` "
-        "(its generated code: the URDF's placements folded into floats), Pinocchio through `buildModelFromXML` "
-        "reduced to the same joints, `computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)` at the tip frame. "
-        "Checked first: kinlib = Pinocchio (rows reordered, np.allclose at 20 random configurations). "
-        + ("" if have_pin else '**Pinocchio (`pin`) is not installed: its column says "not available"**. ')
-        + "Both timed in this run; kinlib ÷ Pinocchio is the ratio of their medians. The Robotics Toolbox "
-        "is not installed (43 packages; its URDF models download at run time): its column says not available.",
+        "Each arm's URDF read by the three libraries (`bench/urdf_arms.py`): kinlib through `robots.from_urdf_joints` "
+        "(its generated code: the URDF's placements folded into floats; the single call is the compiled C of "
+        "`kinlib.native`, the Python code of the same expressions beside it), Pinocchio through `buildModelFromXML` "
+        "reduced to the same joints, `computeFrameJacobian(..., LOCAL_WORLD_ALIGNED)` at the tip frame, the "
+        f"Robotics Toolbox {_version('roboticstoolbox-python')} through `Robot.URDF` on the same file, the compiled "
+        "ETS of its base-to-tip path: `ets.jacob0(q)`. Checked first: kinlib = Pinocchio = RTB (rows reordered, "
+        "np.allclose at 20 random configurations). "
+        + ("" if have_pin else '**Pinocchio (`pin`) is not installed: its columns say "not available"**. ')
+        + ("" if have_rtb else '**The Robotics Toolbox is not installed: its columns say "not available"**. ')
+        + "All timed in this run (medians; the fastest run in parentheses); ratios of medians (and of fastest runs), "
+        "< 1: kinlib is "
+        f"faster. Batched: kinlib's batch call on N = {args.batch:,} configurations against Python loops over "
+        f"{args.pin_batch:,} (Pinocchio, RTB), per configuration.",
         "",
     ]
     rng = np.random.default_rng(7)
-    rows = []
+    rows, brows, status = [], [], ""
     for name, source, get_xml, tip in ARMS:
         xml = get_xml()
         if xml is None:
-            rows.append([name, source, NA, NA, NA, "≤ 2× Pinocchio", NA, NA])
+            rows.append([name, source] + [NA] * 8)
             targets.upper(f"{name} URDF geometric J ÷ Pinocchio's", None, T_URDF_VS_PIN, fmt=fmt_x)
+            targets.upper(f"{name} URDF geometric J ÷ RTB's", None, T_URDF_VS_RTB, fmt=fmt_x)
             continue
         chain = kinlib_chain(name, xml, tip)
         pa = PinArm(xml, tip) if have_pin else None
+        ra = RtbArm(xml, tip) if have_rtb else None
         Q = rng.uniform(-np.pi, np.pi, (20, chain.n))
+        python_single = chain.numeric_code("jg")._single
         for qk in Q:
             if pa is not None:
                 assert np.allclose(chain.jacobian_geometric(qk), pa.book(qk), atol=1e-9), f"{name}: kinlib != Pinocchio"
+            if ra is not None:
+                assert np.allclose(chain.jacobian_geometric(qk), ra.book(qk), atol=1e-9), f"{name}: kinlib != RTB"
+        status = compile_chain(chain, ("jg",))
+        for qk in Q:
+            assert np.allclose(chain.jacobian_geometric(qk), python_single(list(qk)), rtol=0, atol=1e-15)
         q = Q[0].copy()
+        t_py = per_call(lambda: python_single(q.tolist()), args.reps)
         t_k, t_best = per_call(lambda: chain.jacobian_geometric(q), args.reps, best=True)
-        t_p = per_call(lambda: pa.geometric(q), args.reps) if pa is not None else None
-        ratio = t_k / t_p if t_p else None
+        t_p, p_best = per_call(lambda: pa.geometric(q), args.reps, best=True) if pa is not None else (None, None)
+        t_r, r_best = per_call(lambda: ra.geometric(q), args.reps, best=True) if ra is not None else (None, None)
+        rp = t_k / t_p if t_p else None
+        rr = t_k / t_r if t_r else None
         rows.append(
             [
                 f"{name} (n={chain.n})",
                 source,
                 f"{fmt_t(t_k)} ({fmt_t(t_best)})",
-                fmt_t(t_p) if t_p else NA,
-                fmt_x(ratio) if ratio else NA,
-                "≤ 2× Pinocchio",
-                targets.upper(f"{name} URDF geometric J ÷ Pinocchio's", ratio, T_URDF_VS_PIN, fmt=fmt_x),
-                NA,
+                fmt_t(t_py),
+                f"{fmt_t(t_p)} ({fmt_t(p_best)})" if t_p else NA,
+                f"{fmt_t(t_r)} ({fmt_t(r_best)})" if t_r else NA,
+                f"{fmt_x(rp)} ({fmt_x(t_best / p_best)})" if rp else NA,
+                f"{fmt_x(rr)} ({fmt_x(t_best / r_best)})" if rr else NA,
+                targets.upper(f"{name} URDF geometric J ÷ Pinocchio's", rp, T_URDF_VS_PIN, fmt=fmt_x),
+                targets.upper(f"{name} URDF geometric J ÷ RTB's", rr, T_URDF_VS_RTB, fmt=fmt_x),
+            ]
+        )
+        Qb = rng.uniform(-np.pi, np.pi, (args.batch, chain.n))
+        chain.jacobian_geometric(Qb[:10])  # generate the batched code
+        tb_k = once(lambda: chain.jacobian_geometric(Qb), max(3, args.reps // 2)) / len(Qb)
+        Ql = Qb[: args.pin_batch]
+        tb_p = once(lambda: _loop(pa.geometric, Ql, (6, chain.n)), 3) / len(Ql) if pa is not None else None
+        tb_r = once(lambda: _loop(ra.geometric, Ql, (6, chain.n)), 3) / len(Ql) if ra is not None else None
+        brows.append(
+            [
+                f"{name}, n={chain.n}",
+                fmt_t(tb_k),
+                fmt_t(tb_p) if tb_p else NA,
+                fmt_t(tb_r) if tb_r else NA,
+                _ratio_cell(tb_k, tb_p),
+                _ratio_cell(tb_k, tb_r),
             ]
         )
     lines += table(
-        ["arm", "URDF", "kinlib (best)", "Pinocchio", "kinlib ÷ Pinocchio", "target", "status", "Robotics Toolbox"],
+        [
+            "arm",
+            "URDF",
+            "kinlib C (best)",
+            "kinlib Python code",
+            "Pinocchio (best)",
+            "RTB (best)",
+            "kinlib ÷ Pinocchio (best ÷ best)",
+            "kinlib ÷ RTB (best ÷ best)",
+            "≤ 2× Pinocchio",
+            "< 1× RTB",
+        ],
         rows,
     )
+    lines += ["", f"kinlib's single call ran: {status or NA}."]
+    if have_rtb:
+        lines += ["", _rtb_own_models(args)]
+    lines += ["", "Batched, per configuration:", ""]
+    lines += table(["arm", "kinlib batch", "Pinocchio loop", "RTB loop", "kinlib ÷ Pinocchio", "kinlib ÷ RTB"], brows)
     # the numeric free function against modern-robotics and the chain's generated code
     import modern_robotics as mr
 
@@ -648,7 +803,7 @@ def urdf_section(args, targets: Targets) -> list[str]:
     assert np.allclose(kinlib.jacobian_space(S, q), mr.JacobianSpace(S, q), atol=1e-12)
     t_free = per_call(lambda: kinlib.jacobian_space(S, q), args.reps)
     t_mr = per_call(lambda: mr.JacobianSpace(S, q), max(3, args.reps // 2))
-    ur5.jacobian_space(q)
+    compile_chain(ur5, ("js",))
     t_chain = per_call(lambda: ur5.jacobian_space(q), args.reps)
     lines += [
         "",
@@ -661,7 +816,7 @@ def urdf_section(args, targets: Targets) -> list[str]:
         [
             ["kinlib.jacobian_space(S, q)", fmt_t(t_free), fmt_x(t_mr / t_free)],
             ["mr.JacobianSpace(S, q)", fmt_t(t_mr), "1×"],
-            ["ur5.jacobian_space(q) (generated code)", fmt_t(t_chain), fmt_x(t_mr / t_chain)],
+            ["ur5.jacobian_space(q) (generated code, compiled C)", fmt_t(t_chain), fmt_x(t_mr / t_chain)],
         ],
     )
     return lines
@@ -1227,6 +1382,12 @@ def main(argv=None) -> int:
     )
     ap.add_argument("--moves", type=int, default=20, help="slider moves per explorer in the browser (default 20)")
     ap.add_argument("--quick", action="store_true", help="tiny batch; skip notebooks, explorers and the checker")
+    ap.add_argument(
+        "--only",
+        default="",
+        help="comma-separated sections to run, e.g. --only urdf,numeric (names: numeric, urdf, first_call, symbolic, "
+        "exact, analysis, notebook, explorer, browser, static, lite, grader, import; default: all)",
+    )
     args = ap.parse_args(argv)
     if args.quick:
         args.batch = min(args.batch, 2000)
@@ -1254,6 +1415,8 @@ def main(argv=None) -> int:
         grader_section,
         import_section,
     ):
+        if args.only and fn.__name__.removesuffix("_section") not in args.only.split(","):
+            continue
         t0 = time.perf_counter()
         sections.append(fn(args, targets))
         print(f"[bench] {fn.__name__}: {time.perf_counter() - t0:.1f} s", file=sys.stderr, flush=True)

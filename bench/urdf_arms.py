@@ -2,14 +2,18 @@
 
 The Panda's and the UR5's URDFs are the files example-robot-data ships (the ``bench`` extra:
 ``panda_description/urdf/panda.urdf`` and ``ur_description/urdf/ur5_robot.urdf``); example-robot-data
-ships no iiwa, so the iiwa14's joint table is written here as data (``IIWA14_URDF``), transcribed from
-IFL-CAMP/iiwa_stack, ``iiwa_description/urdf/iiwa14.xacro`` (PI = 3.1415926535897931; its link
-offsets add up to KUKA's published lengths 0.36, 0.42, 0.4 and 0.126 m).
+ships no iiwa, so the iiwa14's joints are written here as URDF (``IIWA14_URDF``), the xacro macro of
+IFL-CAMP/iiwa_stack ``iiwa_description/urdf/iiwa14.xacro`` at commit 325f5bf60331a38df7b5c0bd6bb5dfa9e3c240c3
+expanded by hand (checked against that file: every origin, axis and limit; ``${PI / 2}`` etc. as the doubles
+xacro computes from math.pi; its ``iiwa_joint_ee`` has rpy ``${PI} ${PI} ${PI}``, a rotation equal to the
+identity but for rounding; limits ±170°, ±120°, …, ±175° in radians, its max_effort 300 and max_velocity 10).
+Its link offsets add up to KUKA's published lengths 0.36, 0.42, 0.4 and 0.126 m.
 
-Each arm is read the same way by both libraries: kinlib through ``robots.from_urdf_joints`` on the
+Each arm is read the same way by the three libraries: kinlib through ``robots.from_urdf_joints`` on the
 joints from the base link to the tip link (:func:`urdf_joints`), Pinocchio through
 ``buildModelFromXML`` on the same XML, reduced to those joints (any other joint, e.g. the Panda's
-fingers, locked at 0) with a frame at the tip link.
+fingers, locked at 0) with a frame at the tip link, the Robotics Toolbox through ``Robot.URDF`` on the same
+XML (:class:`RtbArm`).
 """
 
 from __future__ import annotations
@@ -23,29 +27,58 @@ IIWA14_URDF = """<robot name="iiwa14">
   <link name="iiwa_link_ee"/>
   <joint name="iiwa_joint_1" type="revolute"><parent link="iiwa_link_0"/><child link="iiwa_link_1"/>
     <origin xyz="0 0 0.1575" rpy="0 0 0"/><axis xyz="0 0 1"/>
-    <limit lower="-2.97" upper="2.97" effort="320" velocity="1.48"/></joint>
+    <limit lower="-2.9670597283903604" upper="2.9670597283903604" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_2" type="revolute"><parent link="iiwa_link_1"/><child link="iiwa_link_2"/>
     <origin xyz="0 0 0.2025" rpy="1.5707963267948966 0 3.141592653589793"/><axis xyz="0 0 1"/>
-    <limit lower="-2.09" upper="2.09" effort="320" velocity="1.48"/></joint>
+    <limit lower="-2.0943951023931953" upper="2.0943951023931953" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_3" type="revolute"><parent link="iiwa_link_2"/><child link="iiwa_link_3"/>
     <origin xyz="0 0.2045 0" rpy="1.5707963267948966 0 3.141592653589793"/><axis xyz="0 0 1"/>
-    <limit lower="-2.97" upper="2.97" effort="176" velocity="1.75"/></joint>
+    <limit lower="-2.9670597283903604" upper="2.9670597283903604" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_4" type="revolute"><parent link="iiwa_link_3"/><child link="iiwa_link_4"/>
     <origin xyz="0 0 0.2155" rpy="1.5707963267948966 0 0"/><axis xyz="0 0 1"/>
-    <limit lower="-2.09" upper="2.09" effort="176" velocity="1.31"/></joint>
+    <limit lower="-2.0943951023931953" upper="2.0943951023931953" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_5" type="revolute"><parent link="iiwa_link_4"/><child link="iiwa_link_5"/>
     <origin xyz="0 0.1845 0" rpy="-1.5707963267948966 3.141592653589793 0"/><axis xyz="0 0 1"/>
-    <limit lower="-2.97" upper="2.97" effort="110" velocity="2.27"/></joint>
+    <limit lower="-2.9670597283903604" upper="2.9670597283903604" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_6" type="revolute"><parent link="iiwa_link_5"/><child link="iiwa_link_6"/>
     <origin xyz="0 0 0.2155" rpy="1.5707963267948966 0 0"/><axis xyz="0 0 1"/>
-    <limit lower="-2.09" upper="2.09" effort="40" velocity="2.36"/></joint>
+    <limit lower="-2.0943951023931953" upper="2.0943951023931953" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_7" type="revolute"><parent link="iiwa_link_6"/><child link="iiwa_link_7"/>
     <origin xyz="0 0.081 0" rpy="-1.5707963267948966 3.141592653589793 0"/><axis xyz="0 0 1"/>
-    <limit lower="-3.05" upper="3.05" effort="40" velocity="2.36"/></joint>
+    <limit lower="-3.0543261909900763" upper="3.0543261909900763" effort="300" velocity="10"/></joint>
   <joint name="iiwa_joint_ee" type="fixed"><parent link="iiwa_link_7"/><child link="iiwa_link_ee"/>
-    <origin xyz="0 0 0.045" rpy="0 0 0"/></joint>
+    <origin xyz="0 0 0.045" rpy="3.141592653589793 3.141592653589793 3.141592653589793"/></joint>
 </robot>
 """
+
+
+_H = 1.5707963267948966
+#: the joints :func:`urdf_joints` reads from example-robot-data 6.0.0's ``panda.urdf`` (to ``panda_hand_tcp``) and
+#: ``ur5_robot.urdf`` (to ``tool0``), for the tests (which run without the bench extra;
+#: tests/core/test_native.py checks them against the files when example-robot-data is installed)
+PANDA_JOINTS = [
+    ("revolute", (0.0, 0.0, 0.333), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.0, 0.0, 0.0), (-_H, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.0, -0.316, 0.0), (_H, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.0825, 0.0, 0.0), (_H, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (-0.0825, 0.384, 0.0), (-_H, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.0, 0.0, 0.0), (_H, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.088, 0.0, 0.0), (_H, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("fixed", (0.0, 0.0, 0.107), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+    ("fixed", (0.0, 0.0, 0.0), (0.0, 0.0, -0.7853981633974483), (1.0, 0.0, 0.0)),
+    ("fixed", (0.0, 0.0, 0.1034), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+]
+_H11 = 1.57079632679  # the UR5 file's own digits
+UR5_JOINTS = [
+    ("fixed", (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), (1.0, 0.0, 0.0)),
+    ("revolute", (0.0, 0.0, 0.089159), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.0, 0.13585, 0.0), (0.0, _H11, 0.0), (0.0, 1.0, 0.0)),
+    ("revolute", (0.0, -0.1197, 0.425), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+    ("revolute", (0.0, 0.0, 0.39225), (0.0, _H11, 0.0), (0.0, 1.0, 0.0)),
+    ("revolute", (0.0, 0.093, 0.0), (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)),
+    ("revolute", (0.0, 0.0, 0.09465), (0.0, 0.0, 0.0), (0.0, 1.0, 0.0)),
+    ("fixed", (0.0, 0.0823, 0.0), (-_H11, 0.0, 0.0), (1.0, 0.0, 0.0)),
+]
 
 
 def _example_robot_data_urdf(relative: str) -> str | None:
@@ -139,6 +172,39 @@ class PinArm:
         return self.pin.computeFrameJacobian(
             self.model, self.data, q, self.fid, self.pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
         )
+
+    def book(self, q):
+        """The same in the book's order [ω_s; ṗ]."""
+        return self._np.asarray(self.geometric(q))[[3, 4, 5, 0, 1, 2]]
+
+
+class RtbArm:
+    """The Robotics Toolbox's model of the same URDF (``Robot.URDF`` on the file) and the ETS of its path from the
+    base link to ``tip``: the timed call is that ETS's compiled ``jacob0`` (rows [v; ω] of the tip origin in the
+    base frame, i.e. the geometric Jacobian [ṗ; ω])."""
+
+    def __init__(self, xml: str, tip: str):
+        import tempfile
+
+        import numpy as np
+        import roboticstoolbox as rtb
+
+        _, names = urdf_joints(xml, tip)
+        root = ET.fromstring(xml)  # without the meshes (package:// paths RTB's xacro step cannot resolve)
+        for link in root.findall("link"):
+            for shape in link.findall("visual") + link.findall("collision"):
+                link.remove(shape)
+        with tempfile.TemporaryDirectory() as d:
+            path = Path(d) / "arm.urdf"
+            path.write_text(ET.tostring(root, encoding="unicode"), encoding="utf-8")
+            robot = rtb.Robot.URDF(str(path))
+        self.ets = robot.ets(end=tip)
+        assert self.ets.n == len(names), (self.ets.n, names)
+        self._np = np
+
+    def geometric(self, q):
+        """The timed call."""
+        return self.ets.jacob0(q)
 
     def book(self, q):
         """The same in the book's order [ω_s; ṗ]."""

@@ -293,8 +293,10 @@ class SerialChain:
         return self._numeric_form("skeleton")
 
     def _eval(self, what: str, q):
+        c = self._num.get(what)
+        if c is not None and c._fast is not None and (out := c._fast(q)) is not None:
+            return out  # compiled C (kinlib.native) took a plain finite joint vector; None: the paths below
         if type(q) is np.ndarray and q.dtype is _F8:  # fast path: a float64 array, code already generated
-            c = self._num.get(what)
             if c is not None:
                 if q.shape == self._vec_shape:
                     v = q.tolist()
@@ -304,7 +306,6 @@ class SerialChain:
                 elif q.ndim == 2 and q.shape[1] == self.n and np.isfinite(q).all():
                     return c(q)
         elif type(q) is list or type(q) is tuple:  # plain floats (and small ints): no array needed
-            c = self._num.get(what)
             if (
                 c is not None
                 and len(q) == self.n

@@ -27,7 +27,8 @@ float literals, ``c - a*b`` rather than ``-a*b + c``, ``(x*x)`` rather than ``x*
 numbers agree with the expression to rounding.
 ``CompiledMatrix.source`` holds the generated code; :meth:`CompiledMatrix.javascript` prints the same
 temporaries and entries as a JavaScript function (SymPy's JavaScript printer), for the explorers that compute
-in the browser (:mod:`kinlib.widgets`).
+in the browser (:mod:`kinlib.widgets`); :meth:`CompiledMatrix.compile_native` the same as C (:mod:`kinlib.native`: the
+single call compiled after 1000 calls, in the background, with the same floats).
 """
 
 from __future__ import annotations
@@ -43,7 +44,9 @@ from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.precedence import precedence
 from sympy.printing.pycode import PythonCodePrinter
 
+from . import native
 from ._backend import describe
+from .native import ArithmeticRules
 
 __all__ = ["CompiledMatrix", "javascript_function"]
 
@@ -64,48 +67,12 @@ _NUMPY = {
 BLOCK = 8192
 
 
-class _Printer(PythonCodePrinter):
-    """Python printer for generated numeric code: fewer operations, same value."""
+class _Printer(ArithmeticRules, PythonCodePrinter):
+    """Python printer for generated numeric code: fewer operations, same value (the rules the C printer of
+    :mod:`kinlib.native` shares)."""
 
     def __init__(self):
         super().__init__({"fully_qualified_modules": False, "standard": "python3"})
-
-    def _print_Rational(self, expr):  # 89/1000 -> 0.089 (the same correctly rounded float)
-        return repr(float(expr))
-
-    def _print_Half(self, expr):
-        return "0.5"
-
-    def _print_Pow(self, expr, rational=False):
-        b, e = expr.args
-        if e.is_Integer and 2 <= int(e) <= 4:  # x*x is cheaper than x**2 for Python floats
-            base = self.parenthesize(b, precedence(expr), strict=False)
-            return "(" + "*".join([base] * int(e)) + ")"  # parenthesized: a/x**2 is a/(x*x)
-        return super()._print_Pow(expr, rational=rational)
-
-    def _print_Add(self, expr, order=None):
-        # print as the base class does, then put a '+' term first: 'c - a*b' saves a negation
-        terms = self._as_ordered_terms(expr, order=order)
-        prec = precedence(expr)
-        items = []
-        for term in terms:
-            t = self._print(term)
-            if t.startswith("-") and not term.is_Add:
-                sign, t = "-", t[1:]
-            else:
-                sign = "+"
-            if precedence(term) < prec or term.is_Add:
-                t = f"({t})"
-            items.append((sign, t))
-        for k, (sign, _) in enumerate(items):
-            if sign == "+":
-                items.insert(0, items.pop(k))
-                break
-        first_sign, first = items[0]
-        out = ("-" if first_sign == "-" else "") + first
-        for sign, t in items[1:]:
-            out += f" {sign} {t}"
-        return out
 
 
 class _JSPrinter(JavascriptCodePrinter):
@@ -606,7 +573,39 @@ class CompiledMatrix:
         self._batch_source = None
         ns_single = dict(_MATH, _empty=np.empty, _pack=struct.Struct(f"{size}d").pack_into)
         exec(compile(self._single_source, f"<kinlib {name} single>", "exec"), ns_single)
-        self._single = ns_single["_single"]
+        # the compiled C of the same pieces (kinlib.native): after HOT_CALLS single calls, or compile_native()
+        self._native = native.NativeSingle(repl, reduced, self.n, self.shape, name, self._single_source)
+        self._fast = None  # its single(q) once loaded: a plain joint vector in, the array out (else None)
+        self._single = self._native.counting(ns_single["_single"], self, lambda: self.compile_native(wait=False))
+
+    def compile_native(self, wait: bool = True) -> bool:
+        """Use compiled C for the single-configuration call from now on (see :mod:`kinlib.native`): loaded from
+        the cache, or compiled now (``wait=True``, ≈ 0.2–0.5 s) or in a background thread (``wait=False``);
+        True once it is in use. Without a C compiler (or with ``KINLIB_COMPILE=0``, in Pyodide) it returns False
+        and the Python code stays, with the reason in :attr:`native_status`. The numbers are the same.
+
+        >>> x = sp.Symbol("x", real=True)
+        >>> c = CompiledMatrix(sp.Matrix([[sp.sin(x), x / 3]]), [x])
+        >>> before = c([0.5])   # the Python code
+        >>> c.compile_native() == c.native_status.startswith("C")
+        True
+        >>> c([0.5]).tolist() == before.tolist()   # the same floats, bit for bit
+        True
+        """
+
+        def ready(fn):
+            self._fast = fn
+
+        return self._native.build(wait, ready)
+
+    @property
+    def native_status(self) -> str:
+        """What the single-configuration call runs: ``C (...)`` or ``Python: <why>`` (see :meth:`compile_native`).
+
+        >>> CompiledMatrix(sp.Matrix([[1]]), []).native_status
+        'Python (not compiled yet)'
+        """
+        return self._native.status
 
     def _batch(self, q):
         """The batched code (generated on its first call): (N, n) in, (rows, cols, N) out."""
@@ -668,6 +667,8 @@ class CompiledMatrix:
 
     def __call__(self, q):
         """Evaluate at q: shape (n,) gives (rows, cols); shape (N, n) gives (N, rows, cols)."""
+        if self._fast is not None and (out := self._fast(q)) is not None:
+            return out  # compiled C: a plain finite joint vector (anything else: None, and the checks below)
         # fast path: a list/tuple of n numbers, or a float array of shape (n,)
         tq = type(q)
         if tq is np.ndarray:
