@@ -235,10 +235,15 @@ _RUN_ALL = """() => {
 }"""
 
 
+class CellFailed(AssertionError):
+    """A cell raised, or did not run to the end (:func:`run_all`): the kernel itself answered."""
+
+
 def run_all(page, timeout: float = 300, details: bool = False):
     """Run All Cells; wait until the kernel has replied to every non-empty code cell. Returns seconds
     (page clock, from the command to the last reply), or with ``details`` the pair (seconds, seconds the
-    kernel spent executing the cells by its own clock). Raises AssertionError if a cell failed."""
+    kernel spent executing the cells by its own clock). Raises :class:`CellFailed` (an AssertionError) if a
+    cell failed."""
     page.evaluate(_RUN_ALL)
     page.wait_for_function("() => window.__kinlibRun.t1 !== null", timeout=timeout * 1000, polling=100)
     run = page.evaluate("() => window.__kinlibRun")
@@ -249,9 +254,9 @@ def run_all(page, timeout: float = 300, details: bool = False):
     )
     errors = page.locator(".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
     if errors.count():
-        raise AssertionError("a cell raised: " + errors.first.text_content()[:800])
+        raise CellFailed("a cell raised: " + errors.first.text_content()[:800])
     if run["aborted"]:
-        raise AssertionError(f"{run['aborted']} cells did not run to the end")
+        raise CellFailed(f"{run['aborted']} cells did not run to the end")
     wall = (run["t1"] - run["t0"]) / 1000
     return (wall, run["kernel"]) if details else wall
 

@@ -10,6 +10,8 @@ Chromium everywhere else.
    hung other projects' kernels on engines without WebAssembly stack switching (JSPI); the scenario reports
    whether this engine has JSPI (``WebAssembly.Suspending``) and the test passes only if the kernel finished.
    Every URI the page asked for is on loopback (or a ``data:``/``blob:`` URI).
+
+Both run in one WebKit process (one Xvfb, one engine start), one page load after the other.
 """
 
 from __future__ import annotations
@@ -45,24 +47,47 @@ def _webkit_ready() -> str | None:
     return None if r.returncode == 0 else f"WebKitGTK through /usr/bin/python3 is missing: {r.stderr.strip()[-200:]}"
 
 
+def run_webkit(steps: list, tmp: Path) -> list:
+    """Run ``steps`` [(url, scenario JS, timeout s)] one after the other in one WebKit process
+    (tests/webkit_run.py under Xvfb: one engine start for all); returns each step's JSON line, in order."""
+    cmd = ["xvfb-run", "-a", "/usr/bin/python3", str(DRIVER)]
+    for k, (url, scenario, timeout) in enumerate(steps):
+        path = tmp / f"scenario-{k}.js"
+        path.write_text(scenario)
+        cmd += [url, str(path), str(timeout)]
+    r = subprocess.run(cmd, capture_output=True, text=True, timeout=sum(t for *_, t in steps) + 60)
+    lines = [json.loads(ln) for ln in r.stdout.splitlines() if ln.startswith("{")]
+    assert len(lines) == len(steps), (
+        f"the WebKit driver printed {len(lines)} of {len(steps)} results (exit {r.returncode}): {r.stderr[-800:]}"
+    )
+    return lines
+
+
 @pytest.fixture(scope="module")
-def webkit():
+def webkit(request, handouts_site, tmp_path_factory):  # noqa: F811
+    """{test name: the driver's result of its scenario}: the scenarios of this module's tests that the run
+    selected, run in one WebKit process (one Xvfb and one engine start for the module), the static page first."""
     why = _webkit_ready()
     if why:
         pytest.fail(f"{why}: `make webkit` installs Debian's gir1.2-webkit2-4.1, python3-gi and xvfb", pytrace=False)
+    from kinlib.course.publish import lite
 
-    def run(url: str, scenario: str, tmp: Path, timeout: float = 120) -> dict:
-        path = tmp / "scenario.js"
-        path.write_text(scenario)
-        r = subprocess.run(
-            ["xvfb-run", "-a", "/usr/bin/python3", str(DRIVER), url, str(path), str(timeout)],
-            capture_output=True, text=True, timeout=timeout + 60,
-        )  # fmt: skip
-        lines = [ln for ln in r.stdout.splitlines() if ln.startswith("{")]
-        assert lines, f"the WebKit driver printed nothing (exit {r.returncode}): {r.stderr[-800:]}"
-        return json.loads(lines[-1])
-
-    return run
+    wanted = {i.originalname for i in request.session.items if getattr(i, "module", None) is request.module}
+    server = lite.serve(handouts_site, 0, block=False)
+    base = f"http://127.0.0.1:{server.server_address[1]}/"
+    steps = {
+        "test_static_page_explorer_in_webkit": (
+            (handouts_site / "solutions" / "05_singularities_planar.html").as_uri(), _STATIC, 120),
+        "test_jupyterlite_runs_workbook_05_in_webkit": (
+            base + lite.lite_link("workbooks/05_singularities_planar.ipynb"), _LITE, 1300),
+    }  # fmt: skip
+    names = [n for n in steps if n in wanted]
+    try:
+        out = run_webkit([steps[n] for n in names], tmp_path_factory.mktemp("webkit"))
+    finally:
+        server.shutdown()
+        server.server_close()
+    return {"base": base, **dict(zip(names, out))}
 
 
 _STATIC = """
@@ -84,9 +109,8 @@ return {drawn: true, moved: ex.querySelector('.kinlib-arm').getAttribute('d') !=
 """
 
 
-def test_static_page_explorer_in_webkit(webkit, handouts_site, tmp_path):  # noqa: F811
-    page = handouts_site / "solutions" / "05_singularities_planar.html"
-    out = webkit(page.as_uri(), _STATIC, tmp_path)
+def test_static_page_explorer_in_webkit(webkit):
+    out = webkit["test_static_page_explorer_in_webkit"]
     assert out["error"] is None, out["error"]
     r = out["result"]
     assert r["drawn"], "no explorer drawn on the static page"
@@ -144,16 +168,8 @@ return res;
 """
 
 
-def test_jupyterlite_runs_workbook_05_in_webkit(webkit, handouts_site, tmp_path):  # noqa: F811
-    from kinlib.course.publish import lite
-
-    server = lite.serve(handouts_site, 0, block=False)
-    base = f"http://127.0.0.1:{server.server_address[1]}/"
-    try:
-        out = webkit(base + lite.lite_link("workbooks/05_singularities_planar.ipynb"), _LITE, tmp_path, timeout=1300)
-    finally:
-        server.shutdown()
-        server.server_close()
+def test_jupyterlite_runs_workbook_05_in_webkit(webkit):
+    out, base = webkit["test_jupyterlite_runs_workbook_05_in_webkit"], webkit["base"]
     r = out["result"] or {}
     print(f"\n{out['engine']}: JSPI {r.get('jspi')}; kernel ready {r.get('ready_s')} s, run-all {r.get('run_s')} s")
     assert out["error"] is None, (out["error"], r)
