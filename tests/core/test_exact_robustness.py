@@ -222,6 +222,10 @@ def test_issue_ranks_answer_exactly(case):
     assert got == want and got.exact
     # the conditions stated hold at the oracle's lengths (none of them vanishes there)
     assert all(sp.N(u.xreplace(lengths), 30) != 0 for u in got.unless)
+    if case == "ur5_symbolic":  # and where the stated condition fails (L2 = H2: the shoulder), the rank drops
+        L2, H2 = sp.symbols("L2 H2", positive=True)
+        assert got.unless == (H2 - L2,)
+        assert O.rank(_oracle_J(r, q, rows, {**lengths, H2: lengths[L2]})) == 5
     if want == J.rows == J.cols:  # square, full rank: the whole space, nothing it cannot do
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", ConditionalResultWarning)
