@@ -375,3 +375,25 @@ def test_revolute_screws_with_symbolic_points_are_answered(w, c, joints):
         assert conds == [] and conds.complete
     else:  # answered: every condition found is singular at a member (checked on the first family's point)
         assert isinstance(conds, list)
+
+
+def test_puma560_is_corkes_dh_table():
+    """robots.puma560's screws reproduce the standard DH forward kinematics of Corke's table (written here with
+    NumPy: T = Π Rz(θ_i) Tz(d_i) Tx(a_i) Rx(α_i)) at random configurations, with its own and with other lengths."""
+
+    def dh_fk(q, a2, d3, a3, d4):
+        T = np.eye(4)
+        for th, d, a, al in zip(
+            q, [0, 0, d3, d4, 0, 0], [0, a2, a3, 0, 0, 0], np.pi / 2 * np.array([1, 0, -1, 1, -1, 0])
+        ):
+            ct, st, ca, sa = np.cos(th), np.sin(th), np.cos(al), np.sin(al)
+            T = T @ np.array(
+                [[ct, -st * ca, st * sa, a * ct], [st, ct * ca, -ct * sa, a * st], [0, sa, ca, d], [0, 0, 0, 1]]
+            )
+        return T
+
+    rng = np.random.default_rng(560)
+    for lengths in ((0.4318, 0.15005, 0.0203, 0.4318), (0.5, 0.0, 0.0, 0.5), (0.3, 0.1, 0.05, 0.7)):
+        r = robots.puma560(*lengths)
+        for q in rng.uniform(-np.pi, np.pi, (5, 6)):
+            np.testing.assert_allclose(r.fk(q), dh_fk(q, *lengths), atol=1e-12)
