@@ -4,14 +4,15 @@ SymPy's ``Matrix.rank()`` of the symbolic J gives the *generic* rank and hides t
 configuration; and deciding "is this entry zero?" from a float (or by guessing a closed form from one) is
 wrong at angles such as θ = 10 or θ = 1/2. Here every zero test is a proof.
 
-**How.** Every zero test is made in the field of :mod:`kinlib.exactfield` (the sines and cosines of the
-configuration's angles written with t = tan(g/2), which is transcendental, so "zero" there is a proof). But
-first, when J has no symbolic parameters, a 60-digit SVD (entries to 100 digits) decides every *nonzero*: a
-singular value above 10⁻²⁰·σ_max is certified nonzero (entries and SVD are accurate to ~10⁻⁵⁵·σ_max, and
-|σ_i(A) − σ_i(Ã)| ≤ ‖A − Ã‖); only a decision "this is zero" (a rank drop, a skipped pivot column, a zero
-entry) is left to exact Gaussian elimination in K(t, L1, L2, …). Parameters count as indeterminates: the
-rank found is the rank for all their positive values except where a stated expression vanishes
-(see :class:`Rank`).
+**How** (:mod:`kinlib.exact_rank`). Every zero test is made in the field of :mod:`kinlib.exactfield` (the sines
+and cosines of the configuration's angles written with t = tan(g/2), which is transcendental, so "zero" there is
+a proof). But first a 60-digit SVD (entries to 100 digits) decides every *nonzero*: a singular value above
+10⁻²⁰·σ_max is certified nonzero (entries and SVD are accurate to ~10⁻⁵⁵·σ_max, and |σ_i(A) − σ_i(Ã)| ≤
+‖A − Ã‖). With symbolic parameters this is done at fixed rational values of them: a minor nonzero there is a
+nonzero function of the parameters, so full rank there proves full rank. Only a decision "this is zero" (a rank
+drop, a skipped pivot column, a zero entry) is left to exact fraction-free elimination over K[t, L1, L2, …].
+Parameters count as indeterminates: the rank found is the rank for all their positive values except where a
+stated expression vanishes (see :class:`Rank`).
 
 The canonical basis entries (rref) are then written with the configuration's own sines and cosines, as ratios
 of minors (Cramer's rule) of the evaluated J, each minor computed exactly in the polynomial ring of those sines
@@ -30,7 +31,6 @@ computed from a singular value decomposition in mpmath with ``FALLBACK_DIGITS`` 
 
 from __future__ import annotations
 
-import itertools
 import warnings
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -41,18 +41,10 @@ from sympy.polys.matrices import DomainMatrix
 
 from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
 from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
-from .display import readable, readable_fold, readable_ratio
-from .exactfield import (
-    FALLBACK_DIGITS,
-    MAX_MULTIPLE,
-    ExactField,
-    NotExact,
-    decide_zero,
-    exact_is_zero,
-    mp_matrix,
-)
+from .display import readable
+from .exact_rank import RankAnalysis, canonical_rows, rank_conditions
+from .exactfield import FALLBACK_DIGITS, MAX_MULTIPLE, NotExact, decide_zero, exact_is_zero
 from .fallback import NumericFallbackWarning, fallback_rank, fallback_rref, fallback_warning
-from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = [
     "Rank",
@@ -90,11 +82,6 @@ def exact_det(M: sp.Matrix) -> sp.Expr:
         return dM.domain.to_sympy(dM.det())
     except Exception:
         return sp.expand(M.det(method="bareiss"))
-
-
-#: exact elimination only while (largest multiple n of the common angle measure g) × min(m, n) ≤ this
-#: (a 6×6 J: multiples up to 16, a few seconds; beyond, the 60-digit fallback answers, and says so)
-EXACT_BUDGET = 100
 
 
 class ConditionalResultWarning(UserWarning):
@@ -253,203 +240,6 @@ def _as_float(M: sp.Matrix) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------------------------
-# exact rank and canonical bases
-# ----------------------------------------------------------------------------------------------
-def _ring_det(A: sp.Matrix) -> sp.Expr:
-    """det A exactly, computed in the polynomial ring of the sines and cosines in A, folded for display."""
-    if A.rows == 0:
-        return sp.S.One
-    if A.rows == 1:
-        return A[0, 0]
-    try:
-        ring = TrigRing(list(A), opaque=True)
-        if ring.domain.is_EX:
-            raise NotTrigPolynomial(A)
-        dA = DomainMatrix(
-            [[ring.normal_form(A[i, j]) for j in range(A.cols)] for i in range(A.rows)], A.shape, ring.ring.to_domain()
-        )
-        return ring.to_expr(ring.reduce(dA.det()), collect=True)
-    except NotTrigPolynomial:
-        return sp.expand(A.det(method="bareiss"))
-
-
-def _numeric_pivots(X, top) -> tuple:
-    """(pivot columns, certain?) of the mpmath matrix X by greedy certified rank tests at 60 digits.
-
-    A column joins when the smallest singular value of the chosen columns plus it exceeds 10⁻²⁰·σ_max(X)
-    (certified: the entries and the SVD are accurate to ~10⁻⁵⁵·σ_max, and σ moves by at most that much).
-    A column that does not join is a "zero" decision, certain only once the pivots already span every row."""
-    import mpmath
-
-    m, n = X.rows, X.cols
-    piv: list = []
-    with mpmath.workdps(FALLBACK_DIGITS):
-        big = top * mpmath.mpf(10) ** -20
-        for j in range(n):
-            if len(piv) == m:
-                break
-            cols = piv + [j]
-            sub = mpmath.matrix(m, len(cols))
-            for a, c in enumerate(cols):
-                for i in range(m):
-                    sub[i, a] = X[i, c]
-            smin = min(abs(x) for x in mpmath.svd_r(sub, compute_uv=False))
-            if smin > big:
-                piv.append(j)
-            else:
-                return piv, False
-    return piv, True
-
-
-class _Analysis:
-    """The rank of an evaluated matrix A, its pivot columns (those of rref A) and independent rows.
-
-    Without parameters, first by certified 60-digit numerics (each "independent" decision certified, see
-    :func:`_numeric_pivots`); as soon as a decision would be "dependent" (a rank drop, a skipped column), exactly:
-    Gaussian elimination in K(t, params) (module docstring)."""
-
-    def __init__(self, A: sp.Matrix):
-        self.A = A
-        self._fld = None
-        if not A.free_symbols:
-            X = mp_matrix(A)
-            import mpmath
-
-            with mpmath.workdps(FALLBACK_DIGITS):
-                top = max((abs(x) for x in mpmath.svd_r(X, compute_uv=False)), default=mpmath.mpf(0))
-            if top > 0:
-                piv, ok = _numeric_pivots(X, top)
-                if ok:
-                    rows, ok = _numeric_pivots(X.T, top)
-                    if ok:
-                        self.pivots, self.rows, self.rank, self.R = piv, rows, len(piv), None
-                        return
-        fld = self.fld
-        size = max((abs(n) for n, _ in fld.multiples.values()), default=0) * min(A.shape)
-        if size > EXACT_BUDGET:
-            raise NotExact(
-                f"exact elimination with angles up to {size // min(A.shape)} multiples of their common "
-                f"measure {fld.g} on a {A.rows}×{A.cols} matrix is out of reach in seconds"
-            )
-        dA = fld.matrix(A).to_field()
-        self.R, self.pivots = dA.rref()
-        self.R = self.R.to_list()
-        self.rank = len(self.pivots)
-        _, rows = dA.transpose().rref()  # independent rows: the pivot columns of Aᵀ
-        self.rows = list(rows)
-
-    @property
-    def fld(self) -> ExactField:
-        if self._fld is None:
-            self._fld = ExactField(list(self.A))
-        return self._fld
-
-    def entry_is_zero(self, k: int, j: int, expr) -> bool:
-        """Whether rref(A)[k, j] is 0; ``expr()`` gives its numerator (a minor) when it must be computed."""
-        if self.R is not None:
-            return not self.R[k][j]
-        return decide_zero(expr())
-
-
-def _canonical_rows(A: sp.Matrix, an: _Analysis) -> sp.Matrix:
-    """The nonzero rows of rref(A), exact, entries written as ratios of minors of A (Cramer's rule)."""
-    r = an.rank
-    if r == 0:
-        return sp.zeros(0, A.cols)
-    I, P = an.rows, list(an.pivots)
-    B = A.extract(I, P)
-    D = _ring_det(B)
-    out = sp.zeros(r, A.cols)
-    for k in range(r):
-        for j in range(A.cols):
-            if j in P:
-                out[k, j] = sp.S.One if P.index(j) == k else sp.S.Zero
-                continue
-            Bk = B.copy()
-            Bk[:, k] = A.extract(I, [j])
-            minor = {}
-
-            def numerator(Bk=Bk, minor=minor):
-                minor["d"] = _ring_det(Bk)
-                return minor["d"]
-
-            if an.entry_is_zero(k, j, numerator):
-                continue
-            out[k, j] = readable_ratio(minor["d"] if "d" in minor else _ring_det(Bk), D)
-    return out
-
-
-def _never_zero(factor: sp.Expr, fld: ExactField) -> bool:
-    """True when the factor (an expression in the positive parameters with exact-number coefficients) is nonzero
-    for every positive value of the parameters: written as a polynomial in them, all its coefficients (numbers,
-    evaluated at the true t with 50 digits) share one strict sign. A nonzero polynomial in the transcendental t is
-    nonzero at the true t, so a coefficient that evaluates to below 1e-40 is treated as "sign unknown"."""
-    num = fld.convert(factor).numer
-    nparam, base = len(fld.params), 1 + len(fld.extra)
-    gens_sym = [fld.t] + list(fld.extra)
-    grouped: dict = {}
-    for monom, coeff in num.terms():
-        pm = monom[base : base + nparam]
-        val = sp.Mul(fld.K.to_sympy(coeff), *[s**d for s, d in zip(gens_sym, monom[:base])])
-        grouped[pm] = grouped.get(pm, 0) + val
-    tval = sp.tan(fld.g / 2) if fld.g != 0 else sp.S.Zero
-    signs = set()
-    for val in grouped.values():
-        v = sp.N(sp.sympify(val).subs(fld.t, tval), 50)
-        signs.add(0 if v == 0 or abs(v) < sp.Float("1e-40") else (1 if v > 0 else -1))
-    return len(signs) == 1 and 0 not in signs
-
-
-#: how many r×r minors :func:`_conditions` looks at for one that never vanishes
-MAX_MINORS = 60
-
-
-def _vanishing_factors(D: sp.Expr, an: _Analysis) -> list:
-    """The factors of D that involve the parameters and can vanish for positive parameters (sign-normalised)."""
-    params = set(an.fld.params)
-    try:  # factored in the parameters, the configuration's constants as coefficients (nested radicals such
-        # as √(5 + √5) make SymPy's factor_list over all atoms fail: "Cannot construct a polynomial from 1")
-        _, factors = sp.factor_list(sp.factor_terms(D), *sorted(params, key=str))
-    except sp.PolynomialError:
-        factors = [(sp.expand(D), 1)]  # one factor: a sufficient condition all the same
-    out = []
-    for f, _mult in factors:
-        if not (f.free_symbols & params):
-            continue
-        if f.could_extract_minus_sign():
-            f = -f
-        if not _never_zero(f, an.fld) and f not in out:
-            out.append(f)
-    return out
-
-
-def _conditions(A: sp.Matrix, an: _Analysis) -> tuple:
-    """Where the rank r found (over the field of the parameters) could be lower for positive parameters.
-
-    rank A < r exactly where every r×r minor vanishes. The pivot minor and then others (up to ``MAX_MINORS``) are
-    examined: one that never vanishes for positive parameters proves the rank for all of them (no condition);
-    otherwise the factors shared by all the minors examined (each can vanish) are returned — the rank is r wherever
-    none of them vanishes. If the minors share none, the pivot minor's factors are returned (sufficient)."""
-    if not A.free_symbols or an.rank == 0:
-        return ()
-    r = an.rank
-    first = (tuple(an.rows), tuple(an.pivots))
-    others = itertools.product(itertools.combinations(range(A.rows), r), itertools.combinations(range(A.cols), r))
-    common, pivot_factors = None, None
-    for I, P in itertools.islice(itertools.chain([first], (c for c in others if c != first)), MAX_MINORS):
-        D = _ring_det(A.extract(list(I), list(P)))  # in the sines and cosines of A (the field's atoms)
-        if D == 0 or not an.fld.convert(D):
-            continue
-        facs = _vanishing_factors(D, an)
-        if not facs:
-            return ()
-        if pivot_factors is None:
-            pivot_factors = facs
-        common = facs if common is None else [f for f in common if f in facs]
-    return tuple(readable_fold(f) for f in (common or pivot_factors or ()))
-
-
-# ----------------------------------------------------------------------------------------------
 # public functions
 # ----------------------------------------------------------------------------------------------
 def _numeric_J(J: Any, name: str = "J") -> np.ndarray:
@@ -516,9 +306,9 @@ def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = N
 
 
 def _analyse(M: sp.Matrix, what: str):
-    """(_Analysis or None, reason): the exact analysis, or None with the reason it is out of reach."""
+    """(RankAnalysis or None, reason): the exact analysis, or None with the reason it is out of reach."""
     try:
-        return _Analysis(M), ""
+        return RankAnalysis(M), ""
     except NotExact as err:
         return None, str(err)
 
@@ -567,7 +357,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None,
         with within(seconds, "rank_at"):
             an, why = _analyse(M, "rank_at")
             if an is not None:
-                unless = _conditions(M, an)
+                unless = rank_conditions(M, an)
                 return Rank(an.rank, unless=unless, note="exact elimination in K(tan(g/2), parameters)")
     except OutOfTime:
         why = _late(seconds)
@@ -612,8 +402,8 @@ def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = 
         with within(seconds, "column_space"):
             an, why = _analyse(A, "column_space")
             if an is not None:
-                unless = _conditions(A, an)
-                out = _canonical_rows(A, an).T
+                unless = rank_conditions(A, an)
+                out = canonical_rows(A, an).T
                 _warn_conditions("column_space", unless)
                 return out
     except OutOfTime:
@@ -650,12 +440,12 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
         with within(seconds, "left_null_space"):
             an, why = _analyse(A, "left_null_space")
             if an is not None:
-                unless = _conditions(A, an)
+                unless = rank_conditions(A, an)
                 if an.rank == m:
                     out = sp.zeros(m, 0)
                 else:
-                    N = _null_from_rref(_canonical_rows(A, an), m)
-                    out = _canonical_rows(N, _Analysis(N)).T if N.rows else sp.zeros(m, 0)
+                    N = _null_from_rref(canonical_rows(A, an), m)
+                    out = canonical_rows(N, RankAnalysis(N)).T if N.rows else sp.zeros(m, 0)
                 _warn_conditions("left_null_space", unless)
                 return out
     except OutOfTime:

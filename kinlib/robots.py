@@ -21,6 +21,7 @@ __all__ = [
     "planar_3r",
     "planar_rpp",
     "ur5",
+    "puma560",
     "length",
     "from_urdf_joints",
 ]
@@ -212,6 +213,52 @@ def ur5(W1=None, W2=None, L1=None, L2=None, H1=None, H2=None) -> SerialChain:
     )
     pts = _cols([0, 0, 0], [0, 0, H1], [L1, 0, H1], [L1 + L2, 0, H1], [L1 + L2, W1, H1], [L1 + L2, W1, H1 - H2])
     return SerialChain(M, S, name="ur5", joint_points=pts, description="UR5 (Modern Robotics Example 4.5)")
+
+
+#: Corke's Puma 560 (Robotics Toolbox, ``mdl_puma560``; Corke and Armstrong-Hélouvry, "A search for consensus
+#: among model parameters reported for the PUMA 560 robot", ICRA 1994), standard DH, metres
+_PUMA560 = {"a2": "0.4318", "d3": "0.15005", "a3": "0.0203", "d4": "0.4318"}
+
+
+def puma560(a2=None, d3=None, a3=None, d4=None) -> SerialChain:
+    """A PUMA 560 (6R, spherical wrist) from Corke's standard DH table; defaults are its lengths in metres, exact.
+
+    DH rows (d, a, α): (0, 0, π/2), (0, a2, 0), (d3, a3, −π/2), (d4, 0, π/2), (0, 0, −π/2), (0, 0, 0): upper arm
+    a2, shoulder offset d3, elbow offset a3, forearm d4 (a2 = d4 = 0.4318 m: upper arm and forearm are equally
+    long). At θ = 0 the upper arm lies along x_s, the forearm points up, the tool is at the wrist centre
+    (a2 + a3, −d3, d4). The space screw axes come from the DH frames at θ = 0 (joint i turns about z_{i−1}).
+    Shoulder singularity: a2 cos θ2 + a3 cos(θ2 + θ3) − d4 sin(θ2 + θ3) = 0 (the wrist centre over the line
+    of joint 1's axis in the arm's plane; on that axis when d3 = 0); elbow: a3 cos θ3 − d4 sin θ3 = 0; wrist:
+    sin θ5 = 0. Pass symbols (``puma560(L, 0, 0, L)``) for a symbolic arm.
+
+    >>> import sympy as sp
+    >>> r = puma560()
+    >>> r.M[:3, 3].T   # the wrist centre at θ = 0
+    Matrix([[4521/10000, -3001/20000, 2159/5000]])
+    >>> L = sp.Symbol("L", positive=True)
+    >>> r = puma560(L, 0, 0, L)   # equal upper arm and forearm, no offsets
+    >>> r.fk([0, sp.pi / 4, sp.pi / 2, 0, 0, 0])[:3, 3].T   # forearm folded back: the wrist centre at the shoulder
+    Matrix([[0, 0, 0]])
+    """
+    given = dict(a2=a2, d3=d3, a3=a3, d4=d4)
+    v = {k: (sp.Rational(_PUMA560[k]) if x is None else length(x, k)) for k, x in given.items()}
+    a2, d3, a3, d4 = (v[k] for k in ("a2", "d3", "a3", "d4"))
+    half = sp.pi / 2
+    dh = [(0, 0, half), (0, a2, 0), (d3, a3, -half), (d4, 0, half), (0, 0, -half), (0, 0, 0)]
+    T, cols, pts = sp.eye(4), [], []
+    for d, a, alpha in dh:  # joint i: about z_{i-1} through o_{i-1}; then A_i(0) = Tz(d) Tx(a) Rx(α)
+        z, o = T[:3, 2], T[:3, 3]
+        cols.append(list(z) + list(-z.cross(o)))
+        pts.append(o)
+        ca, sa = sp.cos(alpha), sp.sin(alpha)
+        T = T * _T([a, 0, d], [[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
+    return SerialChain(
+        T,
+        _cols(*cols),
+        name="puma560",
+        joint_points=sp.Matrix.hstack(*pts),
+        description="PUMA 560 (Corke's standard DH parameters)",
+    )
 
 
 # --- issue 11, item 6: a student's own arm from URDF joint placements --------------------------------

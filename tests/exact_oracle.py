@@ -110,3 +110,17 @@ def fk(screws, M, q):
         for i in range(n):
             T = T * _exp6([_mp(screws[r, i]) for r in range(6)], _mp(q[i]))
         return T * to_mp(M)
+
+
+def geometric_jacobian(screws, M, q):
+    """The geometric Jacobian [ω_s; ṗ] (6×n) at q, 60 digits: ṗ = v_s + ω_s × p = v_s − [p] ω_s with p the tool
+    origin (from :func:`fk`), so it rests on :func:`space_jacobian` and :func:`fk` only."""
+    with mpmath.workdps(DIGITS + 15):
+        Js = space_jacobian(screws, q)
+        T = fk(screws, M, q)
+        P = _skew([T[0, 3], T[1, 3], T[2, 3]])
+        J = Js.copy()
+        for r in range(3):
+            for j in range(Js.cols):
+                J[3 + r, j] = Js[3 + r, j] - sum(P[r, k] * Js[k, j] for k in range(3))
+        return J
