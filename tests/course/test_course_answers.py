@@ -1,4 +1,4 @@
-"""kinlib.course.answers.normalise: the one answer normaliser of the self-checks and of the instructor checker.
+"""The answer normalisers of kinlib.course.answers' kind modules: one per kind, for the self-checks and the grader alike.
 
 It replaced two (the self-check's coercions and the checker probe's); it accepts the union of the
 forms either accepted, and both consumers now accept each of them. The last tests check that: the same
@@ -16,15 +16,10 @@ import numpy as np
 import pytest
 import sympy as sp
 
-from kinlib.course.answers.normalise import (
-    choice_value,
-    is_bool,
-    is_unanswered,
-    looks_like_set,
-    set_conditions,
-    to_set,
-    to_sympy,
-)
+from kinlib.course.answers.base import is_bool, is_unanswered
+from kinlib.course.answers.choice import choice_value
+from kinlib.course.answers.expr import to_sympy
+from kinlib.course.answers.sets import looks_like_set, set_conditions, to_set
 from kinlib.course.grader.in_kernel.export import exported
 from kinlib.course.grader.judge import judge_answer
 from kinlib.course.grader.refdata import Reference, reference_answers

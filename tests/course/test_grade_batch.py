@@ -12,6 +12,7 @@ import csv
 import json
 import os
 import signal
+import subprocess
 import sys
 import threading
 from pathlib import Path
@@ -447,6 +448,43 @@ def test_without_cgroups_the_enclosure_falls_back_to_rlimits(monkeypatch):
     with limits.Enclosure(limits.Limits(processes=100), "t") as e:
         assert e.kind == "" and e.cgroups == [] and e.wrap(["python"]) == ["python"]
         assert e.rlimits()["nproc"] == 100 and "rlimits only" in e.describe() and e.reached() == []
+
+
+def test_the_cgroup_v2_path_on_a_fake_cgroup_filesystem(tmp_path, monkeypatch):
+    """This machine has cgroup v1; the v2 path runs here against a folder standing in for /sys/fs/cgroup (the
+    grader in /grader.slice/me): the grader's base cgroup with memory and pids delegated, one cgroup per
+    submission with memory.max, memory.swap.max and pids.max, a launcher that joins it before exec, the limits
+    reached read from memory.events and pids.events, cgroup.kill written, the folder removed."""
+    root = tmp_path / "cgroup"
+    (root / "grader.slice" / "me").mkdir(parents=True)
+    (root / "cgroup.controllers").write_text("cpu memory pids\n")
+    (root / "cgroup.subtree_control").write_text("memory pids\n")
+    (root / "grader.slice" / "cgroup.subtree_control").write_text("memory pids\n")
+    monkeypatch.setattr(limits, "_CG2", root)
+    monkeypatch.setattr(limits, "_own_cgroup", lambda ctl: "/grader.slice/me" if ctl == "" else None)
+    monkeypatch.delitem(limits._SUPPORT, "res", raising=False)  # noqa: SLF001  (checked once per process)
+    monkeypatch.setattr(limits.atexit, "register", lambda f: f)  # no release() of the fake at exit
+    kind, base = limits.cgroup_support()
+    assert (kind, base) == ("v2", root / "grader.slice" / f"kinlib-grade-{os.getpid()}")
+    assert (base / "cgroup.subtree_control").read_text() == "+memory +pids"
+    lim = limits.Limits(memory_bytes=2**30, processes=64)
+    with limits.Enclosure(lim, "ann/02 é") as e:
+        (c,) = e.cgroups
+        assert e.kind == "v2" and c.parent == base and "cgroup v2" in e.describe()
+        assert [(c / f).read_text() for f in ("memory.max", "memory.swap.max", "pids.max")] == [str(2**30), "0", "64"]
+        assert e.rlimits() == {"as": 2**30 + 2 * 2**30, "fsize": lim.disk_bytes}  # no nproc: the cgroup counts
+        ran = subprocess.run(e.wrap([sys.executable, "-c", "import os; print(os.getpid())"]), capture_output=True)
+        assert (c / "cgroup.procs").read_text().split() == ran.stdout.decode().split()  # joined, then exec'd
+        (c / "memory.events").write_text("low 0\nhigh 0\nmax 7\noom 2\noom_kill 2\n")
+        (c / "pids.events").write_text("max 5\n")
+        reached = " ".join(e.reached())
+        assert "more than 1 GiB in all; 2 process(es) killed" in reached and "64 at once; 5 new" in reached
+        (c / "cgroup.procs").write_text("")  # the launcher has exited (its PID must not be killed again)
+        (c / "cgroup.kill").write_text("0")
+        assert e.kill() == [] and (c / "cgroup.kill").read_text() == "1"
+        for f in c.iterdir():  # cgroupfs removes a cgroup's files with it; a plain folder needs them gone first
+            f.unlink()
+    assert not c.exists()
 
 
 BOMBS = {

@@ -443,6 +443,38 @@ def test_modules_are_small():
     )
 
 
+#: the grader path (the trusted host and what decides an answer): no function longer than this, its docstring aside
+MAX_FUNCTION_LINES = 60
+GRADER_PATH = ("kinlib.course.grader", "kinlib.course.answers")
+
+
+def test_grader_path_functions_are_small():
+    """Every function (and method) in kinlib/course/grader/** and kinlib/course/answers/** has at most
+    MAX_FUNCTION_LINES lines of code (its docstring, doctests included, not counted): one submission is graded as
+    named steps, each small (issue 22; nbgrader's autograde converters are the model)."""
+    long, seen = [], 0
+    for m, p in MODULES.items():
+        if not m.startswith(GRADER_PATH):
+            continue
+        for node in ast.walk(ast.parse(p.read_text(encoding="utf-8"))):
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                seen += 1
+                n = node.end_lineno - node.lineno + 1
+                doc = node.body[0]
+                if (
+                    isinstance(doc, ast.Expr)
+                    and isinstance(doc.value, ast.Constant)
+                    and isinstance(doc.value.value, str)
+                ):
+                    n -= doc.end_lineno - doc.lineno + 1
+                if n > MAX_FUNCTION_LINES:
+                    long.append(f"{_rel(p)}:{node.lineno} {node.name}: {n} lines")
+    assert seen > 100, seen  # the folders were found and read
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines in the grader path (split them):\n  " + "\n  ".join(
+        long
+    )
+
+
 _LIGHT_IMPORT = textwrap.dedent("""
     import json, pkgutil, sys
     from pathlib import Path

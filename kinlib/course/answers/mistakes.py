@@ -1,6 +1,6 @@
 """Named mistakes: the known ways a right answer goes wrong, each with the transform that undoes it.
 
-Shared by the instructor checker (:func:`kinlib.course.answers.compare.compare_expr`, which compares numbers) and
+Shared by the instructor checker (:func:`kinlib.course.answers.expr.compare_expr`, which compares numbers) and
 the workbook self-check (:mod:`kinlib.course.workbook.selfcheck`, which compares salted fingerprints): both take
 the student's answer, undo one known mistake (or two of the simple ones) and ask "is *this* the right
 answer?". The first yes names the mistake. Each :class:`Mistake` has

@@ -1,29 +1,45 @@
-"""Open-ended answers graded by the property asked (the grader's side, trusted process), never by one design's value.
+"""The ``property:<p>`` kind: an open-ended answer graded by the property asked, never by one design's value.
 
 A ``property`` answer (kind "property:<name>" in the grader; declared by ``properties`` in the solution cell's
-metadata, see :func:`kinlib.course.schema.grading_kind`) is described in the grader as a JSON expression tree
-(:func:`kinlib.course.answers.normalise.expr_tree`), rebuilt here by :func:`from_tree` from a whitelist (never ``eval``),
-with bounded size, so a hostile tree cannot run code or exhaust the grader. :data:`PROPERTIES` maps each
-property to its decision, ``(ok, message)``; the message talks about the student's own answer only.
+metadata, see :func:`kinlib.course.schema.grading_kind`) is the student's own design (problem 5.5: "your redesign
+has no singular configuration").
 
-:func:`exact_ranks` compares constant exact subspaces exactly (:func:`kinlib.course.answers.compare.compare_subspace`).
+* **normalise** (:func:`property_answer`): a robot (any object with a 6×n ``screws`` matrix, a kinlib
+  ``SerialChain``, found by duck typing: :func:`robot_screws`), its task Jacobian as a matrix, or an expression,
+  as its exact tree (:func:`kinlib.course.answers.exacttree.expr_tree`).
+* **wire form**: ``robot`` (only its screw axes cross the kernel boundary), ``Matrix``, SymPy expressions.
+* **describe** (:func:`describe_property`): the exact tree (and, for a matrix or an expression, its values).
+* **compare** (:func:`compare_property` → :func:`judge`): :data:`PROPERTIES` maps each property to its decision,
+  ``(ok, message)``, on the tree rebuilt by a whitelist (:func:`~.exacttree.from_tree`, never ``eval``); the
+  message talks about the student's own answer only. The reference is not used (:func:`reference_property`).
 
-* ``nonsingular`` (problem 5.5): the student's redesigned robot (a ``SerialChain``: the judge computes its J from
-  its screw axes) or its task Jacobian J has det(J Jᵀ) ≠ 0 for every joint value, proved exactly by
+* ``nonsingular`` (problem 5.5): the student's redesigned robot (the judge computes its J from its screw axes) or
+  its task Jacobian J has det(J Jᵀ) ≠ 0 for every joint value, proved exactly by
   :func:`kinlib.singularities.singular_configurations` (trigonometric normal forms, :mod:`kinlib.trigsign`
   proofs of non-vanishing). A bare value of det(J Jᵀ) belongs to no robot and is refused.
 
 The same judges serve the workbook self-check (:func:`kinlib.course.workbook.selfcheck.verdict`, spec
-``property|nonsingular|-``) and the grader (:func:`kinlib.course.compare.compare_property`).
+``property|nonsingular|-``: :func:`property_spec`, :func:`property_verdict`) and the grader.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
+
+import numpy as np
+import sympy as sp
+
+from .base import not_answered, type_name
+from .exacttree import expr_tree, from_tree
+from .expr import describe_expr, to_sympy
 
 __all__ = [
-    "from_tree",
-    "exact_ranks",
+    "robot_screws",
+    "property_answer",
+    "describe_property",
+    "compare_property",
+    "reference_property",
     "nonsingular",
     "judge",
     "PROPERTIES",
@@ -31,113 +47,10 @@ __all__ = [
     "MAX_ROBOT_JOINTS",
     "judge_value",
     "property_spec",
+    "property_verdict",
 ]
 
 MAX_TERMS_ESTIMATE = 50_000  # a bound on the terms of det(J Jᵀ) expanded (see _terms_estimate)
-
-
-def from_tree(t, syms: dict | None = None, budget: list | None = None):
-    """Rebuild a student's expression from its JSON tree (``probe.expr_tree``) by a whitelist, never ``eval``:
-    numbers (at most 60 digits), symbols (real, or positive as declared), π, +, ×, powers with small exact
-    exponents, sin/cos/tan. Anything else raises ValueError. ``syms`` collects the symbols made (one per name and
-    assumption), ``budget`` ([nodes left]) bounds the size.
-
-    >>> from_tree(["add", ["rat", "1", "2"], ["fn", "cos", ["sym", "theta1", False]]])
-    cos(theta1) + 1/2
-    >>> from_tree(["call", "__import__", "os"])
-    Traceback (most recent call last):
-    ...
-    ValueError: 'call' is not supported here
-    """
-    import sympy as sp
-
-    syms = {} if syms is None else syms
-    budget = [20_000] if budget is None else budget
-    budget[0] -= 1
-    if budget[0] < 0:
-        raise ValueError("the expression is too large")
-    if not isinstance(t, list) or not t or not isinstance(t[0], str):
-        raise ValueError("malformed expression")
-    op, args = t[0], t[1:]
-
-    def digits(x):
-        if not isinstance(x, str) or not 0 < len(x) <= 60 or not x.lstrip("-").isdigit():
-            raise ValueError("malformed number")
-        return int(x)
-
-    if op == "int" and len(args) == 1:
-        return sp.Integer(digits(args[0]))
-    if op == "rat" and len(args) == 2:
-        q = digits(args[1])
-        if q == 0:
-            raise ValueError("malformed number")
-        return sp.Rational(digits(args[0]), q)
-    if op == "float" and len(args) == 1 and isinstance(args[0], str) and len(args[0]) <= 40:
-        x = float(args[0])
-        if not math.isfinite(x):
-            raise ValueError("not a finite number")
-        return sp.Rational(x)  # its exact binary value (as kinlib.trigpoly takes floats)
-    if op == "pi" and not args:
-        return sp.pi
-    if op == "sym" and len(args) == 2 and isinstance(args[0], str) and 0 < len(args[0]) <= 40:
-        key = (args[0], bool(args[1]))
-        if key not in syms:
-            syms[key] = sp.Symbol(args[0], positive=True) if args[1] else sp.Symbol(args[0], real=True)
-        return syms[key]
-    if op in ("add", "mul") and args:
-        parts = [from_tree(a, syms, budget) for a in args]
-        return sp.Add(*parts) if op == "add" else sp.Mul(*parts)
-    if op == "pow" and len(args) == 2:
-        base, exp = from_tree(args[0], syms, budget), from_tree(args[1], syms, budget)
-        if not (exp.is_Rational and abs(exp.p) <= 12 and exp.q <= 2):
-            raise ValueError("a power that is not a small whole number or half")
-        return sp.Pow(base, exp)
-    if op == "fn" and len(args) == 2 and args[0] in ("sin", "cos", "tan"):
-        return getattr(sp, args[0])(from_tree(args[1], syms, budget))
-    raise ValueError(f"{op!r} is not supported here")
-
-
-def exact_ranks(stu_tree, ref_tree):
-    """(rank A, rank B, rank [A B]) computed exactly for two constant exact matrices given as expression trees
-    (``probe.expr_tree``; both sides must have one), or None (then the spans are compared numerically): when
-    a tree is missing or malformed, has symbols, or SymPy cannot decide whether a pivot is zero. Equal spans ⇔
-    rank A = rank B = rank [A B].
-
-    >>> col = lambda *xs: ["matrix", len(xs), 1, *[["int", str(x)] for x in xs]]
-    >>> exact_ranks(col(1, 0, 10**30), col(0, 0, 1)), exact_ranks(col(1, 0), ["sym", "x", False])
-    ((1, 1, 2), None)
-    """
-    import sympy as sp
-
-    if not (isinstance(stu_tree, list) and isinstance(ref_tree, list)):
-        return None
-    mats = []
-    try:
-        for t in (stu_tree, ref_tree):
-            if t[:1] != ["matrix"] or len(t) < 3 or not all(isinstance(x, int) and 0 < x <= 12 for x in t[1:3]):
-                return None
-            if len(t) != 3 + t[1] * t[2]:
-                return None
-            budget = [600]
-            M = sp.Matrix(t[1], t[2], [from_tree(x, {}, budget) for x in t[3:]])
-            if M.free_symbols:
-                return None
-            mats.append(M)
-    except (ValueError, TypeError, RecursionError):
-        return None
-    A, B = mats
-    if A.rows != B.rows:
-        return None
-    unsure = []
-
-    def iszero(x):
-        z = sp.sympify(x).equals(0)
-        if z is None:
-            unsure.append(x)
-        return bool(z)
-
-    ranks = tuple(M.rank(iszerofunc=iszero) for M in (A, B, A.row_join(B)))
-    return None if unsure else ranks
 
 
 def _terms_estimate(e) -> float:
@@ -159,8 +72,6 @@ def _terms_estimate(e) -> float:
 
 def _where(conds) -> str:
     """Singular conditions as text: one-joint families merged (θ2 = 0, π (+ 2πk)), others as given."""
-    import sympy as sp
-
     from kinlib.singularities import representatives
 
     merged: dict = {}
@@ -189,8 +100,6 @@ def _never_zero(M, what: str):
     """(True, None) when det M ≠ 0 for every real value of M's non-positive symbols (its joint values) is
     proved by :func:`kinlib.singularities.singular_configurations` (no condition, complete); else
     (False, message). For a non-square M (m < n) the rank test is det(M Mᵀ) (Cauchy–Binet)."""
-    import sympy as sp
-
     from kinlib.singularities import singular_configurations
 
     variables = sorted((s for s in M.free_symbols if not s.is_positive), key=lambda s: s.name)
@@ -223,8 +132,6 @@ MAX_ROBOT_JOINTS = 6  # a redesign with more joints is not decided here (the pro
 
 def _matrix(tree, syms: dict, budget: list, name: str):
     """A matrix rebuilt from its tree, or a message (str) saying why not."""
-    import sympy as sp
-
     if len(tree) < 3 or not all(isinstance(x, int) and 0 < x <= 12 for x in tree[1:3]):
         return f"{name} could not be read (malformed matrix)"
     r, c = tree[1], tree[2]
@@ -236,8 +143,6 @@ def _matrix(tree, syms: dict, budget: list, name: str):
 def _robot_task_jacobian(S, name: str):
     """The task rows (ω_z, v_x, v_y) of the space Jacobian of the planar robot with screw axes S (6×n), or a
     message (str) saying why the robot cannot be judged: not planar, not valid screws, too many joints."""
-    import sympy as sp
-
     from kinlib.jacobians import jacobian_space
 
     if S.cols > MAX_ROBOT_JOINTS:
@@ -257,8 +162,6 @@ def _robot_task_jacobian(S, name: str):
 
 
 def _judge_task_jacobian(J, syms: dict, name: str, what: str) -> tuple[bool, str]:
-    import sympy as sp
-
     r, c = J.shape
     if r == 6:
         return False, f"{name}: give the task rows (ω_z, v_x, v_y) of J, a 3×{c} matrix (task_rows(J, 'planar'))"
@@ -275,7 +178,7 @@ def _judge_task_jacobian(J, syms: dict, name: str, what: str) -> tuple[bool, str
 
 def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
     """The student's own redesign has no singular configuration: det(J Jᵀ) ≠ 0 for every joint value, decided
-    exactly for **their robot**. The answer (:func:`kinlib.course.answers.normalise.property_answer`) is the robot (tag
+    exactly for **their robot**. The answer (:func:`property_answer`) is the robot (tag
     "robot": its space screw axes, 6×n; the judge computes J_s from them, :func:`kinlib.jacobians.jacobian_space`,
     and takes its task rows ω_z, v_x, v_y; the robot must be planar) or its task Jacobian J (a 3×n matrix). A
     number or expression alone (a claimed det(J Jᵀ), e.g. 1) is refused: it belongs to no robot. Proofs by
@@ -311,7 +214,7 @@ PROPERTIES = {"nonsingular": nonsingular}
 
 def judge(prop: str, stu: dict, name: str) -> tuple[bool, str]:
     """``(ok, message)``: the property ``prop`` of :data:`PROPERTIES` judged on the answer description ``stu``
-    (:func:`kinlib.course.answers.normalise.property_answer`); never raises.
+    (:func:`property_answer`); never raises.
 
     >>> judge("nonsingular", {"tag": "ellipsis"}, "redesign")
     (False, 'redesign is not answered yet')
@@ -333,13 +236,11 @@ def judge(prop: str, stu: dict, name: str) -> tuple[bool, str]:
 
 def judge_value(prop: str, value, name: str) -> tuple[bool, str]:
     """:func:`judge` on a value itself (the workbook self-check's side, in the student's kernel), described by
-    :func:`kinlib.course.answers.normalise.property_answer` exactly as the grader's kernel describes it.
+    :func:`property_answer` exactly as the grader's kernel describes it.
 
     >>> judge_value("nonsingular", 1, "redesign")[0]
     False
     """
-    from .normalise import property_answer
-
     return judge(prop, property_answer(value), name)
 
 
@@ -367,3 +268,103 @@ def property_verdict(prop: str, value) -> tuple[str, str]:
     """
     ok, message = judge_value(prop, value, "your answer")
     return ("correct", f"correct: {message}") if ok else ("incorrect", f"not right yet: {message}")
+
+
+def robot_screws(value):
+    """The space screw axes (a 6×n SymPy Matrix, one per column) of a robot answer, or None when ``value`` is
+    not a robot: any object, not itself a matrix, number, container or SymPy object, whose ``screws``
+    attribute is a 6×n matrix (a kinlib ``SerialChain``; duck typing, never an import of kinlib).
+
+    >>> class Arm:
+    ...     screws = sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 0, 1, 0, 0]]).T
+    >>> robot_screws(Arm()).shape, robot_screws(sp.eye(6)), robot_screws([1, 2])
+    ((6, 2), None, None)
+    """
+    if isinstance(value, (sp.Basic, sp.MatrixBase, np.ndarray, list, tuple, dict, set, str, bytes, numbers.Number)):
+        return None
+    try:
+        screws = getattr(value, "screws", None)
+    except Exception:  # noqa: BLE001  (a property that raises: not a robot)
+        return None
+    if screws is None:
+        return None
+    tag, S = to_sympy(screws)
+    if tag != "matrix" or S.rows != 6 or not 1 <= S.cols <= 12:
+        return None
+    return S
+
+
+def property_answer(value) -> dict:
+    """An answer judged by a property of the student's own design (problem 5.5: "your redesign has no singular
+    configuration") as plain JSON data for the judge (:mod:`kinlib.course.answers.properties`): ``{"tag": "robot",
+    "tree": …}`` for a robot (its screw axes, :func:`robot_screws`), ``{"tag": "matrix"|"scalar", "tree": …}``
+    for a matrix (its task Jacobian) or an expression, with the exact :func:`expr_tree`; ``tree_error`` says
+    why there is none; other tags as :func:`to_sympy`.
+
+    >>> property_answer(sp.Matrix([[1, 0], [0, 1]]))["tree"][:3]
+    ['matrix', 2, 2]
+    >>> property_answer(...)["tag"], property_answer("robot")["tag"]
+    ('ellipsis', 'other')
+    """
+    S = robot_screws(value)
+    if S is not None:
+        tag, obj = "robot", S
+    else:
+        tag, obj = to_sympy(value)
+    out = {"tag": tag, "type": type_name(value)}
+    if obj is not None:
+        try:
+            out["tree"] = expr_tree(obj)
+        except Exception as exc:  # noqa: BLE001  (any failure is reported, not raised)
+            out["tree_error"] = str(exc)[:200]
+    return out
+
+
+def describe_property(value, points, seed=0):
+    """An answer graded by a property (``kind`` "property:<name>"): a robot as its screw axes' exact tree
+    (:func:`property_answer`), anything else described as an expression plus its exact expression tree
+    (:func:`~.exacttree.expr_tree`), for the grader's proof.
+
+    >>> describe_property(sp.Rational(1, 2), [{}])["tree"]
+    ['rat', '1', '2']
+    """
+    prop = property_answer(value)  # a robot (its screw axes), a matrix or an expression, as a tree
+    if prop["tag"] == "robot":
+        return prop
+    out = describe_expr(value, points, seed)
+    out.update({k: v for k, v in prop.items() if k in ("tree", "tree_error")})
+    return out
+
+
+def compare_property(stu: dict, ref: dict, name: str, prop: str = "nonsingular") -> tuple[bool, str]:
+    """An open-ended answer graded by the property asked, never by one design's value (the reference is not
+    used): :func:`kinlib.course.answers.properties.judge`. ``prop``: "nonsingular": the answer is the student's own
+    redesigned robot (or its task Jacobian J), whose det(J Jᵀ) must be nonzero for every joint value, proved
+    exactly (kinlib.singularities); a bare value of det(J Jᵀ) belongs to no robot and fails.
+
+    >>> compare_property({"tag": "scalar", "tree": ["int", "1"]}, {}, "d")[0]
+    False
+    >>> col = lambda *xs: [["int", str(x)] for x in xs]
+    >>> three_r = col(0, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, -1, -2, 0, 0, 0)   # joints at x = 0, 1, 2
+    >>> compare_property({"tag": "robot", "tree": ["matrix", 6, 3, *three_r]}, {}, "d")[1]
+    'd: det(J Jᵀ) of your robot = 0 where theta2 = 0, pi (+ 2πk): your design still has singular configurations'
+    """
+    na = not_answered(stu)
+    if na:
+        return False, f"{name} {na}"
+    return judge(prop, stu, name)
+
+
+def reference_property(value):
+    """The reference value of a property answer, kept as data only (the property alone judges): a robot's screw
+    axes, or the value as a SymPy object (0 when it is none).
+
+    >>> from kinlib.robots import planar_rpp
+    >>> reference_property(planar_rpp()).shape, reference_property("x")
+    ((6, 3), 0)
+    """
+    screws = robot_screws(value)
+    if screws is not None:
+        return screws
+    obj = to_sympy(value)[1]
+    return obj if obj is not None else sp.Integer(0)

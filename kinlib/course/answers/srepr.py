@@ -9,6 +9,8 @@ lambdas, strings that SymPy would ``sympify``) is accepted, so a tampered text c
 trusted side only; answers from a kernel are read by :mod:`kinlib.course.answers.wire`.
 """
 
+import ast
+
 __all__ = ["parse_srepr"]
 
 _SREPR_NAMES = {}
@@ -30,6 +32,68 @@ def _srepr_names():
 _NAMED_BY_STRING = {"Symbol", "Dummy", "Function", "Wild", "Float"}
 
 
+def _bad(why):
+    return ValueError(f"not reference data: {why}")
+
+
+def _num(node):
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+        return -_num(node.operand)
+    if isinstance(node, ast.Constant) and type(node.value) in (int, float, bool) and abs(node.value) < 10**100:
+        return node.value
+    raise _bad("a keyword or number argument that is not a number")
+
+
+def _key(node, names):
+    """A dict key: a string (answers keyed by name) is plain data, never given to SymPy."""
+    if isinstance(node, ast.Constant) and isinstance(node.value, str):
+        return node.value
+    if node is None:
+        raise _bad("**mapping")
+    return _build(node, names)
+
+
+def _build(node, names):
+    if isinstance(node, ast.Name):
+        if node.id not in names:
+            raise _bad(f"{node.id} is not a SymPy class")
+        return names[node.id]
+    if isinstance(node, (ast.List, ast.Tuple)):
+        items = [_build(e, names) for e in node.elts]
+        return items if isinstance(node, ast.List) else tuple(items)
+    if isinstance(node, ast.Dict):
+        return {_key(k, names): _build(v, names) for k, v in zip(node.keys, node.values)}
+    if isinstance(node, (ast.Constant, ast.UnaryOp)) and not isinstance(getattr(node, "value", 0), str):
+        return _num(node)
+    if not isinstance(node, ast.Call):
+        raise _bad(f"{type(node).__name__} is not allowed")
+    return _call(node, names)
+
+
+def _call(node, names):
+    """A call of a SymPy class (or of an undefined function: ``Function('f')(x)``) on data arguments."""
+    f = node.func
+    if isinstance(f, ast.Call) and isinstance(f.func, ast.Name) and f.func.id == "Function":
+        fn = _build(f, names)
+    elif isinstance(f, ast.Name) and f.id in names and isinstance(names[f.id], type):
+        fn = names[f.id]
+    else:
+        raise _bad(f"{ast.unparse(f)[:40]} is not a SymPy class")
+    args = list(node.args)
+    first = []
+    if args and isinstance(args[0], ast.Constant) and isinstance(args[0].value, str):
+        if not (isinstance(f, ast.Name) and f.id in _NAMED_BY_STRING):
+            raise _bad(f"a string argument to {ast.unparse(f)[:40]}")
+        s = args.pop(0).value
+        if f.id == "Float" and not all(c in "0123456789.eE+-" for c in s):
+            raise _bad("a Float that is not a number")
+        first = [s]
+    kw = {k.arg: _num(k.value) for k in node.keywords if k.arg is not None}
+    if len(kw) != len(node.keywords):
+        raise _bad("**keywords")
+    return fn(*first, *[_build(a, names) for a in args], **kw)
+
+
 def parse_srepr(text, max_len=2_000_000):
     """A SymPy object from its ``srepr`` text, parsed as data (never ``eval``): only SymPy class calls,
     singletons, numbers, lists, tuples and dicts are accepted; anything else raises ValueError.
@@ -41,66 +105,10 @@ def parse_srepr(text, max_len=2_000_000):
     ...
     ValueError: not reference data: __import__ is not a SymPy class
     """
-    import ast
-
     if not isinstance(text, str) or len(text) > max_len:
-        raise ValueError("not reference data: not a string of at most 2 MB")
-    names = _srepr_names()
-
-    def bad(why):
-        return ValueError(f"not reference data: {why}")
-
-    def num(node):
-        if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
-            return -num(node.operand)
-        if isinstance(node, ast.Constant) and type(node.value) in (int, float, bool) and abs(node.value) < 10**100:
-            return node.value
-        raise bad("a keyword or number argument that is not a number")
-
-    def key(node):  # a dict key: a string (answers keyed by name) is plain data, never given to SymPy
-        if isinstance(node, ast.Constant) and isinstance(node.value, str):
-            return node.value
-        if node is None:
-            raise bad("**mapping")
-        return build(node)
-
-    def build(node):
-        if isinstance(node, ast.Name):
-            if node.id not in names:
-                raise bad(f"{node.id} is not a SymPy class")
-            return names[node.id]
-        if isinstance(node, (ast.List, ast.Tuple)):
-            items = [build(e) for e in node.elts]
-            return items if isinstance(node, ast.List) else tuple(items)
-        if isinstance(node, ast.Dict):
-            return {key(k): build(v) for k, v in zip(node.keys, node.values)}
-        if isinstance(node, (ast.Constant, ast.UnaryOp)) and not isinstance(getattr(node, "value", 0), str):
-            return num(node)
-        if not isinstance(node, ast.Call):
-            raise bad(f"{type(node).__name__} is not allowed")
-        f = node.func
-        if isinstance(f, ast.Call) and isinstance(f.func, ast.Name) and f.func.id == "Function":
-            fn = build(f)  # an undefined function applied to arguments: Function('f')(x)
-        elif isinstance(f, ast.Name) and f.id in names and isinstance(names[f.id], type):
-            fn = names[f.id]
-        else:
-            raise bad(f"{ast.unparse(f)[:40]} is not a SymPy class")
-        args = list(node.args)
-        first = []
-        if args and isinstance(args[0], ast.Constant) and isinstance(args[0].value, str):
-            if not (isinstance(f, ast.Name) and f.id in _NAMED_BY_STRING):
-                raise bad(f"a string argument to {ast.unparse(f)[:40]}")
-            s = args.pop(0).value
-            if f.id == "Float" and not all(c in "0123456789.eE+-" for c in s):
-                raise bad("a Float that is not a number")
-            first = [s]
-        kw = {k.arg: num(k.value) for k in node.keywords if k.arg is not None}
-        if len(kw) != len(node.keywords):
-            raise bad("**keywords")
-        return fn(*first, *[build(a) for a in args], **kw)
-
+        raise _bad("not a string of at most 2 MB")
     try:
         tree = ast.parse(text.strip(), mode="eval")
     except SyntaxError as exc:
-        raise bad(f"syntax error ({exc.msg})") from None
-    return build(tree.body)
+        raise _bad(f"syntax error ({exc.msg})") from None
+    return _build(tree.body, _srepr_names())

@@ -38,6 +38,8 @@ from dataclasses import dataclass, field
 from multiprocessing.connection import Connection, wait
 from pathlib import Path
 
+from .isolation.reap import kill_group
+
 __all__ = ["run", "Supervisor", "MAX_START_FAILURES", "BEAT_SECONDS"]
 
 MAX_START_FAILURES = 3  # failed worker starts (with none running) before the rest of the batch is given up
@@ -161,14 +163,7 @@ class Supervisor:
         return w
 
     def _kill(self, w: _Worker) -> None:
-        try:
-            os.killpg(w.proc.pid, signal.SIGKILL)
-        except (ProcessLookupError, PermissionError):
-            pass
-        try:
-            w.proc.wait(timeout=10)
-        except subprocess.TimeoutExpired:
-            pass
+        kill_group(w.proc, timeout=10)
         w.conn.close()
         if w in self.workers:
             self.workers.remove(w)

@@ -99,7 +99,7 @@ import math
 import os
 import random
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from ..schema import cell_meta, cell_part, match_notebook, notebook_id, stash_points
@@ -123,6 +123,8 @@ from .steps import Grading, Row, run_steps
 __all__ = [
     "grade_batch",
     "grade_submission",
+    "Job",
+    "SUBMISSION_STEPS",
     "build_reference",
     "load_references",
     "find_submissions",
@@ -176,6 +178,179 @@ def _error_rows(sub, nid, parts, msg) -> list[Row]:
     return [Row(sub, nid, p["part"], "error", 0, msg, p["points"]) for p in parts]
 
 
+@dataclass
+class Job:
+    """One submission passing through :data:`SUBMISSION_STEPS` (each step reads and fills its fields; a step
+    that returns False ends the grading with the rows it wrote).
+
+    >>> job = Job(Path("ann.ipynb"), {}, {"submission": "ann.ipynb"})
+    >>> job.sub, job.nid, job.points
+    ('ann.ipynb', '', [])
+    """
+
+    path: Path  # the file
+    refs: dict  # notebook id -> refdata.Reference
+    out: dict  # the result (rows, notes, timing, ...): what grade_submission returns
+    cell_timeout: float = 60.0
+    total_timeout: float = 300.0
+    sandbox: object = True  # a Sandbox, True (the default one) or False
+    secret: object = None  # the grader secret (bytes) or its file
+    limits: Limits | None = None
+    user: object = None  # without the sandbox: the unprivileged StudentUser the kernel runs as
+    data: bytes = b""  # the file's bytes (the evaluation seed is derived from them)
+    nb: dict = field(default_factory=dict)  # the notebook
+    nid: str = ""  # its notebook id
+    ref: Reference | None = None
+    points: list = field(default_factory=list)  # the secret evaluation points (never sent to the kernel)
+    seed: int = 0
+
+    @property
+    def sub(self) -> str:
+        return self.out["submission"]
+
+    def stop(self, rows: list) -> bool:
+        """End the grading with ``rows`` (returns False, what a step returns then)."""
+        self.out["rows"] = rows
+        return False
+
+
+def _read(job: Job) -> bool:
+    """The file's bytes and notebook, read defensively (:func:`kinlib.course.grader.intake.read_notebook`)."""
+    data, nb, problem = intake.read_notebook(job.path)  # never raises, never blocks, never recurses deeply
+    if problem:
+        return job.stop([Row(job.sub, "", "-", "error", 0, problem)])
+    job.data, job.nb = data, nb
+    return True
+
+
+def _identify(job: Job) -> bool:
+    """Which notebook it is (its metadata, or its questions when the metadata was lost) and its reference."""
+    nid = notebook_id(job.nb)
+    if nid is None:  # metadata lost (solution cells pasted into a new notebook): recognised by its questions
+        nid = match_notebook(job.nb, {k: r.parts for k, r in job.refs.items() if not r.error})
+        if nid is not None:
+            job.out.setdefault("notes", []).append(
+                f"recognised as {nid} by its answers and questions: the notebook's kinlib metadata was missing"
+            )
+    if nid is None:
+        why = (
+            "not one of the kinlib notebooks: its metadata has no kinlib.notebook (start from the workbook you "
+            "were given)"
+        )
+        return job.stop([Row(job.sub, "", "-", "error", 0, why)])
+    job.nid = job.out["notebook"] = nid
+    job.ref = job.refs.get(nid)
+    if job.ref is None:
+        why = f"unknown notebook {nid!r}: no solution notebook with that id"
+        return job.stop([Row(job.sub, nid, "-", "error", 0, why)])
+    job.out["title"] = job.ref.title
+    job.out["parts"] = job.ref.parts  # points per answer and manual rows: credit.score_parts, in _done
+    if job.ref.error:
+        why = f"the reference for {nid} is broken: {job.ref.error}"
+        return job.stop(_error_rows(job.sub, nid, job.ref.parts, why))
+    return True
+
+
+def _prepare(job: Job) -> bool:
+    """The secret, the sandbox, and the submission's secret evaluation points (seeded by HMAC(secret, bytes))."""
+    try:
+        key = job.secret if isinstance(job.secret, bytes) else load_secret(job.secret)
+        if job.sandbox is True:
+            ok, why = check()
+            if not ok:
+                raise SandboxUnavailable(why)
+            job.sandbox = Sandbox()
+    except (OSError, ValueError, SandboxUnavailable) as exc:
+        job.out["infrastructure"] = str(exc)
+        return job.stop(_error_rows(job.sub, job.nid, job.ref.parts, f"not graded: infrastructure: {exc}"))
+    job.seed = evaluation_seed(key, job.data)
+    symbols: dict = {}
+    for a in job.ref.answers.values():
+        symbols.update(a.get("symbols", {}))
+    job.points = make_points(symbols, job.seed, N_POINTS)
+    return True
+
+
+def _grade(job: Job) -> bool:
+    """Run the notebook in a fresh kernel inside the submission's enclosure (its cgroup and size-limited tmpfs)
+    and grade it by the steps of :mod:`kinlib.course.grader.steps`; a limit reached adds a ``limits`` row."""
+    out = job.out
+    enc = Enclosure(job.limits or Limits(), tag=out["relpath"])
+    out["limits"] = enc.describe()
+    try:
+        rows = _run_and_judge(job, enc)
+    finally:
+        reached = enc.reached()
+        enc.close()  # every process of the submission killed, its tmpfs gone
+    if reached:  # a row that says which limit stopped what (the parts' rows say what it cost)
+        out["limits_reached"] = reached
+        rows.append(Row(job.sub, job.nid, "limits", "error", 0, "limit reached: " + "; ".join(reached), 0.0))
+    out["rows"] = rows
+    return True
+
+
+def _run_and_judge(job: Job, enc: Enclosure) -> list:
+    """The kernel run of :func:`_grade` (a checker bug becomes error rows, never a stopped batch)."""
+    out, parts = job.out, job.ref.parts
+    code = code_cells(job.nb)
+    part_of_cell = {i: part for i, c in enumerate(code) if (part := cell_part(cell_meta(c)))}
+    run, cpu0 = None, time.process_time()
+    try:
+        scratch = os.path.join(enc.folder, "work")
+        os.makedirs(scratch)
+        with open(os.path.join(scratch, job.path.name), "wb") as f:
+            f.write(job.data)
+        run = NotebookRun(
+            code,
+            scratch,
+            enc.folder,
+            job.cell_timeout,
+            job.total_timeout,
+            stash_after=stash_points(job.nb),
+            sandbox=job.sandbox or None,
+            enclosure=enc,
+            user=job.user,
+        )
+        g = run_steps(Grading(run, job.sub, job.nid, job.ref, parts, job.points, job.seed, part_of_cell, out))
+        out["restarts"] = run.restarts
+        out["cells"] = [asdict(r) | {"part": part_of_cell.get(i, "")} for i, r in sorted(run.results.items())]
+        out["output_bytes"] = sum(r.output_bytes for r in run.results.values())
+        out.setdefault("exact", {})
+        return g.rows
+    except Exception as exc:  # noqa: BLE001  a checker bug must not stop the batch
+        out["exact"] = {}
+        return _error_rows(job.sub, job.nid, parts, f"internal error in the checker: {type(exc).__name__}: {exc}")
+    finally:
+        if run is not None:
+            run.close()
+            out["namespaces"], out["start_failures"] = run.namespaces, run.start_failures
+            out["cpu_seconds"] = round(run.cpu_seconds + time.process_time() - cpu0, 3)
+
+
+#: grading one file, as named steps (as nbgrader's autograde converters); each takes the :class:`Job`
+#: and returns False when it has written the submission's final rows (a file that is not gradable)
+SUBMISSION_STEPS = (
+    ("read", _read),
+    ("identify", _identify),
+    ("prepare", _prepare),
+    ("grade", _grade),
+)
+
+
+def _new_result(path, display_name, sandbox, relpath, root, user) -> dict:
+    """The result dict of a submission before any step ran."""
+    p = Path(path)
+    out = {"submission": display_name or str(path), "notebook": "", "title": "", "rows": [], "cells": []}
+    out.update(restarts=0, output_bytes=0, sandbox=sandbox is not False, path=str(p.absolute()))
+    out["relpath"] = relpath or p.name  # the student id is read from it (intake.student_id)
+    out["root"] = root or str(p.absolute().parent)
+    if sandbox is False:
+        out["notes"] = [
+            NO_SANDBOX_NOTE if user is None else f"graded without bubblewrap, as the unprivileged user {user.name}"
+        ]
+    return out
+
+
 def grade_submission(
     path,
     refs: dict,
@@ -189,7 +364,9 @@ def grade_submission(
     limits: Limits | None = None,
     user=None,
 ) -> dict:
-    """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises).
+    """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises), by the
+    named steps of :data:`SUBMISSION_STEPS` (read, identify, prepare, grade: the last runs
+    :data:`kinlib.course.grader.steps.STEPS` in the kernel's enclosure).
 
     ``sandbox``: a :class:`~kinlib.course.grader.isolation.sandbox.Sandbox`, True (the default one) or False (no sandbox:
     said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
@@ -212,122 +389,12 @@ def grade_submission(
     >>> [(r["part"], r["status"], r["points"]) for r in res["rows"]]  # one row per part  # doctest: +SKIP
     """
     t0 = time.monotonic()
-    sub = display_name or str(path)
-    out = {"submission": sub, "notebook": "", "title": "", "rows": [], "cells": [], "restarts": 0, "output_bytes": 0}
-    out["sandbox"] = sandbox is not False
-    out["path"] = str(Path(path).absolute())
-    out["relpath"] = relpath or Path(path).name  # the student id is read from it (intake.student_id)
-    out["root"] = root or str(Path(path).absolute().parent)
-    if sandbox is False:
-        out["notes"] = [
-            NO_SANDBOX_NOTE if user is None else f"graded without bubblewrap, as the unprivileged user {user.name}"
-        ]
-    data, nb, problem = intake.read_notebook(path)  # never raises, never blocks, never recurses deeply
-    if problem:
-        out["rows"] = [Row(sub, "", "-", "error", 0, problem)]
-        return _done(out, t0)
-    nid = notebook_id(nb)
-    if nid is None:  # metadata lost (solution cells pasted into a new notebook): recognised by its questions
-        nid = match_notebook(nb, {k: r.parts for k, r in refs.items() if not r.error})
-        if nid is not None:
-            out.setdefault("notes", []).append(
-                f"recognised as {nid} by its answers and questions: the notebook's kinlib metadata was missing"
-            )
-    if nid is None:
-        out["rows"] = [
-            Row(
-                sub,
-                "",
-                "-",
-                "error",
-                0,
-                "not one of the kinlib notebooks: its metadata has no "
-                "kinlib.notebook (start from the workbook you were given)",
-            )
-        ]
-        return _done(out, t0)
-    out["notebook"] = nid
-    ref = refs.get(nid)
-    if ref is None:
-        out["rows"] = [Row(sub, nid, "-", "error", 0, f"unknown notebook {nid!r}: no solution notebook with that id")]
-        return _done(out, t0)
-    out["title"] = ref.title
-    parts = ref.parts
-    out["parts"] = parts  # points per answer and manual rows: credit.score_parts, in _done
-    if ref.error:
-        out["rows"] = _error_rows(sub, nid, parts, f"the reference for {nid} is broken: {ref.error}")
-        return _done(out, t0)
-    try:
-        key = secret if isinstance(secret, bytes) else load_secret(secret)
-        if sandbox is True:
-            ok, why = check()
-            if not ok:
-                raise SandboxUnavailable(why)
-            sandbox = Sandbox()
-    except (OSError, ValueError, SandboxUnavailable) as exc:
-        out["infrastructure"] = str(exc)
-        out["rows"] = _error_rows(sub, nid, parts, f"not graded: infrastructure: {exc}")
-        return _done(out, t0)
-    seed = evaluation_seed(key, data)
-    symbols: dict = {}
-    for a in ref.answers.values():
-        symbols.update(a.get("symbols", {}))
-    points = make_points(symbols, seed, N_POINTS)
-
-    code = code_cells(nb)
-    part_of_cell = {}
-    for i, c in enumerate(code):
-        part = cell_part(cell_meta(c))
-        if part:
-            part_of_cell[i] = part
-    stash_after = stash_points(nb)
-
-    enc = Enclosure(limits or Limits(), tag=out["relpath"])  # the submission's cgroup and size-limited tmpfs
-    tmp = enc.folder
-    out["limits"] = enc.describe()
-    run, cpu0 = None, time.process_time()
-    try:
-        scratch = os.path.join(tmp, "work")
-        os.makedirs(scratch)
-        with open(os.path.join(scratch, Path(path).name), "wb") as f:
-            f.write(data)
-        run = NotebookRun(
-            code,
-            scratch,
-            tmp,
-            cell_timeout,
-            total_timeout,
-            stash_after=stash_after,
-            sandbox=sandbox or None,
-            enclosure=enc,
-            user=user,
-        )
-        rows, exact = _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out)
-        out["restarts"] = run.restarts
-        out["cells"] = [asdict(r) | {"part": part_of_cell.get(i, "")} for i, r in sorted(run.results.items())]
-        out["output_bytes"] = sum(r.output_bytes for r in run.results.values())
-    except Exception as exc:  # noqa: BLE001  a checker bug must not stop the batch
-        rows, exact = _error_rows(sub, nid, parts, f"internal error in the checker: {type(exc).__name__}: {exc}"), {}
-    finally:
-        if run is not None:
-            run.close()
-            out["namespaces"], out["start_failures"] = run.namespaces, run.start_failures
-            out["cpu_seconds"] = round(run.cpu_seconds + time.process_time() - cpu0, 3)
-        reached = enc.reached()
-        enc.close()  # every process of the submission killed, its tmpfs gone
-    if reached:  # a row that says which limit stopped what (the parts' rows say what it cost)
-        out["limits_reached"] = reached
-        rows.append(Row(sub, nid, "limits", "error", 0, "limit reached: " + "; ".join(reached), 0.0))
-    out["rows"] = rows
-    out["exact"] = exact
+    out = _new_result(path, display_name, sandbox, relpath, root, user)
+    job = Job(Path(path), refs, out, cell_timeout, total_timeout, sandbox, secret, limits, user)
+    for _, step in SUBMISSION_STEPS:
+        if not step(job):
+            break
     return _done(out, t0)
-
-
-def _grade_in_kernel(run, sub, nid, ref, parts, points, seed, part_of_cell, out):
-    """The grading steps (:data:`kinlib.course.grader.steps.STEPS`: execute, restore, export, stop, judge, rows)
-    on the submission's run; returns (rows, {answer: exact-check word})."""
-    g = run_steps(Grading(run, sub, nid, ref, parts, points, seed, part_of_cell, out))
-    return g.rows, out.get("exact", {})
 
 
 def _done(out, t0):
@@ -459,23 +526,13 @@ def grade_batch(
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
     key = secret if isinstance(secret, bytes) else load_secret(secret)
-    sb = None
-    if sandbox:
-        ok, why = check()
-        if not ok:
-            raise SandboxUnavailable(f"{why}; to grade without the sandbox pass --no-sandbox")
-        hidden = [notebooks, out, cache or "", "" if isinstance(secret, bytes) else secret or default_secret_path()]
-        sb = Sandbox(hidden=[str(Path(h).resolve()) for h in hidden if h] + sorted({s.root for s in subs}))
-        sb.command(["true"], cwd="/tmp", rw=[], env={})  # refuses now if a bind would expose a hidden folder
-    else:
+    hidden = [notebooks, out, cache or "", "" if isinstance(secret, bytes) else secret or default_secret_path()]
+    sb = _batch_sandbox(hidden, subs) if sandbox else None
+    if sb is None:
         log(f"WARNING: {NO_SANDBOX_NOTE}")
-    readable = [s.path for s in subs if not s.refused]
-    ids = {i for i in (_peek_id(p) for p in readable) if i}
-    if any(_peek_id(p, unmatched=True) for p in readable):
-        ids = None  # a notebook without its id is matched against every assignment's questions
-    refs = load_references(notebooks, Path(cache) if cache else None, ids, log=log, jobs=max(1, int(jobs)), secret=key)
-    t_ref = time.monotonic() - t0
     jobs = max(1, int(jobs))
+    refs = load_references(notebooks, Path(cache) if cache else None, _needed_ids(subs), log=log, jobs=jobs, secret=key)
+    t_ref = time.monotonic() - t0
     results: list = []  # filled as submissions are graded: an interrupted batch still writes what it graded
     try:
         opts = dict(timeout=timeout, cell_timeout=cell_timeout, sandbox=sb or False, secret=key, limits=limits)
@@ -489,7 +546,33 @@ def grade_batch(
             )
         write_outputs(out, results, id_pattern=id_pattern, overrides=overrides, merge=merge, log=log, roots=subs)
     wall = time.monotonic() - t0
-    summary = {
+    log(summary_table(results, wall, t_ref, jobs))  # control characters already escaped
+    return _summary(results, wall, t_ref, sb is not None)
+
+
+def _batch_sandbox(hidden: list, subs: list) -> Sandbox:
+    """The batch's sandbox, hiding the notebooks, outputs, cache, secret and submission folders from every kernel;
+    raises SandboxUnavailable without bubblewrap, or if a bind would expose a hidden folder."""
+    ok, why = check()
+    if not ok:
+        raise SandboxUnavailable(f"{why}; to grade without the sandbox pass --no-sandbox")
+    sb = Sandbox(hidden=[str(Path(h).resolve()) for h in hidden if h] + sorted({s.root for s in subs}))
+    sb.command(["true"], cwd="/tmp", rw=[], env={})  # refuses now if a bind would expose a hidden folder
+    return sb
+
+
+def _needed_ids(subs: list):
+    """The notebook ids the readable submissions name (None: every assignment's, when one lost its id and is
+    matched against every assignment's questions)."""
+    readable = [s.path for s in subs if not s.refused]
+    if any(_peek_id(p, unmatched=True) for p in readable):
+        return None
+    return {i for i in (_peek_id(p) for p in readable) if i}
+
+
+def _summary(results: list, wall: float, t_ref: float, sandboxed: bool) -> dict:
+    """What :func:`grade_batch` returns."""
+    return {
         "results": results,
         "rows": [r for res in results for r in res["rows"]],
         "seconds": wall,
@@ -497,10 +580,8 @@ def grade_batch(
         "n": len(results),
         "per_minute": 60 * len(results) / max(wall - t_ref, 1e-9) if results else 0.0,
         "infrastructure_errors": sum(1 for r in results if r.get("infrastructure")),
-        "sandbox": sb is not None,
+        "sandbox": sandboxed,
     }
-    log(summary_table(results, wall, t_ref, jobs))  # control characters already escaped
-    return summary
 
 
 def _grade_all(done, subs, refs, jobs, opts, batch_timeout, on_event, log) -> None:

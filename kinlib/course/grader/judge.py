@@ -24,15 +24,14 @@ import time
 from contextlib import contextmanager
 from dataclasses import dataclass
 
-from ..answers import compare, describe, wire
-from ..answers.normalise import to_sympy
+from ..answers import compare, describe, kinds, wire
+from ..answers.expr import exact_equal, to_sympy
 
 __all__ = ["Verdict", "judge_answer", "time_limit", "JudgeTimeout", "JUDGE_SECONDS", "EXACT_SECONDS", "n_points"]
 
 JUDGE_SECONDS = 30.0  # the most one answer may take to read, evaluate and compare in the grader
 EXACT_SECONDS = 5.0  # of which the advisory exact check may take (SymPy simplify)
-N_POINTS = 5  # secret points for an expression or subspace
-N_SET_POINTS = 2  # for a set (its members are listed at each)
+N_POINTS = max(k.points for k in kinds.KINDS.values())  # secret points made per submission (each kind uses its own)
 
 
 class JudgeTimeout(Exception):
@@ -71,12 +70,12 @@ class Verdict:
 
 
 def n_points(kind: str) -> int:
-    """How many secret points an answer of ``kind`` is evaluated at.
+    """How many secret points an answer of ``kind`` is evaluated at (the table of kinds says).
 
     >>> n_points("expr"), n_points("set"), n_points("choice")
     (5, 2, 0)
     """
-    return N_SET_POINTS if kind == "set" else (0 if kind == "choice" else N_POINTS)
+    return kinds.lookup(kind)[0].points
 
 
 @contextmanager
@@ -182,7 +181,7 @@ def _exact(value, ref_text, seconds) -> str:
         return "not proved"
     try:
         with time_limit(seconds):
-            return describe.exact_equal(value, ref_text, budget=seconds / 2)
+            return exact_equal(value, ref_text, budget=seconds / 2)
     except JudgeTimeout:
         return "timed out"
     except Exception:  # noqa: BLE001

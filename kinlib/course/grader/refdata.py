@@ -24,8 +24,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from ..answers import describe, wire
-from ..answers import normalise as answers
+from ..answers.expr import to_sympy
 from ..answers.srepr import parse_srepr
+from ..answers.subspace import exact_tree
 from ..schema import notebook_id, notebook_title, parse_parts, stash_points
 from .isolation.kernel import SHIPPED, NotebookRun
 from .secret import sign, verify
@@ -90,7 +91,8 @@ def code_cells(nb: dict) -> list:
 
 def _hash(data: bytes) -> str:
     h = hashlib.sha256(data)
-    host = [Path(m.__file__).read_text() for m in (describe, wire, answers)]
+    # every module that reads and describes an answer (the answers package: kinds, wire, srepr, ...)
+    host = [p.read_text() for p in sorted(Path(describe.__file__).parent.glob("*.py"))]
     for s in (*SHIPPED.values(), *host, GRADE_VERSION):
         h.update(s.encode())
     return h.hexdigest()
@@ -151,6 +153,48 @@ def reference_answers(exported: dict, kinds: dict) -> dict:
     return {n: errors.get(n) or dumped[n] for n in kinds}
 
 
+def _run_solution(path: Path, nb: dict, kinds: dict, timeout: float) -> tuple[dict, str]:
+    """(answers, error): the solution notebook run in the grader's own kernel, each answer exported as data as a
+    student's is, read and described here (:func:`reference_answers`); the error says what failed ("" if none)."""
+    tmp = tempfile.mkdtemp(prefix="kinlib-grade-ref-")
+    err = ""
+    ans: dict = {}
+    run = NotebookRun(
+        code_cells(nb),
+        str(path.parent.resolve()),
+        tmp,
+        cell_timeout=timeout,
+        total_timeout=timeout * 4,
+        stash_after=stash_points(nb),
+        snapshot=False,
+    )
+    try:
+        run.execute()
+        bad = [r for r in run.results.values() if r.status != "ok"]
+        if bad:
+            err = f"code cell {bad[0].index + 1} of the solution notebook: {bad[0].summary()}"
+        exported = {}
+        for name in kinds:
+            got, e = run.call(f"export_answer(globals(), {name!r}, PATH)", timeout=120)
+            exported[name] = got if got is not None else {"error": f"could not read the reference answer: {e}"}
+        ans = reference_answers(exported, kinds)
+    except RuntimeError as exc:
+        err = str(exc)
+    finally:
+        run.close()
+        shutil.rmtree(tmp, ignore_errors=True)
+    missing = [f"{n}: {a['error']}" for n, a in ans.items() if "error" in a]
+    if missing and not err:
+        err = "; ".join(missing)[:1000]
+    for n, a in ans.items():  # the key must read back as data now, not fail later at grading time
+        if "srepr" in a and not err:
+            try:
+                parse_srepr(a["srepr"])
+            except ValueError as exc:
+                err = f"{n}: {exc}"
+    return ans, err
+
+
 def build_reference(
     path: Path, cache: Path | None = None, timeout: float = 300.0, log=None, secret: bytes | None = None
 ) -> Reference:
@@ -179,42 +223,7 @@ def build_reference(
     parts = parse_parts(nb)
     title = notebook_title(nb, nid)
     kinds = {n: k for p in parts for n, k in p.kinds.items()}
-    tmp = tempfile.mkdtemp(prefix="kinlib-grade-ref-")
-    err = ""
-    ans: dict = {}
-    run = NotebookRun(
-        code_cells(nb),
-        str(path.parent.resolve()),
-        tmp,
-        cell_timeout=timeout,
-        total_timeout=timeout * 4,
-        stash_after=stash_points(nb),
-        snapshot=False,
-    )
-    try:
-        run.execute()
-        bad = [r for r in run.results.values() if r.status != "ok"]
-        if bad:
-            err = f"code cell {bad[0].index + 1} of the solution notebook: {bad[0].summary()}"
-        exported = {}
-        for name in kinds:  # each answer as data, as a student's is exported; read and described here
-            got, e = run.call(f"export_answer(globals(), {name!r}, PATH)", timeout=120)
-            exported[name] = got if got is not None else {"error": f"could not read the reference answer: {e}"}
-        ans = reference_answers(exported, kinds)
-    except RuntimeError as exc:
-        err = str(exc)
-    finally:
-        run.close()
-        shutil.rmtree(tmp, ignore_errors=True)
-    missing = [f"{n}: {a['error']}" for n, a in ans.items() if "error" in a]
-    if missing and not err:
-        err = "; ".join(missing)[:1000]
-    for n, a in ans.items():  # the key must read back as data now, not fail later at grading time
-        if "srepr" in a and not err:
-            try:
-                parse_srepr(a["srepr"])
-            except ValueError as exc:
-                err = f"{n}: {exc}"
+    ans, err = _run_solution(path, nb, kinds, timeout)
     ref = Reference(nid, title, str(path), sha, [asdict(p) for p in parts], ans, err)
     if log:
         log(
@@ -307,7 +316,7 @@ def reference_description(ref: Reference, name: str, kind: str, points: list, se
         obj = parse_srepr(a["srepr"])
         fast = (
             _fast_expr(obj)
-            if kind in ("expr", "subspace") and obj is not None and answers.to_sympy(obj)[0] in ("matrix", "scalar")
+            if kind in ("expr", "subspace") and obj is not None and to_sympy(obj)[0] in ("matrix", "scalar")
             else None
         )
         _PARSED[key] = (obj, fast)
@@ -317,10 +326,9 @@ def reference_description(ref: Reference, name: str, kind: str, points: list, se
             tmpl, values = fast
             out = dict(tmpl, values=[values(p) for p in points])
             if kind == "subspace" and not tmpl.get("symbols") and not tmpl.get("has_float"):
-                try:  # a constant exact span: compared exactly (compare.compare_subspace)
-                    out["tree"] = answers.expr_tree(answers.to_sympy(obj, vectors=True)[1], max_nodes=600)
-                except Exception:  # noqa: BLE001
-                    pass
+                tree = exact_tree(obj)  # a constant exact span: compared exactly (subspace.compare_subspace)
+                if tree is not None:
+                    out["tree"] = tree
             return out
         except Exception:  # noqa: BLE001  fall back to SymPy's evaluation
             pass

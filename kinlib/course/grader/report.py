@@ -138,6 +138,56 @@ def _label(r: dict) -> str:
     return f"{r['part']} ({r['answer']})" if r.get("answer") else str(r["part"])
 
 
+def _feedback_parts(rows: list) -> list[str]:
+    """The feedback's table of parts, and of points per answer for parts of several answers (Markdown lines)."""
+    lines = ["| Part | Points | Result | Feedback |", "|---|---|---|---|"]
+    for r in rows:
+        pts = "–" if r.get("status") == "pending" else _g(r.get("points"))
+        status = _md(r["status"]) + (" (override)" if r.get("override") else "")
+        if r.get("kind") == "manual":
+            status += ", graded by hand"
+        msg = r.get("message", "")
+        if r.get("comment"):
+            msg = "; ".join(x for x in (msg, f"Instructor: {r['comment']}") if x)
+        lines.append(f"| {_md(_label(r))} | {pts} / {_g(r.get('max_points'))} | {status} | {_md(msg)} |")
+    multi = [r for r in rows if len(r.get("answers") or []) > 1]
+    if multi:
+        lines += ["", "## Points per answer", "", "| Part | Answer | Points | Result |", "|---|---|---|---|"]
+        for r in multi:
+            for a in r["answers"]:
+                st = _md(a["status"]) + (" (override)" if a.get("override") else "")
+                lines.append(
+                    f"| {_md(r['part'])} | {md_code(a['answer'])} | {_g(a['points'])} / {_g(a['max_points'])} | {st} |"
+                )
+    return lines
+
+
+def _feedback_cells(res: dict) -> list[str]:
+    """The feedback's notes on the student's code: cells that did not run cleanly, restarts, what the checker put
+    back, output too large to keep (Markdown lines)."""
+    lines: list = []
+    bad = [c for c in res.get("cells", []) if c["status"] != "ok"]
+    if bad or res.get("restarts"):
+        lines += ["", "## Cells that did not run cleanly", ""]
+        for c in bad:
+            what = cell_text(c)
+            part = f" (part {_md(c['part'])})" if c.get("part") else ""
+            lines.append(f"- code cell {c['index'] + 1}{part}: {_md(what)}")
+        if res.get("restarts"):
+            lines.append(
+                f"- the kernel was restarted {res['restarts']} time(s); the cells that stopped it were skipped"
+            )
+    if res.get("restored") and isinstance(res["restored"], list):
+        names = ", ".join(md_code(n) for n in res["restored"][:8]) + (" …" if len(res["restored"]) > 8 else "")
+        lines += [
+            "",
+            f"Your notebook replaced {names}; the checker put the originals back before reading your answers.",
+        ]
+    if res.get("output_bytes", 0) > 1_000_000:
+        lines.append(f"- your notebook printed {res['output_bytes'] / 1e6:.1f} MB of output (not kept)")
+    return lines
+
+
 def feedback_markdown(res: dict) -> str:
     """The feedback page (Markdown) for one submission's result.
 
@@ -171,44 +221,7 @@ def feedback_markdown(res: dict) -> str:
     if res.get("sandbox") is False and not any("sandbox" in n for n in notes):
         notes.append("graded without the sandbox (--no-sandbox)")
     lines += [f"*Note: {_md(n)}.*" for n in notes] + ([""] if notes else [])
-    lines += ["| Part | Points | Result | Feedback |", "|---|---|---|---|"]
-    for r in rows:
-        pts = "–" if r.get("status") == "pending" else _g(r.get("points"))
-        status = _md(r["status"]) + (" (override)" if r.get("override") else "")
-        if r.get("kind") == "manual":
-            status += ", graded by hand"
-        msg = r.get("message", "")
-        if r.get("comment"):
-            msg = "; ".join(x for x in (msg, f"Instructor: {r['comment']}") if x)
-        lines.append(f"| {_md(_label(r))} | {pts} / {_g(r.get('max_points'))} | {status} | {_md(msg)} |")
-    multi = [r for r in rows if len(r.get("answers") or []) > 1]
-    if multi:
-        lines += ["", "## Points per answer", "", "| Part | Answer | Points | Result |", "|---|---|---|---|"]
-        for r in multi:
-            for a in r["answers"]:
-                st = _md(a["status"]) + (" (override)" if a.get("override") else "")
-                lines.append(
-                    f"| {_md(r['part'])} | {md_code(a['answer'])} | {_g(a['points'])} / {_g(a['max_points'])} | {st} |"
-                )
-    bad = [c for c in res.get("cells", []) if c["status"] != "ok"]
-    if bad or res.get("restarts"):
-        lines += ["", "## Cells that did not run cleanly", ""]
-        for c in bad:
-            what = cell_text(c)
-            part = f" (part {_md(c['part'])})" if c.get("part") else ""
-            lines.append(f"- code cell {c['index'] + 1}{part}: {_md(what)}")
-        if res.get("restarts"):
-            lines.append(
-                f"- the kernel was restarted {res['restarts']} time(s); the cells that stopped it were skipped"
-            )
-    if res.get("restored") and isinstance(res["restored"], list):
-        names = ", ".join(md_code(n) for n in res["restored"][:8]) + (" …" if len(res["restored"]) > 8 else "")
-        lines += [
-            "",
-            f"Your notebook replaced {names}; the checker put the originals back before reading your answers.",
-        ]
-    if res.get("output_bytes", 0) > 1_000_000:
-        lines.append(f"- your notebook printed {res['output_bytes'] / 1e6:.1f} MB of output (not kept)")
+    lines += _feedback_parts(rows) + _feedback_cells(res)
     lines += [
         "",
         "How this was checked: your notebook ran top to bottom in a fresh Python kernel; each answer "

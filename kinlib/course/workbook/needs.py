@@ -19,7 +19,7 @@ import html
 import sys
 import traceback
 
-from ..answers import normalise as answers
+from ..answers.base import is_unanswered
 
 __all__ = ["needs", "friendly_error", "answer_status", "last_results"]
 
@@ -101,7 +101,7 @@ def needs(line: str, cell: str, shell=None, status=answer_status):
 
         shell = get_ipython()
     names = line.split("#", 1)[0].split()
-    missing = [n for n in names if answers.is_unanswered(shell.user_ns.get(n))]
+    missing = [n for n in names if is_unanswered(shell.user_ns.get(n))]
     if missing:
         print(
             f"(skipped: this cell uses {', '.join(missing)} from your answers above; "

@@ -10,7 +10,7 @@ cell runs, so a right answer in any equivalent form (simplified or not, floats o
     check("2.2", Js="matrix|6x3|3f0c1b9e5a7d2c44")
 
 Kinds of answer (``kinds`` in the solution cell's ``kinlib`` metadata; the forms each accepts are
-those of :mod:`kinlib.course.answers.normalise`, the normaliser the instructor checker uses too):
+those of the kind modules of :mod:`kinlib.course.answers`, the normalisers the grader uses too):
 
 - default / ``"expr"``: a SymPy Matrix, expression or number, compared as a function of its symbols;
 - ``"choice"``: an int, string or tuple of them (joint numbers 1-based; order and repeats ignored);
@@ -41,8 +41,11 @@ import numpy as np
 import sympy as sp
 
 from ..answers import mistakes
-from ..answers import normalise as answers
+from ..answers.base import is_bool, is_unanswered
+from ..answers.choice import choice_key, choice_value
+from ..answers.expr import to_sympy
 from ..answers.properties import property_spec, property_verdict
+from ..answers.sets import set_conditions, to_set
 from ..schema import KINDS
 from .needs import answer_status, last_results, needs
 
@@ -196,8 +199,8 @@ _FORM_WORDS = {
 
 
 def _as_sympy_value(value, vectors: bool = False):
-    """The answer as a SymPy Matrix or expression (:func:`kinlib.course.answers.normalise.to_sympy`), or WrongForm."""
-    tag, v = answers.to_sympy(value, vectors=vectors)
+    """The answer as a SymPy Matrix or expression (:func:`kinlib.course.answers.expr.to_sympy`), or WrongForm."""
+    tag, v = to_sympy(value, vectors=vectors)
     if v is not None:
         return v
     what = _FORM_WORDS.get(tag, f"a {type(value).__name__}")
@@ -211,7 +214,7 @@ def _shape_of(v) -> str:
 def _default_value(value, shape: str | None = None):
     """The answer as a SymPy Matrix or expression with the expected ``shape`` ("rxc", "" for a scalar,
     "dict"; None: any), or, for a yes/no or dict answer, its finished canonical form (a tuple)."""
-    if answers.is_bool(value):  # a yes/no answer
+    if is_bool(value):  # a yes/no answer
         return "bool", "", [str(bool(value))]
     if isinstance(value, dict) or shape == "dict":  # e.g. {configuration name: row of J}
         if not isinstance(value, dict):
@@ -256,15 +259,15 @@ def _canon_default(value, shape: str | None = None):
 
 
 def _choice_canon(x):
-    """A choice value as :func:`kinlib.course.answers.normalise.choice_key` gives it (the grader's definition too)."""
+    """A choice value as :func:`kinlib.course.answers.choice.choice_key` gives it (the grader's definition too)."""
     try:
-        return answers.choice_key(x)
+        return choice_key(x)
     except TypeError as e:
         raise WrongForm(str(e)) from None
 
 
 def _canon_choice(value):
-    return "choice", "", _choice_canon(answers.choice_value(value))
+    return "choice", "", _choice_canon(choice_value(value))
 
 
 def _angle_point(p, k):
@@ -284,7 +287,7 @@ def _angle_point(p, k):
 
 def _canon_one_set(s, k, fmap=None):
     try:
-        s = answers.to_set(s)
+        s = to_set(s)
     except TypeError as e:
         raise WrongForm(str(e).replace("a set should be", "it should be")) from None
     if fmap is not None:  # a mistake undone (mistakes.SET_MISTAKES)
@@ -323,7 +326,7 @@ def _canon_condition(cond: list, fmap=None) -> list:
 
 def _canon_set(value, fmap=None):
     """A dict {symbol: Set} is shape "dict", a list of several such dicts (a union) "union", the rest ""."""
-    conds = answers.set_conditions(value)
+    conds = set_conditions(value)
     if conds is None:
         raise WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
     if len(conds) == 1 and conds[0] and conds[0][0][0] is None:
@@ -414,7 +417,7 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     >>> fingerprint((2, 1), "choice") == fingerprint([1, 2, 2], "choice")
     True
     """
-    if answers.is_unanswered(value):
+    if is_unanswered(value):
         raise Unanswered("the value is missing or ...")
     if str(kind).startswith("property:"):
         return property_spec(value, kind.partition(":")[2])
@@ -436,7 +439,7 @@ def describe_answer(value, kind: str = "default") -> str:
         return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"
     if kind == "set":
         return "a dict {symbol: SymPy Set}" if isinstance(value, dict) else "a SymPy Set"
-    if answers.is_bool(value):
+    if is_bool(value):
         return "True or False"
     if kind == "subspace":
         try:
@@ -482,7 +485,7 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     ('incorrect', 'not right yet: it has the wrong sign')
     """
     form, shape, digest = _parse_spec(spec)
-    if answers.is_unanswered(value):
+    if is_unanswered(value):
         return "unanswered", "not answered yet"
     if form == "none":
         return "error", "this answer has no automatic self-check: compare it with the worked solution"
@@ -567,7 +570,7 @@ def _verdict(kind, value, form, shape, digest, salt):
         return "correct", "correct"
     for m in mistakes.CHOICE_MISTAKES:
         try:
-            if right(_choice_canon(next(m.candidates(answers.choice_value(value)))[1])):
+            if right(_choice_canon(next(m.candidates(choice_value(value)))[1])):
                 return "incorrect", f"not right yet: that {m.message()}"
         except WrongForm:
             continue
@@ -576,7 +579,7 @@ def _verdict(kind, value, form, shape, digest, salt):
 
 def _default_mistake(v, form, shape, right, arr=None):
     """The words naming the known mistake that makes ``v`` right, or None."""
-    if isinstance(v, dict) or answers.is_bool(v) or shape == "dict" or form not in ("matrix", "scalar"):
+    if isinstance(v, dict) or is_bool(v) or shape == "dict" or form not in ("matrix", "scalar"):
         return None
     if not isinstance(v, (sp.MatrixBase, sp.Expr)):
         v = _as_sympy_value(v)

@@ -36,6 +36,7 @@ from jupyter_client import BlockingKernelClient
 from jupyter_client.connect import write_connection_file
 
 from ...schema import cell_source, is_plain_selfcheck
+from .reap import kill_group
 
 __all__ = [
     "CellResult",
@@ -180,23 +181,22 @@ class Kernel:
                 self.kill()
         raise KernelStartError(f"the kernel did not start ({START_ATTEMPTS} tries: {'; '.join(errors)})"[:600])
 
-    def _launch(self) -> None:
-        Kernel._counter = getattr(Kernel, "_counter", 0) + 1
-        base = os.path.join(self.conn_dir, f"k{os.getpid()}-{Kernel._counter}")
-        fn, _ = write_connection_file(fname=base + ".json", transport="ipc", ip=base)
-        extra = {"MPLBACKEND": "Agg", "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
+    def _kernel_argv(self, connection_file: str) -> list:
+        """The kernel's command line: Python running the launcher that sets the rlimits, then the kernel."""
         mem, fsize, nproc = int(self.mem_bytes), int(self.fsize_bytes), 0
         if self.enclosure is not None:
             rl = self.enclosure.rlimits()
             mem, fsize, nproc = int(rl["as"]), int(rl["fsize"]), int(rl.get("nproc", 0))
         code = _LAUNCH.format(mem=mem, fsize=fsize, nproc=nproc)
-        argv = [sys.executable, "-P", "-B", "-c", code, "-f", fn, "--HistoryManager.enabled=False"]
-        argv += ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
-        fds: tuple = ()
-        rfd = None
+        argv = [sys.executable, "-P", "-B", "-c", code, "-f", connection_file, "--HistoryManager.enabled=False"]
+        return argv + ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
+
+    def _isolate(self, argv: list) -> tuple:
+        """(argv, env, fds to pass, the sandbox's info pipe or None): the kernel in the sandbox, as the student's
+        user, or (``--no-sandbox`` as the grader's user) with the grader's environment."""
+        extra = {"MPLBACKEND": "Agg", "PYDEVD_DISABLE_FILE_VALIDATION": "1"}
         if self.sandbox is not None:
             rfd, wfd = os.pipe()
-            fds = (wfd,)
             env = self.sandbox.environment(extra)
             sb = self.sandbox
             if self.enclosure is not None and self.enclosure.tmp_dir:
@@ -207,14 +207,21 @@ class Kernel:
                 os.close(rfd)
                 os.close(wfd)
                 raise
-        elif self.user is not None:  # the student's own user: its scratch folder (and nothing of root's) is its own
+            return argv, env, (wfd,), rfd
+        if self.user is not None:  # the student's own user: its scratch folder (and nothing of root's) is its own
             home = os.path.join(self.conn_dir, "home")
             os.makedirs(home, exist_ok=True)
             self.user.give(self.conn_dir)
-            env = self.user.environment(home, extra)
-        else:
-            env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
-            env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+            return argv, self.user.environment(home, extra), (), None
+        env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
+        env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+        return argv, env, (), None
+
+    def _launch(self) -> None:
+        Kernel._counter = getattr(Kernel, "_counter", 0) + 1
+        base = os.path.join(self.conn_dir, f"k{os.getpid()}-{Kernel._counter}")
+        fn, _ = write_connection_file(fname=base + ".json", transport="ipc", ip=base)
+        argv, env, fds, rfd = self._isolate(self._kernel_argv(fn))
         as_user = self.user.popen_kwargs() if self.user is not None and self.sandbox is None else {}
         if self.enclosure is not None:
             if as_user:  # the launcher joins the cgroup as the student's user: it may write cgroup.procs, nothing else
@@ -302,14 +309,7 @@ class Kernel:
                     self.proc.wait(timeout=2)
                 except subprocess.TimeoutExpired:
                     pass
-            try:
-                os.killpg(self.proc.pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
-            try:
-                self.proc.wait(timeout=5)
-            except subprocess.TimeoutExpired:
-                pass
+            kill_group(self.proc, timeout=5)
         if self.user is not None and self.sandbox is None:
             self.user.end_all()  # every process of the student's user, daemons in new sessions included
 
@@ -334,6 +334,34 @@ class Kernel:
                 self.kc.control_channel.send(self.kc.session.msg("interrupt_request", content={}))
         except (ProcessLookupError, PermissionError):
             pass
+
+    def _take_output(self, msg_id: str, res: CellResult, wait: float) -> bool:
+        """Read one output message of cell ``msg_id`` into ``res`` (its size, an error); True when it says idle."""
+        msg = _message_of(self.kc.get_iopub_msg, msg_id, wait)
+        if msg is None:
+            return False
+        mt, c = msg["msg_type"], msg["content"]
+        if mt == "status" and c.get("execution_state") == "idle":
+            return True
+        if mt == "stream":
+            res.output_bytes += len(c.get("text", ""))
+        elif mt in ("display_data", "execute_result", "update_display_data"):
+            res.output_bytes += sum(len(str(v)) for v in c.get("data", {}).values())
+        elif mt == "error" and res.status == "ok":
+            _record_error(res, c)
+        return False
+
+    def _take_reply(self, msg_id: str, res: CellResult, wait: float) -> bool:
+        """Read the execute reply of cell ``msg_id`` into ``res`` if it came; True when it did."""
+        reply = _message_of(self.kc.get_shell_msg, msg_id, wait)
+        if reply is None:
+            return False
+        c = reply["content"]
+        if c.get("status") == "error" and res.status == "ok":
+            _record_error(res, c)
+        elif c.get("status") == "aborted" and res.status == "ok":
+            res.status, res.note = "error", "aborted"
+        return True
 
     def run(self, code: str, timeout: float, index: int = -1, silent: bool = False) -> CellResult:
         """Execute ``code``; never raises for anything the code does."""
@@ -365,46 +393,33 @@ class Kernel:
                 self.dead_reason = "the kernel died (the code exited Python or crashed)"
                 res.status, res.note = "died", self.dead_reason
                 break
-            msg = None
             if not idle:
-                try:
-                    msg = self.kc.get_iopub_msg(timeout=0.1 if replied else 0.05)
-                except queue.Empty:
-                    msg = None
-            if msg is not None and msg.get("parent_header", {}).get("msg_id") == msg_id:
-                mt, c = msg["msg_type"], msg["content"]
-                if mt == "status" and c.get("execution_state") == "idle":
-                    idle = True
-                elif mt == "stream":
-                    res.output_bytes += len(c.get("text", ""))
-                elif mt in ("display_data", "execute_result", "update_display_data"):
-                    res.output_bytes += sum(len(str(v)) for v in c.get("data", {}).values())
-                elif mt == "error" and res.status == "ok":
-                    res.status, res.ename, res.evalue = (
-                        "error",
-                        str(c.get("ename", ""))[:200],
-                        str(c.get("evalue", ""))[:500],
-                    )
-            if not replied:
-                try:
-                    reply = self.kc.get_shell_msg(timeout=0.1 if idle else 0)
-                except queue.Empty:
-                    reply = None
-                if reply is not None and reply.get("parent_header", {}).get("msg_id") == msg_id:
-                    replied, replied_at = True, time.monotonic()
-                    c = reply["content"]
-                    if c.get("status") == "error" and res.status == "ok":
-                        res.status, res.ename, res.evalue = (
-                            "error",
-                            str(c.get("ename", ""))[:200],
-                            str(c.get("evalue", ""))[:500],
-                        )
-                    elif c.get("status") == "aborted" and res.status == "ok":
-                        res.status, res.note = "error", "aborted"
+                idle = self._take_output(msg_id, res, 0.1 if replied else 0.05)
+            if not replied and self._take_reply(msg_id, res, 0.1 if idle else 0):
+                replied, replied_at = True, time.monotonic()
         if res.status == "timeout" and interrupted_at is not None and self.alive():
             res.ename = "TimeoutError"
         res.seconds = time.monotonic() - t0
         return res
+
+
+def _message_of(get, msg_id: str, wait: float):
+    """The next message ``get`` (a kernel client's iopub or shell reader) gives within ``wait`` seconds if it
+    belongs to the execution ``msg_id``, else None."""
+    try:
+        msg = get(timeout=wait)
+    except queue.Empty:
+        return None
+    return msg if msg.get("parent_header", {}).get("msg_id") == msg_id else None
+
+
+def _record_error(res, content: dict) -> None:
+    """The error a cell raised (its name and value, cut short) into its result."""
+    res.status, res.ename, res.evalue = (
+        "error",
+        str(content.get("ename", ""))[:200],
+        str(content.get("evalue", ""))[:500],
+    )
 
 
 def setup_code(nonce: str, snapshot: bool) -> str:

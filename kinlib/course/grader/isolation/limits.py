@@ -29,11 +29,12 @@ import ctypes
 import os
 import re
 import shutil
-import signal
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
+
+from .reap import kill_until_gone
 
 __all__ = ["Limits", "Enclosure", "parse_size", "cgroup_support", "kill_cgroup", "release"]
 
@@ -251,17 +252,7 @@ def kill_cgroup(folders, timeout: float = 10.0) -> list[int]:
     folders = [Path(f) for f in folders]
     for f in folders:
         _write(f / "cgroup.kill", "1") if (f / "cgroup.kill").exists() else None
-    deadline = time.monotonic() + timeout
-    while True:
-        left = sorted({p for f in folders for p in _procs(f)})
-        if not left or time.monotonic() > deadline:
-            return left
-        for pid in left:
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
-        time.sleep(0.02)
+    return kill_until_gone(lambda: sorted({p for f in folders for p in _procs(f)}), timeout, pause=0.02)
 
 
 def _counter(path: Path, key: str) -> int:

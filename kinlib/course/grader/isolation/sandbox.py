@@ -29,12 +29,13 @@ from __future__ import annotations
 import json
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from .reap import kill_until_gone, sigkill
 
 __all__ = [
     "Sandbox",
@@ -299,21 +300,8 @@ def reap_namespaces(records, timeout: float = 10.0) -> list[int]:
     >>> reap_namespaces([])
     []
     """
-    deadline = time.monotonic() + timeout
     for _, pid, start in records:
         st = _stat(pid)
         if st is not None and st[1] == start:
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
-    while True:
-        left = namespace_processes(records)
-        if not left or time.monotonic() > deadline:
-            return left
-        for pid in left:
-            try:
-                os.kill(pid, signal.SIGKILL)
-            except (ProcessLookupError, PermissionError):
-                pass
-        time.sleep(0.05)
+            sigkill(pid)
+    return kill_until_gone(lambda: namespace_processes(records), timeout)

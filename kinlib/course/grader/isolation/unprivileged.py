@@ -20,11 +20,11 @@ from __future__ import annotations
 
 import os
 import pwd
-import signal
 import subprocess
 import sys
-import time
 from dataclasses import dataclass
+
+from .reap import kill_until_gone
 
 __all__ = ["DEFAULT_NAME", "StudentUser", "UnprivilegedUnavailable"]
 
@@ -152,17 +152,4 @@ class StudentUser:
         """Kill every process of this user and wait until none is left (or ``timeout``); returns the PIDs still
         alive (empty when all are gone). Root's SIGKILLs by PID alone could race a process that forks; the
         user's own ``kill(-1)`` reaches every process of the user at once."""
-        deadline = time.monotonic() + timeout
-        while True:
-            left = self.processes()
-            if not left:
-                return []
-            if time.monotonic() > deadline:
-                return left
-            self._kill_as_user()
-            for pid in left:
-                try:
-                    os.kill(pid, signal.SIGKILL)
-                except (ProcessLookupError, PermissionError):
-                    pass
-            time.sleep(0.05)
+        return kill_until_gone(self.processes, timeout, each_round=self._kill_as_user)

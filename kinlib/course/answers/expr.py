@@ -1,0 +1,404 @@
+"""The ``expr`` kind: a SymPy expression, matrix or number, judged as a function of its symbols.
+
+* **normalise** (:func:`to_sympy`): SymPy matrices; NumPy arrays (0-d: a number, 1-D: a column, 2-D: the
+  matrix); a flat list/tuple of numbers (a column); a list of vectors (column or row matrices, 1-D arrays: one
+  vector per *column*, the screw-list convention); a list of lists (the rows); SymPy expressions, Python and
+  NumPy numbers, anything ``sympify(strict=True)`` accepts (e.g. mpmath numbers). A dict with string keys is
+  judged entry by entry. Yes/no and strings are choices (:mod:`.choice`), sets of configurations sets
+  (:mod:`.sets`): :func:`kinlib.course.answers.kinds.resolve` moves them there.
+* **wire form** (what :func:`kinlib.course.answers.wire.load` gives it from a kernel): ``Matrix``, SymPy
+  expression trees, numbers, ``ndarray``, lists and tuples of those, ``dict``.
+* **describe** (:func:`describe_expr`, in the grader, at the secret points): type, shape, symbols and values.
+* **compare** (:func:`compare_expr`): same shape, same values at the points (:func:`~.base.close`); a wrong
+  answer is diagnosed by the named mistakes of :mod:`.mistakes` (the self-check's too), never by a value.
+* **reference** (:func:`reference_expr`) and the advisory exact check (:func:`exact_equal`).
+"""
+
+from __future__ import annotations
+
+import math
+import numbers
+import re
+
+import numpy as np
+import sympy as sp
+
+from . import mistakes
+from .base import (
+    close,
+    extra_value,
+    fmt_shape,
+    is_bool,
+    not_answered,
+    subs_for,
+    symbol_notes,
+    to_complex,
+    type_name,
+    values_array,
+)
+from .srepr import parse_srepr
+
+__all__ = ["to_sympy", "describe_expr", "compare_expr", "reference_expr", "exact_equal"]
+
+
+def _is_vector(x) -> bool:
+    if isinstance(x, sp.MatrixBase):
+        return 1 in x.shape
+    if isinstance(x, np.ndarray):
+        return x.ndim == 1 or (x.ndim == 2 and 1 in x.shape)
+    return False
+
+
+def _flat(x) -> list:
+    if isinstance(x, sp.MatrixBase):
+        return list(x)
+    return list(np.asarray(x, dtype=object).ravel())
+
+
+def _is_matrix_like(x) -> bool:
+    return isinstance(x, sp.MatrixBase) or (isinstance(x, np.ndarray) and x.ndim in (1, 2))
+
+
+def _from_sequence(items: list, vectors: bool):
+    """:func:`to_sympy` of a list or tuple: columns side by side, rows, or a column of numbers."""
+    if not items:
+        return "empty", None
+    if all(_is_vector(v) for v in items) or (
+        vectors
+        and all(
+            isinstance(v, (list, tuple, sp.Tuple)) and not any(isinstance(e, (list, tuple)) for e in v) for v in items
+        )
+    ):
+        cols = [sp.Matrix([sp.sympify(e) for e in _flat(v)]) for v in items]
+        if len({c.shape for c in cols}) != 1:
+            return "ragged", None
+        return "matrix", sp.Matrix.hstack(*cols)
+    if vectors and all(_is_matrix_like(v) for v in items):
+        try:
+            return "matrix", sp.Matrix.hstack(
+                *[sp.Matrix(v.tolist() if isinstance(v, np.ndarray) else v) for v in items]
+            )
+        except Exception:  # noqa: BLE001  (blocks of different heights)
+            return "ragged", None
+    if all(isinstance(v, (list, tuple, sp.Tuple)) for v in items):
+        try:
+            return "matrix", sp.Matrix([[sp.sympify(e) for e in row] for row in items])
+        except Exception:  # noqa: BLE001
+            return "ragged", None
+    try:
+        return "matrix", sp.Matrix([sp.sympify(e) for e in items])
+    except Exception:  # noqa: BLE001
+        return "other", None
+
+
+def to_sympy(value, vectors: bool = False):
+    """``(tag, obj)``: ``obj`` a SymPy Matrix or scalar expression, or None with ``tag`` saying why not.
+
+    Tags: ``matrix``, ``scalar``; and, with ``obj`` None: ``ellipsis``, ``none``, ``bool``, ``empty``
+    (an empty list), ``ragged`` (vectors of different lengths), ``array`` (more than 2 dimensions),
+    ``other``. With ``vectors=True`` (subspaces) a list of lists, or of matrices, is a list of spanning
+    vectors (or blocks of them) put side by side.
+
+    >>> to_sympy([1, 2])
+    ('matrix', Matrix([
+    [1],
+    [2]]))
+    >>> to_sympy([sp.Matrix([1, 0]), np.array([0, 1]), sp.Matrix([[2, 3]])])[1].shape   # one vector per column
+    (2, 3)
+    >>> to_sympy([[1, 2, 3], [4, 5, 6]])[1].shape, to_sympy([[1, 2, 3], [4, 5, 6]], vectors=True)[1].shape
+    ((2, 3), (3, 2))
+    >>> to_sympy(np.float64(0.5)), to_sympy(...), to_sympy("J"), to_sympy([])
+    (('scalar', 0.500000000000000), ('ellipsis', None), ('other', None), ('empty', None))
+    """
+    if value is Ellipsis:
+        return "ellipsis", None
+    if value is None:
+        return "none", None
+    if is_bool(value):
+        return "bool", None
+    if isinstance(value, sp.MatrixBase):
+        return "matrix", sp.Matrix(value)
+    if isinstance(value, np.ndarray):
+        if value.ndim == 0:
+            return to_sympy(value.item())
+        if value.ndim == 1:
+            return "matrix", sp.Matrix([sp.sympify(e) for e in value.tolist()])
+        if value.ndim == 2:
+            return "matrix", sp.Matrix([[sp.sympify(e) for e in row] for row in value.tolist()])
+        return "array", None
+    if isinstance(value, (sp.Tuple, list, tuple)):
+        return _from_sequence(list(value), vectors)
+    if isinstance(value, sp.Expr):
+        return "scalar", value
+    if isinstance(value, sp.Basic):
+        return "other", None
+    if isinstance(value, (numbers.Number, np.number)):
+        v = value.item() if isinstance(value, np.generic) else value
+        return "scalar", sp.sympify(v)
+    if isinstance(value, (str, bytes, dict, set, frozenset)):
+        return "other", None
+    try:  # mpmath numbers, objects with a _sympy_ method, ...
+        v = sp.sympify(value, strict=True)
+    except (sp.SympifyError, TypeError, ValueError, AttributeError):
+        return "other", None
+    if isinstance(v, sp.MatrixBase):
+        return "matrix", sp.Matrix(v)
+    return ("scalar", v) if isinstance(v, sp.Expr) else ("other", None)
+
+
+def _shape(obj):
+    return list(obj.shape) if isinstance(obj, sp.MatrixBase) else []
+
+
+def _degrees_hint(obj):
+    trig = (sp.sin, sp.cos, sp.tan, sp.cot, sp.sec, sp.csc)
+    for f in obj.atoms(*trig) if hasattr(obj, "atoms") else ():
+        for n in f.args[0].atoms(sp.Number):
+            try:
+                if abs(n) in mistakes.DEGREE_CONSTANTS:
+                    return True
+            except TypeError:
+                pass
+    return False
+
+
+def _lambdified_values(obj, entries, points, seed):
+    """Values at ``points`` through a NumPy lambdify (complex128), or None to fall back to evalf."""
+    if not points:
+        return []
+    syms = sorted((s for s in obj.free_symbols if isinstance(s, sp.Symbol)), key=lambda s: s.name)
+    if any(not isinstance(s, sp.Symbol) for s in obj.free_symbols) or obj.atoms(sp.core.function.AppliedUndef):
+        return None
+    try:
+        f = sp.lambdify(syms, entries, modules="numpy", cse=True)
+        out = []
+        for p in points:
+            args = [np.complex128(p[s.name] if s.name in p else extra_value(seed, s.name)) for s in syms]
+            with np.errstate(all="ignore"):
+                vals = [complex(v) for v in f(*args)]
+            if not all(math.isfinite(v.real) and math.isfinite(v.imag) for v in vals):
+                return None
+            out.append([[v.real, v.imag] for v in vals])
+        return out
+    except Exception:  # noqa: BLE001
+        return None
+
+
+def describe_expr(value, points, seed=0, vectors=False):
+    """Matrix/expression answer: type, shape, symbols and values at ``points`` (dicts name -> float).
+    ``vectors``: a list of lists is a list of spanning vectors (subspaces; see :func:`to_sympy`).
+
+    >>> d = describe_expr(sp.Matrix([sp.Symbol("x"), 1]), [{"x": 2.0}])
+    >>> d["tag"], d["shape"], d["symbols"], d["values"]
+    ('matrix', [2, 1], ['x'], [[[2.0, 0.0], [1.0, 0.0]]])
+    """
+    if isinstance(value, dict) and value and all(isinstance(k, (str, int)) for k in value):
+        return {
+            "tag": "dict",
+            "type": "dict",
+            "items": {str(k): describe_expr(v, points, seed, vectors) for k, v in value.items()},
+        }
+    tag, obj = to_sympy(value, vectors=vectors)
+    out = {"tag": tag, "type": type_name(value)}
+    if obj is None:
+        return out
+    syms = sorted({s.name for s in obj.free_symbols if isinstance(s, sp.Symbol)})
+    out.update(
+        shape=_shape(obj),
+        symbols=syms,
+        has_float=bool(obj.atoms(sp.Float)),
+        degrees=_degrees_hint(obj),
+        undefined=sorted({str(f.func) for f in obj.atoms(sp.core.function.AppliedUndef)}),
+    )
+    entries = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
+    fast = _lambdified_values(obj, entries, points, seed)
+    if fast is not None:
+        out["values"] = fast
+        return out
+    values = []
+    for p in points:
+        subs = subs_for(obj, p, seed)
+        row = []
+        for e in entries:
+            try:
+                row.append(to_complex(e.xreplace(subs)))
+            except Exception:
+                row.append(None)
+        values.append(row)
+    out["values"] = values
+    return out
+
+
+def _entries(idx, shape):
+    cols = shape[1] if len(shape) == 2 else 1
+    return ", ".join(f"({i // cols + 1},{i % cols + 1})" for i in idx[:6]) + (" …" if len(idx) > 6 else "")
+
+
+def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
+    """Matrices and expressions as functions of the symbols: same shape, same values at the points.
+
+    >>> ref = {"shape": [1, 2], "symbols": [], "values": [[[1.0, 0.0], [2.0, 0.0]]]}
+    >>> compare_expr(dict(ref, tag="matrix"), ref, "v")
+    (True, '')
+    >>> compare_expr(dict(ref, tag="matrix", shape=[2, 1]), ref, "v")
+    (False, 'v is transposed: yours is 2×1, expected 1×2')
+    """
+    na = not_answered(stu)
+    if na:
+        return False, f"{name} {na}"
+    if ref.get("tag") == "dict":
+        return _compare_dict(stu, ref, name)
+    if stu.get("tag") not in ("matrix", "scalar"):
+        if str(stu.get("type", "")).endswith("Equality"):
+            return False, f"{name} is an equation (sp.Eq): assign the expression or matrix itself"
+        return False, f"{name} is a {stu.get('type')}; expected a SymPy expression or Matrix"
+    rshape, sshape = list(ref["shape"]), list(stu["shape"])
+    if rshape in ([1, 1], []) and sshape in ([1, 1], []):
+        rshape = sshape
+    if sshape != rshape:
+        if len(sshape) == 2 and sshape[::-1] == rshape:
+            return False, (
+                f"{name} is transposed: yours is {fmt_shape(sshape)}, expected "
+                f"{fmt_shape(rshape)}" + (" (one column per joint)" if rshape[0] == 6 else "")
+            )
+        return False, f"{name} has the wrong shape: yours is {fmt_shape(sshape)}, expected {fmt_shape(rshape)}"
+    if stu.get("undefined"):
+        return False, f"{name} contains undefined functions {', '.join(stu['undefined'])}"
+    S, R = values_array(stu["values"]), values_array(ref["values"])
+    if S.shape != R.shape:
+        return False, f"{name} could not be compared (malformed values)"
+    if not np.isfinite(S).all():  # NaN (None: not a number) or inf
+        return False, f"{name} could not be evaluated at some joint values (division by zero, or undefined symbols?)"
+    notes = symbol_notes(stu, ref)
+    if close(S, R):
+        extra = []
+        if stu.get("has_float") and not ref.get("has_float"):
+            extra.append("contains decimals: use exact values (sp.pi, sp.sqrt(2), sp.Rational(1, 2))")
+        return True, "; ".join(extra)
+    return False, f"{name} " + "; ".join(notes + [_no_key(_diagnose(S, R, rshape, stu))])
+
+
+def _compare_dict(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
+    """A dict of answers (e.g. {configuration: row of J}): the same keys, each entry compared."""
+    if stu.get("tag") != "dict":
+        return False, f"{name} is a {stu.get('type')}; expected a dict with keys {', '.join(ref['items'])}"
+    if set(stu["items"]) != set(ref["items"]):
+        missing, extra = (
+            sorted(set(ref["items"]) - set(stu["items"])),
+            sorted(set(stu["items"]) - set(ref["items"])),
+        )
+        what = [f"no key {', '.join(map(repr, missing))}"] if missing else []
+        what += [f"keys {', '.join(map(repr, extra))} that are not asked for"] if extra else []
+        return False, f"{name} has " + " and ".join(what)
+    msgs = [compare_expr(stu["items"][k], ref["items"][k], f"{name}[{k!r}]") for k in ref["items"]]
+    return all(ok for ok, _ in msgs), "; ".join(m for _, m in msgs if m)
+
+
+_NUM = r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?"
+_LEAKS = [
+    (re.compile(rf"\s*\({_NUM}\s*times the answer\)"), ""),
+    (re.compile(rf"\bis {_NUM} times the answer"), "is within 1% of the answer"),
+    (re.compile(rf"\b{_NUM} times the answer"), "a constant times the answer"),
+]
+
+
+def _no_key(msg: str) -> str:
+    """A diagnosis without numbers that give the reference away: "off by a constant factor (0.5 times the
+    answer)" tells the student the answer is theirs / 0.5, so the factor is dropped.
+
+    >>> _no_key("is off by a constant factor (0.5 times the answer)")
+    'is off by a constant factor'
+    >>> _no_key("is 0.997 times the answer: rounded decimals?")
+    'is within 1% of the answer: rounded decimals?'
+    """
+    for rx, rep in _LEAKS:
+        msg = rx.sub(rep, msg)
+    return msg
+
+
+def _diagnose(S, R, shape, stu) -> str:
+    """What is wrong with values S (points × entries) against R: a named mistake of
+    :mod:`kinlib.course.answers.mistakes` (the self-check's too), else which entries differ; never a value."""
+    P = S.shape[0]
+    r, c = (shape + [1, 1])[:2] if len(shape) == 2 else (1, 1)
+    S3, R3 = S.reshape(P, r, c), R.reshape(P, r, c)
+    found = mistakes.search(S3, lambda X: X.shape == R3.shape and close(X, R3), exhaustive=True)
+    if found is not None:
+        return found.says
+    neg = [k for k in range(S.shape[1]) if close(S[:, k], -R[:, k]) and not close(S[:, k], R[:, k])]
+    bad = [k for k in range(S.shape[1]) if not close(S[:, k], R[:, k])]
+    if neg and len(neg) == len(bad):
+        return f"has the wrong sign in entries {_entries(neg, shape)}"
+    if np.all(np.abs(S) < 1e-12):
+        return "is zero everywhere"
+    ratio = _const_ratio(S, R)
+    if ratio is not None:
+        if abs(abs(ratio) - 180 / math.pi) < 1e-6 * 180 / math.pi or abs(abs(ratio) - math.pi / 180) < 1e-9:
+            return "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)"
+        if abs(ratio - 1) < 1e-2:
+            return "is close to the answer but not equal: rounded decimals? Use exact values (sp.sqrt(2), sp.pi)"
+        return "is off by a constant factor (a factor missing or extra, e.g. a length or ½?)"
+    if stu.get("degrees"):
+        return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
+    if S.shape[1] > 1:
+        return f"differs in entries {_entries(bad, shape)}"
+    return "has the wrong value"
+
+
+def _const_ratio(S, R):
+    mask = np.abs(R) > 1e-6
+    if not mask.any() or np.any(np.abs(S[~mask]) > 1e-6):
+        return None
+    q = S[mask] / R[mask]
+    if np.allclose(q, q.flat[0], rtol=1e-6, atol=0) and abs(q.flat[0].imag) < 1e-9:
+        return float(q.flat[0].real)
+    return None
+
+
+def reference_expr(value):
+    """The reference value of an ``expr`` answer as something ``srepr`` round-trips (a dict entry by entry).
+
+    >>> reference_expr([1, 2]).shape, reference_expr({"a": 1})
+    ((2, 1), {'a': 1})
+    """
+    if isinstance(value, dict) and value and all(isinstance(k, (str, int)) for k in value):
+        return {str(k): reference_expr(v) for k, v in value.items()}
+    tag, obj = to_sympy(value)
+    if obj is None:
+        raise TypeError(f"reference answer of kind 'expr' is {tag} ({type_name(value)})")
+    return obj
+
+
+def exact_equal(value, ref, budget=5.0):
+    """'equal' when value - reference simplifies to exactly zero, else 'not proved' (advisory only).
+
+    >>> x = sp.Symbol("x")
+    >>> exact_equal(sp.sin(x)**2 + sp.cos(x)**2, "Integer(1)"), exact_equal(x, "Integer(1)")
+    ('equal', 'not proved')
+    """
+    import time
+
+    t0 = time.monotonic()
+    tag, obj = to_sympy(value)
+    if obj is None:
+        return "not sympy"
+    ref = parse_srepr(ref) if isinstance(ref, str) else ref
+    ref_syms = {s.name: s for s in ref.free_symbols if isinstance(s, sp.Symbol)}
+    obj = obj.xreplace(
+        {s: ref_syms[s.name] for s in obj.free_symbols if isinstance(s, sp.Symbol) and s.name in ref_syms}
+    )
+    a = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
+    b = list(ref) if isinstance(ref, sp.MatrixBase) else [ref]
+    if len(a) != len(b):
+        return "not proved"
+    for x, y in zip(a, b):
+        d = sp.sympify(x - y)
+        if d == 0:
+            continue
+        d = sp.expand(sp.expand_trig(d))
+        if d == 0:
+            continue
+        if time.monotonic() - t0 < budget and sp.count_ops(d) < 400 and sp.simplify(d) == 0:
+            continue
+        return "not proved"
+    return "equal"

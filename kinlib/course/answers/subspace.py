@@ -1,0 +1,175 @@
+"""The ``subspace`` kind: a matrix whose columns span a subspace, judged by its span, whatever the basis.
+
+* **normalise**: :func:`kinlib.course.answers.expr.to_sympy` with ``vectors=True``: a list of lists, or of
+  matrices, is the list of spanning vectors (or blocks of them), side by side.
+* **wire form**: as :mod:`.expr` (``Matrix``, ``ndarray``, lists of vectors).
+* **describe** (:func:`describe_subspace`): the spanning vectors' values at the secret points; a constant exact
+  matrix also as its exact tree (:func:`kinlib.course.answers.exacttree.expr_tree`), compared exactly.
+* **compare** (:func:`compare_subspace`): each column normalised first (no scaling of a basis matters), then
+  orthonormal bases of one dimension with principal angles ~0 between them, at every point; constant exact
+  bases by exact ranks (:func:`~.exacttree.exact_ranks`).
+* **reference** (:func:`reference_subspace`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .base import not_answered, symbol_notes, type_name, values_array
+from .exacttree import exact_ranks, expr_tree
+from .expr import describe_expr, to_sympy
+
+__all__ = ["describe_subspace", "compare_subspace", "reference_subspace", "exact_tree", "SUBSPACE_TOL"]
+
+SUBSPACE_TOL = 1e-7  # rank cut-off on singular values of unit columns; largest principal angle (sine)
+
+
+def exact_tree(obj):
+    """The exact tree of a spanning matrix (for a constant exact one: compared exactly), or None.
+
+    >>> exact_tree([[1, 0], [0, 1]])[:3], exact_tree("not a matrix")
+    (['matrix', 2, 2], None)
+    """
+    try:
+        return expr_tree(to_sympy(obj, vectors=True)[1], max_nodes=600)
+    except Exception:  # noqa: BLE001  (compared numerically then)
+        return None
+
+
+def describe_subspace(value, points, seed=0):
+    """Subspace answer: a matrix whose columns span it (a list of lists: the spanning vectors); a constant
+    exact matrix also as its exact tree (``tree``), so the grader can compare spans exactly.
+
+    >>> d = describe_subspace([[1, 0], [0, 1]], [{}])
+    >>> d["shape"], d["tree"][:3]
+    ([2, 2], ['matrix', 2, 2])
+    """
+    out = describe_expr(value, points, seed, vectors=True)
+    if out.get("tag") == "matrix" and not out.get("symbols") and not out.get("has_float"):
+        tree = exact_tree(value)
+        if tree is not None:
+            out["tree"] = tree
+    return out
+
+
+def reference_subspace(value):
+    """The reference value of a ``subspace`` answer as a SymPy Matrix (its spanning vectors side by side).
+
+    >>> reference_subspace([[1, 0, 0], [0, 1, 0]]).shape
+    (3, 2)
+    """
+    tag, obj = to_sympy(value, vectors=True)
+    if obj is None:
+        raise TypeError(f"reference answer of kind 'subspace' is {tag} ({type_name(value)})")
+    return obj
+
+
+def _orthonormal(A):
+    """An orthonormal basis (columns) of the span of A's columns, whatever their scaling.
+
+    Each column is scaled to length 1 first (a column 10¹² or 10⁻¹² times another counts the same), columns
+    that are zero (or round-off beside the largest: below 10⁻¹³ of it) dropped; the rank is the number of
+    singular values of the unit columns above ``SUBSPACE_TOL`` (the largest is ≥ 1).
+    """
+    if A.size == 0:
+        return A[:, :0]
+    norms = np.linalg.norm(A, axis=0)
+    top = norms.max()
+    if not np.isfinite(top) or top == 0:
+        return A[:, :0]
+    keep = norms > 1e-13 * top
+    U = A[:, keep] / norms[keep]
+    u, s, _ = np.linalg.svd(U, full_matrices=False)
+    return u[:, : int(np.sum(s > SUBSPACE_TOL * s[0]))]
+
+
+def _same_span(QA, QB):
+    """Largest principal angle between two subspaces of one dimension (orthonormal bases) is ~0."""
+    if QA.shape[1] != QB.shape[1]:
+        return False
+    if QA.shape[1] == 0:
+        return True
+    resid = QA - QB @ (QB.conj().T @ QA)
+    return float(np.linalg.norm(resid, 2)) < 1e-6
+
+
+def _as_matrix_shape(shape):
+    shape = list(shape) or [1, 1]
+    return [shape[0], 1] if len(shape) == 1 else shape
+
+
+def _wrong_dimension(name, rank, sshape, note=""):
+    dep = f" ({sshape[1]} columns, {rank} independent)" if sshape[1] != rank else ""
+    return False, f"{name} spans a {rank}-dimensional space{dep}, not the right dimension" + (
+        f"; {note}" if note else ""
+    )
+
+
+def _wrong_span(name, notes=()):
+    return False, (
+        f"{name} spans a space of the right dimension but not the right one (some of your directions "
+        "are not in the answer's span)" + (f"; {'; '.join(notes)}" if notes else "")
+    )
+
+
+def _same_columns_note(sshape, rshape) -> str:
+    return "" if sshape[1] == rshape[1] else f"same span (you gave {sshape[1]} columns)"
+
+
+def _compare_exact(stu, ref, name, sshape, rshape):
+    """(ok, message) by exact ranks for two constant exact bases, or None (then compared numerically)."""
+    exact = exact_ranks(stu.get("tree"), ref.get("tree"))
+    if exact is None:
+        return None
+    ra, rb, rab = exact
+    if ra != rb:
+        return _wrong_dimension(name, ra, sshape)
+    if rab != rb:
+        return _wrong_span(name)
+    return True, _same_columns_note(sshape, rshape)
+
+
+def _compare_numeric(S, R, name, sshape, rshape, notes):
+    """(ok, message) by principal angles between orthonormal bases, at every point."""
+    for p in range(S.shape[0]):
+        QA = _orthonormal(S[p].reshape(sshape))
+        QB = _orthonormal(R[p].reshape(rshape))
+        if QA.shape[1] != QB.shape[1]:
+            return _wrong_dimension(name, QA.shape[1], sshape, notes[0] if notes else "")
+        if not _same_span(QA, QB):
+            return _wrong_span(name, notes)
+    return True, _same_columns_note(sshape, rshape)
+
+
+def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
+    """A subspace by its span, at every point: orthonormal bases of both (each column normalised first,
+    so no scaling of a basis matters) of one dimension, and principal angles ~0 between them.
+
+    >>> ref = {"shape": [2, 1], "symbols": [], "values": [[[1.0, 0.0], [0.0, 0.0]]]}
+    >>> compare_subspace(dict(ref, tag="matrix", values=[[[3e12, 0.0], [0.0, 0.0]]]), ref, "s")
+    (True, '')
+    >>> compare_subspace(dict(ref, tag="matrix", values=[[[1e12, 0.0], [1e12, 0.0]]]), ref, "s")[0]
+    False
+    """
+    na = not_answered(stu)
+    if na:
+        return False, f"{name} {na}"
+    if stu.get("tag") not in ("matrix", "scalar"):
+        return False, f"{name} is a {stu.get('type')}; expected a Matrix whose columns span the subspace"
+    rshape, sshape = _as_matrix_shape(ref["shape"]), _as_matrix_shape(stu["shape"])
+    S, R = values_array(stu["values"]), values_array(ref["values"])
+    if S.shape[0] != R.shape[0]:
+        return False, f"{name} could not be compared (malformed values)"
+    if np.isnan(S).any() or not np.isfinite(S).all():
+        return False, f"{name} could not be evaluated at some values of the symbols"
+    if sshape[0] != rshape[0]:
+        if sshape[1] == rshape[0]:
+            return False, (
+                f"{name} gives the vectors as rows ({sshape[0]}×{sshape[1]}): put one vector per column "
+                f"({rshape[0]} rows)"
+            )
+        return False, f"{name} has vectors of length {sshape[0]}; expected {rshape[0]}"
+    exact = _compare_exact(stu, ref, name, sshape, rshape)
+    if exact is not None:
+        return exact
+    return _compare_numeric(S, R, name, sshape, rshape, symbol_notes(stu, ref))
