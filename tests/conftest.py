@@ -84,7 +84,7 @@ def pytest_collection_modifyitems(session, config, items):
     """The modules that use the shared chromium run last, one after the other (a stable sort: each module's tests
     keep their order), so that one playwright session serves them all and is stopped after the last one.
 
-    Under pytest-xdist (``make test TEST_JOBS=2``, ``--dist loadgroup``) every file is a group, run whole by one
+    Under pytest-xdist (``make test``: TEST_JOBS=2 by default, ``--dist loadgroup``) every file is a group, run whole by one
     worker (its module fixtures are built once; nbval's cells of one notebook share one kernel, in order), and
     the browser modules are one group together (one chromium, one worker)."""
     browser_modules = {item.module.__name__ for item in items if hasattr(item, "module") and _browser_module(item)}
