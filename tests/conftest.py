@@ -1,7 +1,9 @@
 """pytest configuration and fixtures. Shared test helpers live in tests/helpers.py (import them from there)."""
 
+import json
 import os
 import sys
+import uuid
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +17,14 @@ collect_ignore = ["fixtures"]
 
 
 def pytest_configure(config):
-    """``KINLIB_COUNT_EXPENSIVE=counts.json``: count the expensive work per test module (tests/expensive_counter.py)."""
+    """``KINLIB_COUNT_EXPENSIVE=counts.json``: count the expensive work per test module (tests/expensive_counter.py).
+    With nbval on: its items of notebooks/ read the run's handouts execution (tests/nbval_shared.py)."""
+    if config.pluginmanager.has_plugin("nbval") and (config.option.nbval or config.option.nbval_lax):
+        from kinlib.course.publish.incremental import stamp_dir
+        from nbval_shared import PLUGIN, SharedNotebookRuns
+
+        stamps = stamp_dir(ROOT / "build" / "handouts")
+        config.pluginmanager.register(SharedNotebookRuns(real_handouts_build, ROOT / "notebooks", stamps), PLUGIN)
     if os.environ.get("KINLIB_COUNT_EXPENSIVE"):
         from expensive_counter import ExpensiveCounter
 
@@ -75,7 +84,7 @@ def pytest_collection_modifyitems(session, config, items):
     """The modules that use the shared chromium run last, one after the other (a stable sort: each module's tests
     keep their order), so that one playwright session serves them all and is stopped after the last one.
 
-    Under pytest-xdist (``make test TEST_JOBS=2``, ``--dist loadgroup``) every file is a group, run whole by one
+    Under pytest-xdist (``make test``: TEST_JOBS=2 by default, ``--dist loadgroup``) every file is a group, run whole by one
     worker (its module fixtures are built once; nbval's cells of one notebook share one kernel, in order), and
     the browser modules are one group together (one chromium, one worker)."""
     browser_modules = {item.module.__name__ for item in items if hasattr(item, "module") and _browser_module(item)}
@@ -167,28 +176,57 @@ def _vendor_once(tmp_path_factory):
             build_assets(tmp_path_factory.mktemp("assets"), ROOT / "build" / "vendor")
 
 
+# one id per run, shared by the xdist workers (each worker process has its own _RUN otherwise: a serial run)
+_RUN = os.environ.get("PYTEST_XDIST_TESTRUNUID") or uuid.uuid4().hex
+_REAL_HANDOUTS: dict = {}
+
+
+def real_handouts_build() -> tuple[Path, frozenset]:
+    """The run's real handouts build (``real_handouts``), made at most once per run: (folder, the stems of the
+    notebooks it executed in this run: the others were reused from an earlier build). A failure is raised again
+    to every later caller, not retried."""
+    if "result" not in _REAL_HANDOUTS:
+        try:
+            _REAL_HANDOUTS["result"] = _build_real_handouts()
+        except Exception as exc:
+            _REAL_HANDOUTS["result"] = exc
+    if isinstance(_REAL_HANDOUTS["result"], Exception):
+        raise _REAL_HANDOUTS["result"]
+    return _REAL_HANDOUTS["result"]
+
+
+def _build_real_handouts() -> tuple[Path, frozenset]:
+    if os.environ.get("KINLIB_HANDOUTS_DIR"):
+        return Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve(), frozenset()
+    from kinlib.course.publish import handouts
+
+    out = ROOT / "build" / "handouts"
+    done = out.parent / ".handouts-built-by"  # {"run": the run's id, "executed": stems} once built in this run
+    with _lock(out.parent / ".handouts.lock"):
+        try:
+            mark = json.loads(done.read_text())
+        except (OSError, ValueError):
+            mark = {}
+        if not isinstance(mark, dict) or mark.get("run") != _RUN:
+            done.unlink(missing_ok=True)
+            entries = handouts.build(
+                ROOT / "notebooks", out, vendor=ROOT / "build" / "vendor", jobs=2, log=lambda s: None
+            )
+            mark = {"run": _RUN, "executed": [e["stem"] for e in entries if not e.get("reused")]}
+            done.write_text(json.dumps(mark))
+    return out, frozenset(mark["executed"])
+
+
 @pytest.fixture(scope="session")
 def real_handouts() -> Path:
     """The handouts of notebooks/ with the in-browser site and the PDFs, built once per run into build/handouts by
     ``make handouts``'s own code and options (so a ``make handouts`` just before is reused, section by section:
     kinlib.course.publish.incremental; and what the tests built is what ``make handouts`` would publish). With
     ``verify`` on, as ``make handouts``: every workbook is run top to bottom too. Under pytest-xdist the first
-    worker builds (a file lock) and the others read that build. ``KINLIB_HANDOUTS_DIR`` tests an existing build
-    instead. Raises the build's error (NotebookFailed names the notebook and cell)."""
-    if os.environ.get("KINLIB_HANDOUTS_DIR"):
-        return Path(os.environ["KINLIB_HANDOUTS_DIR"]).resolve()
-    from kinlib.course.publish import handouts
-
-    out = ROOT / "build" / "handouts"
-    run = os.environ.get("PYTEST_XDIST_TESTRUNUID", "")
-    done = out.parent / ".handouts-built-by"
-    with _lock(out.parent / ".handouts.lock"):
-        if not (run and done.is_file() and done.read_text() == run):
-            done.unlink(missing_ok=True)
-            handouts.build(ROOT / "notebooks", out, vendor=ROOT / "build" / "vendor", jobs=2, log=lambda s: None)
-            if run:
-                done.write_text(run)
-    return out
+    worker builds (a file lock) and the others read that build. nbval reads the notebooks' executions of this
+    build (tests/nbval_shared.py). ``KINLIB_HANDOUTS_DIR`` tests an existing build instead. Raises the build's
+    error (NotebookFailed names the notebook and cell)."""
+    return real_handouts_build()[0]
 
 
 @pytest.fixture(scope="session")

@@ -9,6 +9,8 @@ worker: ``counts.gw0.json``, ...) and a table to the terminal.
 Kinds counted:
 
 * ``nbclient kernel``: a Jupyter kernel started by nbclient (handouts, ``kinlib execute``, nbval is separate);
+* ``nbval kernel``: a kernel nbval started for a notebook (none for a notebook it judges on the handouts
+  build's execution: tests/nbval_shared.py);
 * ``handouts.build`` / ``section built`` / ``section reused``: whole builds and, inside them, sections made or reused;
 * ``execute_notebook`` / ``run_workbook``: the handouts' notebook executions (each one kernel);
 * ``lite site``: a JupyterLite site built (``lite.build_lite``); ``pdf batch``: ``printing.print_pdfs``;
@@ -62,6 +64,7 @@ class ExpensiveCounter:
 
     def install(self) -> None:
         import nbclient.client
+        import nbval.kernel
         from playwright.sync_api import _context_manager
         from playwright.sync_api._generated import BrowserType
 
@@ -72,6 +75,7 @@ class ExpensiveCounter:
         from kinlib.course.publish import handouts, incremental, lite, printing
 
         self._wrap(nbclient.client.NotebookClient, "async_start_new_kernel", "nbclient kernel")
+        self._wrap(nbval.kernel.RunningKernel, "__init__", "nbval kernel")
         self._wrap(handouts, "build", "handouts.build")
         self._wrap(handouts, "execute_notebook", "execute_notebook")
         self._wrap(handouts, "run_workbook", "run_workbook")
