@@ -36,6 +36,7 @@ ROBOTS = {
     "planar_rpp": (lambda: robots.planar_rpp(1), {}),
     "spatial_rppr": (lambda: robots.spatial_rppr(1, sp.Rational(3, 5)), {"rows": "all"}),
     "ur5": (lambda: robots.ur5(), {}),
+    "puma560": (lambda: robots.puma560(), {}),
 }
 
 
