@@ -123,3 +123,21 @@ __all__ = [
     "JOINT_COLORS",
     "FRAME_COLORS",
 ]
+
+
+def __getattr__(name: str):
+    """Names that moved: the 5.2 animation now plays in the browser front end (``kinlib.widgets``); an old
+    notebook that asks ``kinlib.plotting`` for it is told where it went instead of a bare AttributeError.
+
+    >>> import kinlib.plotting as P
+    >>> P.animate_singularity
+    Traceback (most recent call last):
+    ...
+    AttributeError: kinlib.plotting.animate_singularity moved: use kinlib.widgets.animate_singularity(chain, path) (same arguments; it plays in the browser)
+    """
+    if name == "animate_singularity":
+        raise AttributeError(
+            "kinlib.plotting.animate_singularity moved: use kinlib.widgets.animate_singularity(chain, path) "
+            "(same arguments; it plays in the browser)"
+        )
+    raise AttributeError(f"module 'kinlib.plotting' has no attribute {name!r}")
