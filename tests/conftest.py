@@ -33,14 +33,24 @@ def pytest_configure(config):
         config.pluginmanager.register(counter, "kinlib-expensive-counter")
 
 
+def _run_tmp(tmp_path_factory) -> Path:
+    """A temporary folder of this run shared by its pytest-xdist workers (the parent of each worker's basetemp,
+    made fresh by the controller for every run); this process's basetemp in a serial run."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
 @pytest.fixture(autouse=True, scope="session")
 def _grader_secret(tmp_path_factory):
-    """The grader's secret (kinlib.course.grader.secret) for the whole run: a temporary file, never the tester's
-    ~/.config/kinlib/grader-secret (subprocesses inherit it through the environment)."""
-    import os
+    """The grader's secret (kinlib.course.grader.secret) for the whole run, one for all xdist workers (so that
+    they share ``grader_reference_cache``): a temporary file, never the tester's ~/.config/kinlib/grader-secret
+    (subprocesses inherit it through the environment)."""
+    from kinlib.course.grader.secret import load_secret
 
     old = os.environ.get("KINLIB_GRADER_SECRET")
-    os.environ["KINLIB_GRADER_SECRET"] = str(tmp_path_factory.mktemp("grader-secret") / "grader-secret")
+    path = _run_tmp(tmp_path_factory) / "grader-secret" / "grader-secret"
+    load_secret(path)  # made once (atomically: the first worker's), read by the others
+    os.environ["KINLIB_GRADER_SECRET"] = str(path)
     yield
     if old is None:
         os.environ.pop("KINLIB_GRADER_SECRET", None)
@@ -51,9 +61,12 @@ def _grader_secret(tmp_path_factory):
 @pytest.fixture(scope="session")
 def grader_reference_cache(tmp_path_factory):
     """One signed reference cache (kinlib.course.grader.refdata) for the run's grading tests: a solution notebook is
-    executed for its answer key once per run (per xdist worker), not once per module. Signed with the run's
-    secret (``_grader_secret``); a test of the cache itself (poisoned, another secret) uses a folder of its own."""
-    return tmp_path_factory.mktemp("grader-reference-cache")
+    executed for its answer key once per run, not once per module: the xdist workers share the folder (the first
+    builds a reference under the cache's own lock, refdata.build_reference; the others read it). Signed with the
+    run's secret (``_grader_secret``); a test of the cache itself (poisoned, another secret) uses a folder of its own."""
+    path = _run_tmp(tmp_path_factory) / "grader-reference-cache"
+    path.mkdir(exist_ok=True)
+    return path
 
 
 @pytest.fixture

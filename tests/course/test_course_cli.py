@@ -134,7 +134,7 @@ def test_handouts_on_a_folder(capsys, tmp_path):
     assert "kinlib handouts: wrote" in capsys.readouterr().out
 
 
-def test_grade_a_small_batch(capsys, tmp_path):
+def test_grade_a_small_batch(capsys, tmp_path, grader_reference_cache):
     subs = tmp_path / "subs"
     subs.mkdir()
     shutil.copy(GRADE_FIXTURES / "notebooks" / "90_grade_fixture.ipynb", subs / "solution.ipynb")
@@ -150,7 +150,7 @@ def test_grade_a_small_batch(capsys, tmp_path):
                 "--notebooks",
                 str(GRADE_FIXTURES / "notebooks"),
                 "--cache",
-                str(tmp_path / "cache"),
+                str(grader_reference_cache),  # the run's answer key (signed with its secret), not built again
                 "--jobs",
                 "2",
                 "--quiet",

@@ -22,6 +22,7 @@ import pytest
 
 from kinlib.course.grader import batch, grade, intake, report
 from kinlib.course.grader.isolation import limits
+from kinlib.course.grader.secret import load_secret
 from kinlib.course.lms.bundles import canvas_csv
 
 FIX = Path(__file__).resolve().parents[1] / "fixtures" / "grade"
@@ -373,15 +374,15 @@ def _kill(pid):
 
 @pytest.mark.slow
 @pytest.mark.parametrize("kills", [1, 2])
-def test_a_worker_killed_mid_batch_loses_nothing(tmp_path, kills):
+def test_a_worker_killed_mid_batch_loses_nothing(tmp_path, kills, grader_reference_cache):
     d = _batch_dir(tmp_path, {"victim": 4})
     subs = intake.find_submissions([d])
     hook, seen = _killer("victim.ipynb", kills, subs, after=2.0)
     out = tmp_path / "out"
     with _Alarm(900):
         summary = grade.grade_batch(
-            [d], out, jobs=2, timeout=120, cell_timeout=60, notebooks=FIX / "notebooks", cache=tmp_path / "c",
-            log=None, on_event=hook,
+            [d], out, jobs=2, timeout=120, cell_timeout=60, notebooks=FIX / "notebooks",
+            cache=grader_reference_cache, log=None, on_event=hook,
         )  # fmt: skip
     assert seen["kills"] == kills
     left = [m for m in Path("/proc/self/mountinfo").read_text().split() if "kinlib-grade-" in m]
@@ -403,11 +404,16 @@ def test_a_worker_killed_mid_batch_loses_nothing(tmp_path, kills):
     assert _children() == []
 
 
+# a worker silent this long is stuck: 3 heartbeat periods (batch.BEAT_SECONDS), short enough not to keep the test
+# waiting, long enough that a live worker on a loaded machine is never taken for a stuck one
+BEAT_LIMIT = 3 * batch.BEAT_SECONDS
+
+
 @pytest.mark.slow
-def test_a_stopped_worker_is_noticed_by_its_heartbeat(tmp_path):
-    d = _batch_dir(tmp_path, {"victim": 3}, plain=0)
+def test_a_stopped_worker_is_noticed_by_its_heartbeat(tmp_path, grader_reference_cache):
+    d = _batch_dir(tmp_path, {"victim": BEAT_LIMIT}, plain=0)  # the next worker grades it for longer than the limit
     subs = intake.find_submissions([d])
-    refs = grade.load_references(FIX / "notebooks", tmp_path / "c", None, log=None)
+    refs = grade.load_references(FIX / "notebooks", grader_reference_cache, None, log=None, secret=load_secret())
     stopped = []
 
     def on_event(kind, pid, i):
@@ -422,7 +428,7 @@ def test_a_stopped_worker_is_noticed_by_its_heartbeat(tmp_path):
     events = []
     with _Alarm(600):
         (res,) = batch.Supervisor(
-            2, init, lambda t, why: {"why": why}, 600, beat_limit=5,
+            2, init, lambda t, why: {"why": why}, 600, beat_limit=BEAT_LIMIT,
             on_event=lambda *a: (events.append(a[0]), on_event(*a)),
         ).run(tasks)  # fmt: skip
     assert "stuck" in events and "retry" in events
@@ -530,7 +536,7 @@ BOMBS = {
 
 @pytest.mark.slow
 @pytest.mark.skipif(limits.cgroup_support()[0] == "", reason="no writable cgroup here (not root)")
-def test_bounded_bombs_are_stopped_reported_and_leave_nothing(tmp_path):
+def test_bounded_bombs_are_stopped_reported_and_leave_nothing(tmp_path, grader_reference_cache):
     d = tmp_path / "subs"
     d.mkdir()
     for name, src in BOMBS.items():
@@ -538,8 +544,8 @@ def test_bounded_bombs_are_stopped_reported_and_leave_nothing(tmp_path):
     out = tmp_path / "out"
     with _Alarm(900):
         summary = grade.grade_batch(
-            [d], out, jobs=2, timeout=180, cell_timeout=90, notebooks=FIX / "notebooks", cache=tmp_path / "c",
-            log=None,
+            [d], out, jobs=2, timeout=180, cell_timeout=90, notebooks=FIX / "notebooks",
+            cache=grader_reference_cache, log=None,
         )  # fmt: skip
     res = {Path(r["relpath"]).stem: r for r in summary["results"]}
     for name, words in (("fork", "processes: more than 256"), ("memory", "memory: the submission's processes"),

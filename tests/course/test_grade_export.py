@@ -278,18 +278,18 @@ if found:  # whatever it found, as its answers
 
 
 @pytest.fixture(scope="module")
-def kernel_attacks(tmp_path_factory):
+def kernel_attacks(tmp_path_factory, grader_reference_cache):
     from jupyter_client.session import Session
     from test_grade import FIX, WB, completed
 
     from kinlib.course.grader import grade
     from kinlib.course.grader.isolation import sandbox
-    from kinlib.course.grader.secret import evaluation_seed
+    from kinlib.course.grader.secret import evaluation_seed, load_secret
 
     ok, why = sandbox.check()
     assert ok, f"the grader's sandbox does not work here: {why}"
-    key = b"k" * 32
-    refs = grade.load_references(FIX / "notebooks", cache=None, secret=key)
+    key = b"k" * 32  # the grading's secret (the evaluation points); the answer key is the run's (read, not rebuilt)
+    refs = grade.load_references(FIX / "notebooks", cache=grader_reference_cache, secret=load_secret())
     d = tmp_path_factory.mktemp("kernel-attacks")
     wb = json.loads(WB.read_text())
     cell = {"cell_type": "code", "metadata": {}, "outputs": [], "execution_count": None}

@@ -15,6 +15,7 @@ import hashlib
 import json
 import os
 import re
+import shutil
 import socket
 import sys
 import threading
@@ -134,7 +135,7 @@ def _cleanup():
 
 
 @pytest.fixture(scope="module")
-def attacked(tmp_path_factory):
+def attacked(tmp_path_factory, grader_reference_cache):
     ok, why = sandbox.check()
     assert ok, f"the grader's sandbox does not work here: {why} (make test installs bubblewrap)"
     d = tmp_path_factory.mktemp("attacks")
@@ -146,8 +147,9 @@ def attacked(tmp_path_factory):
     out = tmp_path_factory.mktemp("attack-grades")
     try:
         summary = grade.grade_batch(
-            [d], out, jobs=2, timeout=180, cell_timeout=60, notebooks=FIX / "notebooks", cache=out / "cache", log=None
-        )
+            [d], out, jobs=2, timeout=180, cell_timeout=60, notebooks=FIX / "notebooks", cache=grader_reference_cache,
+            log=None,
+        )  # fmt: skip
         snapshot = {p: p.read_bytes() for p in [out / "grades.csv", *sorted((out / "feedback").glob("*.md"))]}
         ended = time.monotonic()
         time.sleep(3)  # a daemon that outlived the batch would have rewritten the files by now
@@ -264,13 +266,13 @@ def _points_attack(symbols: dict) -> str:
 
 
 @pytest.mark.slow
-def test_evaluation_points_depend_on_the_secret_not_the_file_alone(tmp_path, monkeypatch):
+def test_evaluation_points_depend_on_the_secret_not_the_file_alone(tmp_path, monkeypatch, grader_reference_cache):
     key = load_secret()
     data = WB.read_bytes()
     public = int(hashlib.sha256(data).hexdigest()[:15], 16)
     assert evaluation_seed(key, data) != public
     assert evaluation_seed(key, data) != evaluation_seed(os.urandom(32).hex().encode(), data)
-    refs = grade.load_references(FIX / "notebooks", tmp_path / "cache", secret=key)
+    refs = grade.load_references(FIX / "notebooks", grader_reference_cache, secret=key)
     ref = refs["90_grade_fixture"]
     symbols = {n: v for a in ref.answers.values() for n, v in a.get("symbols", {}).items()}
     sub = tmp_path / "points.ipynb"
@@ -291,10 +293,13 @@ def _no_dummies(answers) -> str:
 
 
 @pytest.mark.slow
-def test_a_poisoned_cache_is_rejected_and_nothing_runs_in_the_grader(tmp_path):
+def test_a_poisoned_cache_is_rejected_and_nothing_runs_in_the_grader(tmp_path, grader_reference_cache):
     key = load_secret()
-    cache = tmp_path / "cache"
-    fresh = grade.load_references(FIX / "notebooks", cache, secret=key)["90_grade_fixture"]
+    fresh = grade.load_references(FIX / "notebooks", grader_reference_cache, secret=key)["90_grade_fixture"]
+    cache = tmp_path / "cache"  # a copy of the run's cache, poisoned here
+    cache.mkdir()
+    for f in grader_reference_cache.glob("90_grade_fixture-*.json"):
+        shutil.copy(f, cache)
     (cfile,) = cache.glob("*.json")
     marker = tmp_path / "payload-ran"
     payload = f"__import__('os').system('touch {marker}')"

@@ -52,13 +52,21 @@ def load_secret(path=None, create: bool = True) -> bytes:
         if not create:
             raise FileNotFoundError(f"no grader secret at {p}")
         p.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+        # written in full under a private name, then linked into place: another grader starting at the same
+        # moment either makes the link itself or reads the whole secret, never an empty file
+        tmp = p.with_name(f".{p.name}.{os.getpid()}.{os.urandom(4).hex()}")
+        fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         try:
-            fd = os.open(p, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        except FileExistsError:  # created meanwhile by another grader: use that one
-            pass
-        else:
             with os.fdopen(fd, "w") as f:
                 f.write(os.urandom(32).hex() + "\n")
+            os.link(tmp, p)
+        except FileExistsError:  # created meanwhile by another grader: use that one
+            pass
+        except OSError:  # a file system without hard links: moved into place instead
+            if not p.exists():
+                os.rename(tmp, p)
+        finally:
+            tmp.unlink(missing_ok=True)
     fd = os.open(p, os.O_RDONLY | getattr(os, "O_NOFOLLOW", 0))
     with os.fdopen(fd, "rb") as f:
         st = os.fstat(f.fileno())
