@@ -5,7 +5,8 @@ browser section of ``make bench`` (bench/bench.py imports this module).
   (``jupyter trust``: JupyterLab renders widget outputs only in trusted notebooks) and the project's settings
   (``notebooks/.lab-settings/overrides.json``), with every Jupyter directory (config, data, settings, workspaces) private to
   the run, on a free loopback port.
-* :func:`open_notebook` opens a notebook fresh in a new page with the network blocked except loopback.
+* :func:`open_notebook` opens a notebook fresh in a new page with the network blocked except loopback;
+  :class:`Lab` opens notebook after notebook in one such page (JupyterLab's front end loaded once).
 * :func:`run_all` runs every cell (Run → Run All Cells) and returns the seconds until the kernel's last reply.
 * :func:`explorers`, :func:`pictures`, :func:`move_slider` find the widget outputs, the pictures in them, and
   time one key press on a slider until the new picture has loaded (all measured in the page's own clock).
@@ -64,15 +65,26 @@ def jupyter_env(work: Path) -> dict:
 
 
 @contextmanager
-def jupyterlab(work: Path, notebooks: Path = NOTEBOOKS, *, trust: bool = True, timeout: float = 120):
+def jupyterlab(
+    work: Path, notebooks: Path = NOTEBOOKS, *, trust: bool = True, untrusted: tuple = (), timeout: float = 120
+):
     """JupyterLab serving a copy of ``notebooks`` (in ``work/notebooks``); yields its URL.
 
     ``trust=True`` is what ``make lab`` does (``jupyter trust`` on the notebooks); ``trust=False`` is a notebook
     opened by someone who never ran ``make lab`` (JupyterLab then shows only safe outputs: text, images).
+    ``untrusted`` (stems) also serves a copy of each of those notebooks as ``untrusted/<stem>.ipynb`` that nobody
+    trusted, in the same server (one start, not two): ``jupyter trust`` signs a notebook's content, so the copy
+    carries one more metadata entry (``kinlib_test_copy``) and no signature matches it.
     """
     work = Path(work)
     scratch = work / "notebooks"
     shutil.copytree(notebooks, scratch)
+    if untrusted:
+        (scratch / "untrusted").mkdir()
+        for stem in untrusted:
+            nb = json.loads((scratch / f"{stem}.ipynb").read_text(encoding="utf-8"))
+            nb["metadata"]["kinlib_test_copy"] = "untrusted: opened without `make lab`"
+            (scratch / "untrusted" / f"{stem}.ipynb").write_text(json.dumps(nb, indent=1), encoding="utf-8")
     env = jupyter_env(work)
     bindir = Path(sys.executable).parent
     # no "news" toast over the notebook (a user's own choice, not the project's)
@@ -188,8 +200,16 @@ class Watch:
 _NOTEBOOK_READY = """(path) => {
   const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;
   const k = w && w.sessionContext && w.sessionContext.session && w.sessionContext.session.kernel;
-  return !!k && k.status === 'idle' && !!w.content && w.content.widgets.length > 0 && w.context.path === path;
+  const ready = !!k && k.status === 'idle' && !!w.content && w.content.widgets.length > 0 && w.context.path === path;
+  if (ready) {  // the current notebook's panel is the one every locator of this module looks in
+    document.querySelectorAll('[data-kinlib-current]').forEach(e => { if (e !== w.node) e.removeAttribute('data-kinlib-current'); });
+    w.node.setAttribute('data-kinlib-current', '');
+  }
+  return ready;
 }"""
+
+#: the panel of the notebook shown (the last one opened or activated: :func:`open_notebook`, :class:`Lab`)
+CURRENT = "[data-kinlib-current]"
 
 
 def open_notebook(browser, url: str, name: str, timeout: float = 120):
@@ -201,7 +221,9 @@ def open_notebook(browser, url: str, name: str, timeout: float = 120):
     host = url.split("//")[1]
     watch = Watch(page, allow=(url, f"ws://{host}", "data:", "blob:", "about:"))
     # a workspace of its own, reset: only this notebook is open (no tab restored from an earlier page)
-    page.goto(f"{url}/lab/workspaces/kinlib-{name}/tree/{name}.ipynb?reset", wait_until="domcontentloaded")
+    page.goto(
+        f"{url}/lab/workspaces/kinlib-{name.replace('/', '-')}/tree/{name}.ipynb?reset", wait_until="domcontentloaded"
+    )
     page.wait_for_function(_NOTEBOOK_READY, arg=f"{name}.ipynb", timeout=timeout * 1000, polling=200)
     return page, watch
 
@@ -212,6 +234,72 @@ def close_notebook(page) -> None:
         page.evaluate("() => window.jupyterapp.shell.currentWidget.sessionContext.shutdown()")
     finally:
         page.close()
+
+
+_OPEN_IN_APP = """async (path) => {
+  const app = window.jupyterapp;
+  const w = await app.commands.execute('docmanager:open', {path, factory: 'Notebook'});
+  app.shell.activateById(w.id);
+  return w.id;
+}"""
+
+_ACTIVATE = """(id) => {
+  window.jupyterapp.shell.activateById(id);
+  return window.jupyterapp.shell.currentWidget.id === id;
+}"""
+
+_DISPOSE = """async (id) => {
+  const w = Array.from(window.jupyterapp.shell.widgets('main')).find(w => w.id === id);
+  if (!w) return;
+  try { await w.sessionContext.shutdown(); } finally { w.dispose(); }
+}"""
+
+
+class Lab:
+    """One JupyterLab page (the application loaded once, as a student keeps one browser tab) in which notebooks
+    are opened one after another, each fresh from the server with its own kernel: loading JupyterLab's front end
+    costs Chromium as much CPU as running a notebook, so the tests load it once per server, not once per notebook.
+
+    :meth:`open` returns (page, watch) as :func:`open_notebook` does (the watch's lists emptied for each
+    notebook); :meth:`close` shuts the notebook's kernel down and disposes of its panel (unsaved changes are
+    dropped: the server's copy is never saved); :meth:`activate` shows a notebook still open. Every locator of
+    this module looks only in the notebook shown (:data:`CURRENT`).
+    """
+
+    def __init__(self, browser, url: str):
+        self.browser, self.url = browser, url
+        self.page, self.watch, self.ids = None, None, {}
+
+    def open(self, name: str, timeout: float = 120):
+        if self.page is None or self.page.is_closed():
+            self.page, self.watch = open_notebook(self.browser, self.url, name, timeout)
+        else:
+            for found in (self.watch.blocked, self.watch.failed, self.watch.errors, self.watch.console):
+                found.clear()
+            self.page.evaluate(_OPEN_IN_APP, f"{name}.ipynb")
+            self.page.wait_for_function(_NOTEBOOK_READY, arg=f"{name}.ipynb", timeout=timeout * 1000, polling=200)
+        self.ids[name] = self.page.evaluate("() => window.jupyterapp.shell.currentWidget.id")
+        return self.page, self.watch
+
+    def activate(self, name: str, timeout: float = 60):
+        assert self.page.evaluate(_ACTIVATE, self.ids[name]), f"{name} is not open"
+        self.page.wait_for_function(_NOTEBOOK_READY, arg=f"{name}.ipynb", timeout=timeout * 1000, polling=200)
+        return self.page, self.watch
+
+    def close(self, name: str) -> None:
+        if self.page is None or self.page.is_closed() or name not in self.ids:
+            return
+        try:
+            self.page.evaluate(_DISPOSE, self.ids.pop(name))
+        except Exception:  # a page that broke is not reused: the next notebook loads JupyterLab again
+            self.page.close()
+            raise
+
+    def quit(self) -> None:
+        if self.page is not None and not self.page.is_closed():
+            for name in list(self.ids):
+                self.close(name)
+            self.page.close()
 
 
 _RUN_ALL = """() => {
@@ -252,7 +340,7 @@ def run_all(page, timeout: float = 300, details: bool = False):
         timeout=timeout * 1000,
         polling=200,
     )
-    errors = page.locator(".jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
+    errors = page.locator(f"{CURRENT} .jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
     if errors.count():
         raise CellFailed("a cell raised: " + errors.first.text_content()[:800])
     if run["aborted"]:
@@ -279,7 +367,8 @@ _MARK_WIDGET_CELLS = r"""() => {
 def widget_cells(page):
     """The output areas of the code cells whose output is a Jupyter widget or a kinlib explorer, animation or
     picker (its ``application/javascript``), in notebook order."""
-    return [page.locator(f"[data-kinlib-cell='{i}'] .jp-OutputArea").first for i in page.evaluate(_MARK_WIDGET_CELLS)]
+    cells = page.evaluate(_MARK_WIDGET_CELLS)
+    return [page.locator(f"{CURRENT} [data-kinlib-cell='{i}'] .jp-OutputArea").first for i in cells]
 
 
 _MARK_CELL_WITH = """(needle) => {
@@ -293,7 +382,7 @@ _MARK_CELL_WITH = """(needle) => {
 def output_of(page, needle: str):
     """The output area of the first code cell whose source contains ``needle`` (None if there is none)."""
     i = page.evaluate(_MARK_CELL_WITH, needle)
-    return page.locator(f"[data-kinlib-cell='{i}'] .jp-OutputArea").first if i >= 0 else None
+    return page.locator(f"{CURRENT} [data-kinlib-cell='{i}'] .jp-OutputArea").first if i >= 0 else None
 
 
 def explorers(page, timeout: float = 60):
@@ -310,7 +399,7 @@ def explorers(page, timeout: float = 60):
 
 def animations(page):
     """The outputs that hold a kinlib animation (``kinlib.widgets.animate_singularity``)."""
-    return page.locator(".jp-OutputArea-output").filter(has=page.locator(".kinlib-animation"))
+    return page.locator(f"{CURRENT} .jp-OutputArea-output").filter(has=page.locator(".kinlib-animation"))
 
 
 _PICTURE = """(root) => Array.from(root.querySelectorAll('img')).some(

@@ -101,6 +101,39 @@ def _open(browser, path: Path):
     return page, watch
 
 
+#: what the tests after test_handout_page_renders_offline drive on a static page (they go on in its page)
+_DRIVEN = ("window.kinlibAnimation(host, S);", "window.kinlibPicker(host, S);")
+_DRIVEN_STEMS = ("05_singularities_planar", "06_singularities_spatial")
+
+
+@pytest.fixture(scope="module")
+def static_pages():
+    """The static pages test_handout_page_renders_offline loaded and checked that a later test of this module
+    drives (animation, picker, the 05 and 06 explorers): kept open, so each is loaded once (a MathJax page costs
+    Chromium seconds), not once per test; closed with the module. {path: (page, watch)}"""
+    kept: dict = {}
+    yield kept
+    for page, _watch in kept.values():
+        try:
+            page.close()
+        except Exception:  # the run's chromium may be stopped already (tests/conftest.py)
+            pass
+
+
+def _open_static(browser, static_pages, path: Path):
+    """(page, watch) of the static page ``path``: the one test_handout_page_renders_offline left open (its watch
+    goes on collecting), or a fresh one (run alone). Give it back with :func:`_done`."""
+    kept = static_pages.get(path)
+    if kept is not None and not kept[0].is_closed():
+        return kept
+    return _open(browser, path)
+
+
+def _done(static_pages, page) -> None:
+    if not any(page is kept for kept, _ in static_pages.values()):
+        page.close()
+
+
 _MATHJAX_DONE = """() => new Promise(resolve => {
   if (!window.MathJax || !MathJax.Hub) { resolve(false); return; }
   MathJax.Hub.Queue(() => resolve(true));
@@ -112,11 +145,12 @@ _MATHJAX_DONE = """() => new Promise(resolve => {
 
 
 @pytest.mark.parametrize("spec", PAGES, ids=_page_id)
-def test_handout_page_renders_offline(sites, browser, spec):
+def test_handout_page_renders_offline(sites, browser, static_pages, spec):
     site, kind, stem = spec
     root = _site(sites, site)
     path = root / "index.html" if kind == "index" else root / kind / f"{stem}.html"
     page, watch = _open(browser, path)
+    keep = False
     try:
         if kind == "index":
             links = page.eval_on_selector_all("a", "els => els.map(e => e.getAttribute('href'))")
@@ -171,8 +205,14 @@ def test_handout_page_renders_offline(sites, browser, spec):
         watch.assert_clean(path.name)
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)
         page.screenshot(path=str(SCREENSHOTS / f"{_page_id(spec)}.png"), full_page=True)
+        keep = kind == "solutions" and (
+            any(needle in html for needle in _DRIVEN) or (site == "handouts" and stem in _DRIVEN_STEMS)
+        )
+        if keep:
+            static_pages[path] = (page, watch)
     finally:
-        page.close()
+        if not keep:
+            page.close()
 
 
 def _has_tex(html: str) -> bool:
@@ -195,14 +235,14 @@ def _pages_with(sites, needle):
     return pages
 
 
-def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser):
+def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser, static_pages):
     """kinlib.widgets' animation (5.2) and configuration picker (4.1) on the static solutions pages (files, no
     kernel, network blocked): the step slider's arrow key and the play button step the arm, a picker button draws
     another configuration (tests/pictures/test_widgets.py checks what is drawn)."""
     pages = _pages_with(sites, "window.kinlibAnimation(host, S);")
     assert any(site == "fixture" for site, _ in pages)
     for _kind, path in pages:
-        page, watch = _open(browser, path)
+        page, watch = _open_static(browser, static_pages, path)
         try:
             root = page.locator(".kinlib-animation").first
             root.locator(".kinlib-arm").wait_for(timeout=15000)
@@ -219,7 +259,7 @@ def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser):
             root.locator("button.kinlib-play").click()  # pause
             watch.assert_clean(path.name)
         finally:
-            page.close()
+            _done(static_pages, page)
     assert "05_singularities_planar" in REAL, "notebooks/05_singularities_planar.ipynb is missing"
     _site(sites, "handouts")
     assert any(site == "handouts" and p.stem.startswith("05") for site, p in pages), (
@@ -227,7 +267,7 @@ def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser):
     )
     pickers = [p for site, p in _pages_with(sites, "window.kinlibPicker(host, S);") if site == "handouts"]
     assert [p.stem[:2] for p in pickers] == ["04"], pickers
-    page, watch = _open(browser, pickers[0])
+    page, watch = _open_static(browser, static_pages, pickers[0])
     try:
         root = page.locator(".kinlib-picker").first
         root.locator(".kinlib-arm").wait_for(timeout=15000)
@@ -241,24 +281,24 @@ def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser):
         )
         watch.assert_clean(pickers[0].name)
     finally:
-        page.close()
+        _done(static_pages, page)
 
 
-def _explorer_on_static_page(sites, browser, stem, index=-1):
+def _explorer_on_static_page(sites, browser, static_pages, stem, index=-1):
     root = _site(sites, "handouts")
     path = root / "solutions" / f"{stem}.html"
-    page, watch = _open(browser, path)
+    page, watch = _open_static(browser, static_pages, path)
     page.wait_for_function("() => document.querySelectorAll('.kinlib-explorer .kinlib-arm').length > 0", timeout=15000)
     ex = page.locator(".kinlib-explorer").nth(index) if index >= 0 else page.locator(".kinlib-explorer").last
     ex.scroll_into_view_if_needed()
     return page, watch, ex
 
 
-def test_static_page_05_explorer_goes_singular_without_a_kernel(sites, browser):
+def test_static_page_05_explorer_goes_singular_without_a_kernel(sites, browser, static_pages):
     """The solutions page of notebook 05 (a file, no kernel, network blocked): θ2 moved to −π/4 with the arrow
     keys shows the singular banner, det J = 0, the collapsed held ellipse and the blocked direction, and the
     aria-live text says so; each key gives a new picture (times printed, `make bench` reports them)."""
-    page, watch, ex = _explorer_on_static_page(sites, browser, "05_singularities_planar")
+    page, watch, ex = _explorer_on_static_page(sites, browser, static_pages, "05_singularities_planar")
     try:
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)
         ex.screenshot(path=str(SCREENSHOTS / "static-05-explorer-before.png"))
@@ -300,10 +340,10 @@ def test_static_page_05_explorer_goes_singular_without_a_kernel(sites, browser):
         )
         watch.assert_clean("solutions/05")
     finally:
-        page.close()
+        _done(static_pages, page)
 
 
-def test_static_page_05_slider_marks_are_singular_configurations(sites, browser):
+def test_static_page_05_slider_marks_are_singular_configurations(sites, browser, static_pages):
     """θ2's track marks exactly the members of singular_configurations' family in the slider's range, computed
     independently here (kinlib.singular_configurations on the exact Jacobian of the same robot)."""
     import sympy as sp
@@ -314,7 +354,7 @@ def test_static_page_05_slider_marks_are_singular_configurations(sites, browser)
     r = robots.planar_offset_3r()
     (cond,) = singular_configurations(task_rows(r.jacobian_geometric(), ["wz", "vx", "vy"]), r.thetas)
     members = sorted(float(x) for x in sp.Intersection(cond[r.thetas[1]], sp.Interval(-sp.pi, sp.pi)))
-    page, watch, ex = _explorer_on_static_page(sites, browser, "05_singularities_planar")
+    page, watch, ex = _explorer_on_static_page(sites, browser, static_pages, "05_singularities_planar")
     try:
         for j, want in ((1, []), (2, members), (3, [])):
             got = ex.locator(f"input.kinlib-slider[data-joint='{j}'] ~ div .kinlib-mark").evaluate_all(
@@ -323,13 +363,13 @@ def test_static_page_05_slider_marks_are_singular_configurations(sites, browser)
             assert got == pytest.approx(want, abs=1e-12), (j, got, want)
         watch.assert_clean("solutions/05")
     finally:
-        page.close()
+        _done(static_pages, page)
 
 
-def test_static_page_3d_explorer_turns_and_moves(sites, browser):
+def test_static_page_3d_explorer_turns_and_moves(sites, browser, static_pages):
     """Notebook 06's spatial explorer on its solutions page: the view turns from the keyboard (the drawing
     changes, the arm's world coordinates do not) and a joint slider moves the arm."""
-    page, watch, ex = _explorer_on_static_page(sites, browser, "06_singularities_spatial")
+    page, watch, ex = _explorer_on_static_page(sites, browser, static_pages, "06_singularities_spatial")
     try:
         SCREENSHOTS.mkdir(parents=True, exist_ok=True)
         ex.screenshot(path=str(SCREENSHOTS / "static-06-explorer-before.png"))
@@ -347,7 +387,7 @@ def test_static_page_3d_explorer_turns_and_moves(sites, browser):
         ex.screenshot(path=str(SCREENSHOTS / "static-06-explorer-after.png"))
         watch.assert_clean("solutions/06")
     finally:
-        page.close()
+        _done(static_pages, page)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -362,18 +402,35 @@ def _lab_notebooks() -> Path:
     return Path(os.environ.get("KINLIB_LAB_NOTEBOOKS") or NOTEBOOKS).resolve()
 
 
+UNTRUSTED_05 = "untrusted/05_singularities_planar"  # the copy of notebook 05 nobody trusted (labdriver.jupyterlab)
+
+
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
-    """JupyterLab on a copy of the notebooks, trusted and with notebooks/.lab-settings/ (what `make lab` does)."""
-    with labdriver.jupyterlab(tmp_path_factory.mktemp("lab"), _lab_notebooks(), trust=True) as url:
-        yield url
+    """JupyterLab on a copy of the notebooks, trusted and with notebooks/.lab-settings/ (what `make lab` does), plus
+    a copy of notebook 05 that nobody trusted (opened without `make lab`): one server for both."""
+    work = tmp_path_factory.mktemp("lab")
+    with labdriver.jupyterlab(work, _lab_notebooks(), trust=True, untrusted=(UNTRUSTED_05.split("/")[1],)) as url:
+        try:
+            yield url
+        finally:
+            app = _APPS.pop(url, None)
+            if app is not None:
+                try:
+                    app.quit()
+                except Exception:  # the run's chromium may be stopped already (tests/conftest.py)
+                    pass
 
 
-@pytest.fixture(scope="module")
-def lab_untrusted(tmp_path_factory):
-    """JupyterLab on a copy of the notebooks that nobody trusted (opened without `make lab`)."""
-    with labdriver.jupyterlab(tmp_path_factory.mktemp("lab-untrusted"), _lab_notebooks(), trust=False) as url:
-        yield url
+#: the JupyterLab page of each server (labdriver.Lab: the front end loaded once, the notebooks opened in turn)
+_APPS: dict = {}
+
+
+def _app(browser, url) -> labdriver.Lab:
+    app = _APPS.get(url)
+    if app is None or app.browser is not browser:
+        app = _APPS[url] = labdriver.Lab(browser, url)
+    return app
 
 
 def test_make_lab_trusts_the_notebooks_and_uses_the_project_settings():
@@ -388,21 +445,22 @@ def test_make_lab_trusts_the_notebooks_and_uses_the_project_settings():
 
 def _no_text_reprs(page):
     """No widget or animation shown as its text repr (`Explorer(children=…`, `<…Animation object…>`)."""
-    text = page.locator(".jp-OutputArea-output[data-mime-type='text/plain']").evaluate_all(
+    text = page.locator(f"{labdriver.CURRENT} .jp-OutputArea-output[data-mime-type='text/plain']").evaluate_all(
         "els => els.map(e => e.textContent).join('\\n')"
     )
     for bad in ("Explorer(children", "ConfigPicker(children", "VBox(children", "Animation object"):
         assert bad not in text, f"a widget is shown as text: {bad}…"
-    assert page.get_by_text("Error displaying widget").count() == 0
+    assert page.locator(labdriver.CURRENT).get_by_text("Error displaying widget").count() == 0
 
 
-#: notebook 05's page once its test below has run it (the next test goes on in it: one run-all, not two)
-_RUN_05: dict = {}
+#: notebook 05 left open (and run) by its test below, per server: the next test goes on in it (one run-all, not two)
+_RUN_05: set = set()
 
 
 @pytest.mark.parametrize("stem", REAL)
 def test_lab_notebook_opens_with_pictures_runs_and_its_explorers_move(browser, lab, stem):
-    page, watch = labdriver.open_notebook(browser, lab, stem)
+    app = _app(browser, lab)
+    page, watch = app.open(stem)
     keep = False
     try:
         # 1. opened fresh, not run: every widget and animation shows its saved picture
@@ -446,10 +504,10 @@ def test_lab_notebook_opens_with_pictures_runs_and_its_explorers_move(browser, l
         assert not watch.errors, f"page errors: {[e[-300:] for e in watch.errors[:3]]}"
         keep = stem == "05_singularities_planar"
         if keep:
-            _RUN_05[lab] = (page, watch)
+            _RUN_05.add(lab)
     finally:
         if not keep:
-            labdriver.close_notebook(page)
+            app.close(stem)
 
 
 def _numbers(text: str) -> list[float]:
@@ -462,10 +520,12 @@ def test_lab_05_explorer_at_a_singular_configuration(browser, lab):
     the test above opened and ran (run alone, it opens and runs the notebook itself)."""
     stem = "05_singularities_planar"
     assert stem in REAL, "notebooks/05_singularities_planar.ipynb is missing"
-    if lab in _RUN_05:
-        page, watch = _RUN_05.pop(lab)
+    app = _app(browser, lab)
+    if lab in _RUN_05 and stem in app.ids:
+        _RUN_05.discard(lab)
+        page, watch = app.activate(stem)
     else:
-        page, watch = labdriver.open_notebook(browser, lab, stem)
+        page, watch = app.open(stem)
         labdriver.run_all(page)
     try:
         explorers = labdriver.explorers(page)
@@ -504,15 +564,28 @@ def test_lab_05_explorer_at_a_singular_configuration(browser, lab):
         assert not watch.blocked, f"JupyterLab tried to reach the network: {watch.blocked[:5]}"
         assert not watch.errors, f"page errors: {[e[-300:] for e in watch.errors[:3]]}"
     finally:
-        labdriver.close_notebook(page)
+        app.close(stem)
 
 
-def test_untrusted_notebook_shows_static_pictures(browser, lab_untrusted):
-    """Opened without `make lab` (not trusted), JupyterLab cannot draw widgets; the explorer's and the
-    animation's display bundles carry a static image/png, which it shows instead of the text repr."""
+_ANY_CODE_CELL_TRUSTED = """() => {
+  const cells = window.jupyterapp.shell.currentWidget.content.model.cells;
+  let n = 0, trusted = false;
+  for (let i = 0; i < cells.length; i++)
+    if (cells.get(i).type === 'code') { n += 1; trusted = trusted || !!cells.get(i).trusted; }
+  return n ? trusted : null;
+}"""
+
+
+def test_untrusted_notebook_shows_static_pictures(browser, lab):
+    """Opened without `make lab` (not trusted: a copy of notebook 05 nobody signed), JupyterLab cannot draw widgets;
+    the explorer's and the animation's display bundles carry a static image/png, which it shows instead of the
+    text repr."""
     stem = "05_singularities_planar"
     assert stem in REAL, "notebooks/05_singularities_planar.ipynb is missing"
-    page, watch = labdriver.open_notebook(browser, lab_untrusted, stem)
+    app = _app(browser, lab)
+    page, watch = app.open(UNTRUSTED_05)
+    trusted = page.evaluate(_ANY_CODE_CELL_TRUSTED)
+    assert trusted is False, "the copy of notebook 05 is trusted"
     try:
         areas = labdriver.widget_cells(page)
         assert areas, "notebook 05 has no widget output"
@@ -525,4 +598,4 @@ def test_untrusted_notebook_shows_static_pictures(browser, lab_untrusted):
         _no_text_reprs(page)
         assert not watch.blocked, f"JupyterLab tried to reach the network: {watch.blocked[:5]}"
     finally:
-        labdriver.close_notebook(page)
+        app.close(UNTRUSTED_05)
