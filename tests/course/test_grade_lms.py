@@ -426,6 +426,17 @@ def _check_after(r, mark):
     assert all(" as uid 0" not in x for x in leaks), leaks  # as the student's user, never root
 
 
+def _check_compiled(site: Path):
+    """setup.sh byte-compiled what a kernel imports (the kernels run with -B, as a user who cannot write the venv:
+    a module without its .pyc would be compiled again in each), the bundle's kinlib too; the test suites left out."""
+    for mod in ("sympy/core/basic", "sympy/matrices/dense", "numpy/linalg/_linalg", "kinlib/poe", "kinlib/jacobians"):
+        folder, name = (site / mod).parent, (site / mod).name
+        assert (folder / f"{name}.py").is_file() and list((folder / "__pycache__").glob(f"{name}.*.pyc")), mod
+    assert (site / "sympy" / "core" / "tests").is_dir() and not list(
+        (site / "sympy" / "core" / "tests").glob("__pycache__/*.pyc")
+    )
+
+
 @pytest.mark.slow
 @needs_bwrap
 def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
@@ -445,9 +456,9 @@ def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
     # Gradescope: setup.sh once (building the image), run_autograder copied to /autograder
     r = box.run("bash /autograder/source/setup.sh && cp /autograder/source/run_autograder /autograder/")
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
-    assert not (
-        tmp_path / "ag" / "venv" / "lib" / "python3.11" / "site-packages" / "kinlib" / "__init__.py"
-    ).is_symlink()
+    site = tmp_path / "ag" / "venv" / "lib" / "python3.11" / "site-packages"
+    assert not (site / "kinlib" / "__init__.py").is_symlink()
+    _check_compiled(site)
     sub, res = tmp_path / "ag" / "submission", tmp_path / "ag" / "results" / "results.json"
     nbs = six["nbs"]
 
@@ -514,6 +525,7 @@ def test_prairielearn_bundle_in_its_own_image(tmp_path, six):
     shutil.copytree(out / "image", tmp_path / "opt-kinlib" / "image")
     r = box.run("KINLIB_VENV=/opt/kinlib/venv bash /opt/kinlib/image/setup.sh")
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-3000:]
+    _check_compiled(tmp_path / "opt-kinlib" / "venv" / "lib" / "python3.11" / "site-packages")
     shutil.copytree(out / "serverFilesCourse", tmp_path / "grade" / "serverFilesCourse")
     sub, res = tmp_path / "grade" / "student", tmp_path / "grade" / "results" / "results.json"
     nbs = six["nbs"]
