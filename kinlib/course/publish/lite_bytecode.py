@@ -9,8 +9,9 @@ needed) as *unchecked-hash* pycs (PEP 552: used as they are, whatever the files'
 sources stay (tracebacks show their lines); ``tests/`` folders are not compiled. Each wheel keeps its file name;
 its ``RECORD`` lists the added files; the site's ``pyodide-lock.json`` carries the new sha256
 (:func:`kinlib.course.publish.lite.build_lite`). The source of a pinned wheel is verified before it is compiled,
-and compiled wheels are cached by the source's sha256. Without ``node`` the wheels go in as they are (slower
-first imports, nothing else changes), and the build says so.
+and compiled wheels are cached by the source's sha256 (``$KINLIB_CACHE/lite/pyc-0.27.7/``: the build's own output,
+trusted as ``build/`` is; delete the folder to compile again). Without ``node`` the wheels go in as they are
+(slower first imports, nothing else changes), and the build says so.
 """
 
 from __future__ import annotations
