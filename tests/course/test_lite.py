@@ -105,6 +105,41 @@ def test_the_site_lock_keeps_what_is_shipped_and_refuses_a_missing_dependency():
         lite.site_lock(official, ["numpy"], {"kinlib": {"name": "kinlib", "depends": ["numpy", "ipywidgets"]}})
 
 
+def test_a_compiled_wheel_keeps_its_members_and_records_its_bytecode(tmp_path):
+    """lite_bytecode's repacking (the compiling itself runs in Pyodide: the built site's test checks it)."""
+    import base64
+    import zipfile
+
+    from kinlib.course.publish import lite_bytecode
+
+    wheel = tmp_path / "pkg-1.0-py3-none-any.whl"
+    with zipfile.ZipFile(wheel, "w") as z:
+        z.writestr("pkg/__init__.py", "x = 1\n")
+        z.writestr("pkg-1.0.dist-info/RECORD", "pkg/__init__.py,sha256=abc,6\npkg-1.0.dist-info/RECORD,,\n")
+    tree = tmp_path / "tree"
+    (tree / "pkg" / "__pycache__").mkdir(parents=True)
+    (tree / "pkg" / "__pycache__" / "__init__.cpython-312.pyc").write_bytes(b"bytecode")
+    out = tmp_path / "out.whl"
+    lite_bytecode._repack(wheel, tree, out)
+    with zipfile.ZipFile(out) as z:
+        assert z.read("pkg/__init__.py") == b"x = 1\n"
+        assert z.read("pkg/__pycache__/__init__.cpython-312.pyc") == b"bytecode"
+        record = z.read("pkg-1.0.dist-info/RECORD").decode().splitlines()
+    digest = base64.urlsafe_b64encode(hashlib.sha256(b"bytecode").digest()).rstrip(b"=").decode()
+    assert record == [
+        "pkg/__init__.py,sha256=abc,6",
+        f"pkg/__pycache__/__init__.cpython-312.pyc,sha256={digest},8",
+        "pkg-1.0.dist-info/RECORD,,",
+    ]
+    assert lite_bytecode.compile_wheels([], tmp_path) == {}
+    # no node: nothing compiled, the build goes on with the wheels as they are and says so
+    said = []
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(lite_bytecode.shutil, "which", lambda name: None)
+        assert lite_bytecode.compile_wheels([wheel], tmp_path, log=said.append) == {}
+    assert said and "no node" in said[0], said
+
+
 # ---------------------------------------------------------------------------------------------------
 # links and serving
 
@@ -268,25 +303,13 @@ def time_to_first_result(handouts: Path, browser=None, moves: int = 0):
     The site is served from a hard-linked copy whose ``jupyter-lite.json`` exposes the app to the driver.
     With ``moves``: the pair (seconds, [ms]) where [ms] are ``moves`` key presses on θ1 of the first explorer,
     each timed from the keydown to the frame that shows the redrawn picture (labdriver.move_slider)."""
-    import os
     import tempfile
 
     import labdriver
 
     with tempfile.TemporaryDirectory(prefix="kinlib-ttfr-") as tmp:
         site = Path(tmp) / "handouts"
-
-        def link(src, dst):  # hard links where the file system allows, else copies
-            try:
-                os.link(src, dst)
-            except OSError:
-                shutil.copy2(src, dst)
-
-        shutil.copytree(Path(handouts), site, copy_function=link)
-        cfg = site / "lite" / "jupyter-lite.json"
-        text = cfg.read_text()
-        cfg.unlink()  # a new file: never write through the hard link into the real site
-        cfg.write_text(text)
+        _linked_copy(Path(handouts), site)  # its jupyter-lite.json a new file: never written through the link
         expose_app(site)
         server = lite.serve(site, 0, block=False)
         base = f"http://127.0.0.1:{server.server_address[1]}/"
@@ -340,7 +363,9 @@ def explorer(page, timeout: float = 120):
     assert i >= 0, "the notebook shows no explorer (no `widgets.explorer(` cell with a widget output)"
     area = page.locator(f"[data-kinlib-explorer='{i}'] .jp-OutputArea").first
     area.locator(".jupyter-widgets, .kinlib-explorer").first.wait_for(state="visible", timeout=timeout * 1000)
-    assert labdriver_explorer_text() in area.text_content(), "the explorer's widget did not render"
+    import labdriver
+
+    assert labdriver.EXPLORER_TEXT in area.text_content(), "the explorer's widget did not render"
     return area
 
 
@@ -368,12 +393,6 @@ def drag(page, area, handle, dx: float = 25, timeout: float = 120) -> float:
     page.mouse.up()
     page.wait_for_function(_NEW_PICTURE, arg=[area.element_handle(), before], timeout=timeout * 1000, polling=50)
     return page.evaluate("() => performance.now()") - t0
-
-
-def labdriver_explorer_text() -> str:
-    import labdriver
-
-    return labdriver.EXPLORER_TEXT
 
 
 @pytest.fixture(scope="module")
@@ -405,89 +424,118 @@ def _linked_copy(src: Path, dest: Path) -> None:
     cfg.write_text(text)
 
 
+@pytest.fixture(scope="module")
+def site_base(handouts_site):
+    """The site served on loopback for the module (one server: a page kept by one test stays usable by the
+    next, ``kept_kernel``): its base URL."""
+    server = lite.serve(handouts_site, 0, block=False)
+    try:
+        yield f"http://127.0.0.1:{server.server_address[1]}/"
+    finally:
+        server.shutdown()
+        server.server_close()
+
+
+@pytest.fixture(scope="module")
+def kept_kernel():
+    """A JupyterLite page whose Pyodide kernel a test of this module is done with, handed to the next test that
+    runs notebooks (``run_solutions``) so that one kernel start serves both: {"open": (context, page,
+    blocker)} once kept; whoever takes it closes it (else it is closed here)."""
+    kept: dict = {}
+    yield kept
+    if "open" in kept:
+        try:
+            kept.pop("open")[0].close()
+        except Exception:  # the run's chromium may already be stopped (tests/conftest.py)
+            pass
+
+
 @pytest.mark.browser
 @pytest.mark.slow
-def test_workbook_05_runs_offline_in_jupyterlite(handouts_site, shared_browser):
+def test_workbook_05_runs_offline_in_jupyterlite(handouts_site, site_base, kept_kernel, shared_browser):
+    """Workbook 05 as a student opens it: Run All offline, a self-check, an explorer by mouse and keyboard. Its
+    kernel, once done, is kept for the solution notebooks (``kept_kernel``; they start from a fresh namespace):
+    one Pyodide start in Chromium for the module."""
     import labdriver
 
     site = handouts_site
     size = sum(p.stat().st_size for p in (site / "lite").rglob("*") if p.is_file())
     print(f"site: {size / 1e6:.0f} MB")
-    server = lite.serve(site, 0, block=False)
-    base = f"http://127.0.0.1:{server.server_address[1]}/"
-    try:
-        with nullcontext(shared_browser) as browser:  # the run's one chromium (tests/conftest.py)
-            context, page, blocker, ready = open_workbook(browser, base)
-            errors = []
-            page.on("pageerror", lambda e: errors.append(str(e)))
-            try:
-                # 1. every cell runs (nothing raises), with nothing fetched from outside the site; the page
-                # notes when its first picture appears (run-all at once on the kernel idle, as
-                # time_to_first_result measures it for `make bench`: printed, not asserted)
-                page.evaluate(_WATCH_FIRST_PICTURE)
-                seconds = labdriver.run_all(page, timeout=300)
-                done = page.evaluate("() => performance.now()") / 1000
-                print(f"kernel ready {ready:.1f} s after page load; run-all {seconds:.1f} s (done at {done:.1f} s)")
+    base = site_base
+    with nullcontext(shared_browser) as browser:  # the run's one chromium (tests/conftest.py)
+        context, page, blocker, ready = open_workbook(browser, base)
+        errors = []
+        page.on("pageerror", lambda e: errors.append(str(e)))
+        keep = False
+        try:
+            # 1. every cell runs (nothing raises), with nothing fetched from outside the site; the page
+            # notes when its first picture appears (run-all at once on the kernel idle, as
+            # time_to_first_result measures it for `make bench`: printed, not asserted)
+            page.evaluate(_WATCH_FIRST_PICTURE)
+            seconds = labdriver.run_all(page, timeout=300)
+            done = page.evaluate("() => performance.now()") / 1000
+            print(f"kernel ready {ready:.1f} s after page load; run-all {seconds:.1f} s (done at {done:.1f} s)")
 
-                # 2. a student fills one answer (5.1, det J) and its self-check says so
-                cell = labdriver.output_of(page, "detJ = ...")
-                assert cell is not None, "workbook 05 has no `detJ = ...` stub"
-                page.evaluate(
-                    """() => {
-                      const w = window.jupyterapp.shell.currentWidget;
-                      const i = w.content.widgets.findIndex(c => c.model.sharedModel.getSource().includes('detJ = ...'));
-                      w.content.widgets[i].model.sharedModel.setSource(
-                        'th1, th2, th3 = robot.thetas\\n(L,) = robot.params\\n'
-                        + 'detJ = sp.sqrt(2) * L**2 * sp.sin(th2 + sp.pi / 4)\\n');
-                      w.content.activeCellIndex = i;
-                      const j = w.content.widgets.findIndex(c => c.model.sharedModel.getSource().includes('check("5.1"'));
-                      w.content.widgets.forEach((c, k) => { if (k === i || k === j) w.content.select(c); });
-                      return window.jupyterapp.commands.execute('notebook:run-cell');
-                    }"""
-                )
-                check = labdriver.output_of(page, 'check("5.1"')
-                page.wait_for_function(
-                    "(root) => /detJ:[^\\n]*correct/.test(root.innerText) && !/detJ:[^\\n]*not answered/.test(root.innerText)",
-                    arg=check.element_handle(),
-                    timeout=60000,
-                    polling=200,
-                )
-                text = check.inner_text()
-                line = next(s for s in text.splitlines() if "detJ" in s)
-                assert "not right" not in line and "correct" in line, text
-                labdriver.scroll_to(check)
-                SCREENSHOTS.mkdir(parents=True, exist_ok=True)
-                check.screenshot(path=str(SCREENSHOTS / "lite-05-selfcheck.png"))
+            # 2. a student fills one answer (5.1, det J) and its self-check says so
+            cell = labdriver.output_of(page, "detJ = ...")
+            assert cell is not None, "workbook 05 has no `detJ = ...` stub"
+            page.evaluate(
+                """() => {
+                  const w = window.jupyterapp.shell.currentWidget;
+                  const i = w.content.widgets.findIndex(c => c.model.sharedModel.getSource().includes('detJ = ...'));
+                  w.content.widgets[i].model.sharedModel.setSource(
+                    'th1, th2, th3 = robot.thetas\\n(L,) = robot.params\\n'
+                    + 'detJ = sp.sqrt(2) * L**2 * sp.sin(th2 + sp.pi / 4)\\n');
+                  w.content.activeCellIndex = i;
+                  const j = w.content.widgets.findIndex(c => c.model.sharedModel.getSource().includes('check("5.1"'));
+                  w.content.widgets.forEach((c, k) => { if (k === i || k === j) w.content.select(c); });
+                  return window.jupyterapp.commands.execute('notebook:run-cell');
+                }"""
+            )
+            check = labdriver.output_of(page, 'check("5.1"')
+            page.wait_for_function(
+                "(root) => /detJ:[^\\n]*correct/.test(root.innerText) && !/detJ:[^\\n]*not answered/.test(root.innerText)",
+                arg=check.element_handle(),
+                timeout=60000,
+                polling=200,
+            )
+            text = check.inner_text()
+            line = next(s for s in text.splitlines() if "detJ" in s)
+            assert "not right" not in line and "correct" in line, text
+            labdriver.scroll_to(check)
+            SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+            check.screenshot(path=str(SCREENSHOTS / "lite-05-selfcheck.png"))
 
-                # 3. an explorer: drag θ1 and the picture changes
-                ex = explorer(page)
-                labdriver.wait_picture(ex, timeout=120, what="the explorer in JupyterLite")
-                before = ex.evaluate(_PICTURE_NOW)
-                _slider, handle, readout = labdriver.slider(ex, "θ1")
-                value = readout.inner_text()
-                ms = drag(page, ex, handle)
-                assert readout.inner_text() != value, "the slider did not move"
-                assert ex.evaluate(_PICTURE_NOW) != before, "the picture did not change"
-                print(f"slider move → new picture {ms:.0f} ms")
-                # and from the keyboard, as in JupyterLab (the site drops the ←/→ heading bindings that would
-                # take the keys first: lite.SETTINGS_OVERRIDES)
-                for key in ("ArrowRight", "ArrowLeft"):
-                    value, before = readout.inner_text(), ex.evaluate(_PICTURE_NOW)
-                    handle.focus()
-                    handle.press(key)
-                    page.wait_for_function(_NEW_PICTURE, arg=[ex.element_handle(), before], timeout=120000)
-                    assert readout.inner_text() != value, f"{key} on the focused slider did not move it"
-                ex.screenshot(path=str(SCREENSHOTS / "lite-05-explorer.png"))
-                assert not errors, f"page errors: {errors[:3]}"
-                first = page.evaluate("() => window.__kinlibFirstPicture")
-                first = "(none seen)" if first is None else f"{first / 1000:.1f}"
-            finally:
+            # 3. an explorer: drag θ1 and the picture changes
+            ex = explorer(page)
+            labdriver.wait_picture(ex, timeout=120, what="the explorer in JupyterLite")
+            before = ex.evaluate(_PICTURE_NOW)
+            _slider, handle, readout = labdriver.slider(ex, "θ1")
+            value = readout.inner_text()
+            ms = drag(page, ex, handle)
+            assert readout.inner_text() != value, "the slider did not move"
+            assert ex.evaluate(_PICTURE_NOW) != before, "the picture did not change"
+            print(f"slider move → new picture {ms:.0f} ms")
+            # and from the keyboard, as in JupyterLab (the site drops the ←/→ heading bindings that would
+            # take the keys first: lite.SETTINGS_OVERRIDES)
+            for key in ("ArrowRight", "ArrowLeft"):
+                value, before = readout.inner_text(), ex.evaluate(_PICTURE_NOW)
+                handle.focus()
+                handle.press(key)
+                page.wait_for_function(_NEW_PICTURE, arg=[ex.element_handle(), before], timeout=120000)
+                assert readout.inner_text() != value, f"{key} on the focused slider did not move it"
+            ex.screenshot(path=str(SCREENSHOTS / "lite-05-explorer.png"))
+            assert not errors, f"page errors: {errors[:3]}"
+            first = page.evaluate("() => window.__kinlibFirstPicture")
+            first = "(none seen)" if first is None else f"{first / 1000:.1f}"
+            keep = True
+        finally:
+            if keep:  # every check passed: the kernel serves the solution notebooks next
+                kept_kernel["open"] = (context, page, blocker)
+            else:
                 context.close()
-            assert not blocker.blocked, f"the site asked for {len(blocker.blocked)} outside URLs: {blocker.blocked[:5]}"
-            print(f"time to first result (page load → first picture, run-all at once): {first} s")
-    finally:
-        server.shutdown()
-        server.server_close()
+        assert not blocker.blocked, f"the site asked for {len(blocker.blocked)} outside URLs: {blocker.blocked[:5]}"
+        print(f"time to first result (page load → first picture, run-all at once): {first} s")
 
 
 SOLUTIONS = sorted(p.stem for p in NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
@@ -513,18 +561,22 @@ _LOAD_NOTEBOOK = """async ([path, fresh]) => {
 }"""
 
 
-def run_solutions(browser, base: str, stems, timeout: float = 400) -> dict:
+def run_solutions(browser, base: str, stems, timeout: float = 400, kept=None) -> dict:
     """Run the solution notebooks ``stems`` of the site served at ``base`` top to bottom, all in one page and
-    one Pyodide kernel: the first opened as a student opens it, each next one loaded from the site into that
-    notebook (its cells and outputs) and run after the kernel's namespace is made fresh (``_FRESH_NAMESPACE``).
-    Returns {stem: {"error": None or what failed, "blocked": [outside URLs asked for], "ready": seconds from the
-    page load to the kernel idle (the first notebook of a page, else 0), "run": run-all seconds}}. A notebook
-    that times out or leaves the kernel unusable costs only itself: the next one opens in a new page."""
+    one Pyodide kernel: the first opened as a student opens it (or, with ``kept`` = (context, page, blocker),
+    loaded into that open page of the site, whose kernel another test is done with), each next one loaded from
+    the site into that notebook (its cells and outputs) and run after the kernel's namespace is made fresh
+    (``_FRESH_NAMESPACE``). Returns {stem: {"error": None or what failed, "blocked": [outside URLs asked for],
+    "ready": seconds from the page load to the kernel idle (the first notebook of a page, else 0), "run":
+    run-all seconds}}. A notebook that times out or leaves the kernel unusable costs only itself: the next one
+    opens in a new page. The page is closed at the end."""
     from playwright.sync_api import Error as PlaywrightError
 
     import labdriver
 
     results, context = {}, None
+    if kept is not None:
+        context, page, blocker = kept
     try:
         for stem in stems:
             r = results[stem] = {"error": None, "blocked": [], "ready": 0.0, "run": None}
@@ -555,10 +607,11 @@ def run_solutions(browser, base: str, stems, timeout: float = 400) -> dict:
 
 
 @pytest.fixture(scope="module")
-def solutions_in_the_browser(request, handouts_site):
+def solutions_in_the_browser(request, site_base, kept_kernel):
     """The solution notebooks run in the site (``run_solutions``: one Pyodide kernel for all of them, not one
-    per notebook), once for the module: every stem this run's ``test_solution_notebook_runs_in_the_browser``
-    items ask for, run when the first of them asks. Returns ``get(browser, stem)`` -> that stem's result."""
+    per notebook; the kernel workbook 05's test kept, when it ran and passed), once for the module: every stem
+    this run's ``test_solution_notebook_runs_in_the_browser`` items ask for, run when the first of them asks.
+    Returns ``get(browser, stem)`` -> that stem's result."""
     wanted = [
         item.callspec.params["stem"]
         for item in request.session.items
@@ -571,12 +624,7 @@ def solutions_in_the_browser(request, handouts_site):
     def get(browser, stem):
         if stem not in results:
             stems = [s for s in SOLUTIONS if (s in wanted or s == stem) and s not in results]
-            server = lite.serve(handouts_site, 0, block=False)
-            try:
-                results.update(run_solutions(browser, f"http://127.0.0.1:{server.server_address[1]}/", stems))
-            finally:
-                server.shutdown()
-                server.server_close()
+            results.update(run_solutions(browser, site_base, stems, kept=kept_kernel.pop("open", None)))
         return results[stem]
 
     return get
@@ -616,6 +664,17 @@ def test_the_built_site_holds_only_verified_pinned_files(built_site):
         lite.verify_file(pyo / fn, sha)
     for f in pyo.iterdir():
         assert f.name in shipped or f.name in lite.CORE_FILES, f"unpinned file in the site: {f.name}"
+    # the wheels carry their bytecode, compiled by the site's own Pyodide (lite_bytecode): CPython 3.12's magic
+    # number (3531), unchecked-hash pycs (PEP 552 flags 0b01), listed in RECORD; the sources stay
+    import zipfile
+
+    with zipfile.ZipFile(pyo / lock["packages"]["sympy"]["file_name"]) as z:
+        names = set(z.namelist())
+        pyc = z.read("sympy/__pycache__/__init__.cpython-312.pyc")
+        record = z.read(next(n for n in names if n.endswith(".dist-info/RECORD"))).decode()
+    assert pyc[:4] == (3531).to_bytes(2, "little") + b"\r\n" and int.from_bytes(pyc[4:8], "little") == 0b01
+    assert "sympy/__init__.py" in names and "sympy/__pycache__/__init__.cpython-312.pyc," in record
+    assert not any("/tests/__pycache__/" in n for n in names), "sympy's tests were compiled"
     # the notebooks open on the Pyodide kernel
     nb = json.loads((site / "files" / "solutions" / "05_singularities_planar.ipynb").read_text())
     assert nb["metadata"]["kernelspec"]["name"] == "python"

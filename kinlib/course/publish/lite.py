@@ -537,6 +537,7 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
         copy_lock_files(official_entries, members, pyo)
         sources = {pure[n].name: pure[n] for n in pure} | {kinlib_whl.name: kinlib_whl}
         copy_lock_files({k: lock["packages"][k] for k in extra}, sources, pyo)
+        _with_bytecode(lock, pyo, pkg, cache, kinlib_whl.name, log)
         (pyo / "pyodide-lock.json").write_text(json.dumps(lock, indent=1))
         _favicons(site / "static" / "favicons")
 
@@ -553,6 +554,23 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
         f"in {time.perf_counter() - t0:.1f} s"
     )
     return target
+
+
+def _with_bytecode(lock: dict, pyo: Path, pkg: Path, cache: Path, own: str, log=print) -> None:
+    """Every wheel of the site (``pyo``, each verified) replaced by its copy with bytecode
+    (:func:`kinlib.course.publish.lite_bytecode.compile_wheels`, cached by the source's sha256 except ``own``,
+    kinlib's wheel of this build); ``lock`` gets the new sha256s."""
+    from .lite_bytecode import compile_wheels
+
+    entries = [e for e in lock["packages"].values() if e["file_name"].endswith(".whl")]
+    compiled = compile_wheels([pyo / e["file_name"] for e in entries], pkg, cache / f"pyc-{PYODIDE_VERSION}", log)
+    for e in entries:
+        src = pyo / e["file_name"]
+        if src in compiled:
+            shutil.copyfile(compiled[src], src)
+            e["sha256"] = _sha256(src)
+    if pyo / own in compiled:  # a new one each build: not kept
+        shutil.rmtree(compiled[pyo / own].parent, ignore_errors=True)
 
 
 # ---------------------------------------------------------------------------------------------------
