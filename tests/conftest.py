@@ -193,8 +193,12 @@ def pytest_collection_modifyitems(session, config, items):
     workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
     rank = {g: i for i, g in enumerate(_schedule(groups, needs_build, workers))}
     items.sort(key=lambda item: rank[group_of[item]])
-    if any(_needs_build(item) for item in items) and not config.option.collectonly:
-        _start_handouts_build(config)
+
+
+def pytest_collection_finish(session):
+    """The selected tests (after -k/-m) need the real handouts build: it starts now (``_start_handouts_build``)."""
+    if any(_needs_build(item) for item in session.items) and not session.config.option.collectonly:
+        _start_handouts_build(session.config)
 
 
 class _SharedChromium:
