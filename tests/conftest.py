@@ -17,8 +17,12 @@ collect_ignore = ["fixtures"]
 
 
 def pytest_configure(config):
-    """``KINLIB_COUNT_EXPENSIVE=counts.json``: count the expensive work per test module (tests/expensive_counter.py).
+    """Under pytest-xdist the groups are handed out in the order ``pytest_collection_modifyitems`` gives them
+    (``--no-loadscope-reorder``: xdist would otherwise sort them by their number of tests).
+    ``KINLIB_COUNT_EXPENSIVE=counts.json``: count the expensive work per test module (tests/expensive_counter.py).
     With nbval on: its items of notebooks/ read the run's handouts execution (tests/nbval_shared.py)."""
+    if hasattr(config.option, "loadscopereorder"):
+        config.option.loadscopereorder = False
     if config.pluginmanager.has_plugin("nbval") and (config.option.nbval or config.option.nbval_lax):
         from kinlib.course.publish.incremental import stamp_dir
         from nbval_shared import PLUGIN, SharedNotebookRuns
@@ -92,21 +96,102 @@ def _browser_module(item) -> bool:
     return item.get_closest_marker("browser") is not None and "shared_browser" in item.fixturenames
 
 
+# The schedule under pytest-xdist (``make test``: ``-n 2 --dist loadgroup``). A work unit is an xdist group: by
+# default a test file (its module fixtures are built once; nbval's cells of one notebook share one kernel, in order).
+# A few files are split where their parts share nothing expensive, so that both workers can run them at once:
+# the part of a file whose item ``_SPLIT[file](item)`` names is the group "file::part".
+_SPLIT = {
+    # JupyterLab (module fixtures ``lab``/``lab_untrusted``) vs the static pages (the run's handouts build)
+    "tests/pictures/test_browser.py": lambda item: "lab" if {"lab", "lab_untrusted"} & set(item.fixturenames) else "",
+    # the two heavy hypothesis properties (no fixtures) apart from each other and from the small tests
+    "tests/core/test_singular_sets.py": lambda item: (
+        item.originalname if item.originalname.startswith("test_random_") else ""
+    ),
+}
+
+# Seconds per group on an idle machine (issue 24's baseline /work/brief/D.log: ``--durations=0`` summed per group,
+# less the handouts build that one of them waited for), rounded. Only the order of the groups is read from it:
+# heavy groups first (longest processing time first: the two workers end close together), the others after them in
+# collection order. Stale numbers cost packing, never correctness; a group not listed counts 1 s. Refresh after a
+# big change from ``make test PYTEST_ARGS=--durations=0``.
+_SECONDS = {
+    "tests/course/test_grade_lms.py": 190,
+    "tests/course/test_lite.py": 155,
+    "tests/pictures/test_browser.py::lab": 115,
+    "tests/pictures/test_browser.py": 95,
+    "tests/core/test_singular_sets.py::test_random_bigger_arms": 85,
+    "tests/course/test_print.py": 75,
+    "tests/course/test_second_engine.py": 70,
+    "tests/core/test_velocity.py": 68,
+    "tests/course/test_handouts.py": 67,
+    "tests/course/test_grade_batch.py": 60,
+    "tests/core/test_singular_sets.py::test_random_arms_members_singular_nonmembers_not_and_nothing_missing": 43,
+    "tests/course/test_grade.py": 40,
+    "tests/course/test_grade_sandbox.py": 40,
+    "tests/core/test_exact_robustness.py": 33,
+    "tests/pictures/test_widgets.py": 29,
+    "tests/project/test_bench.py": 24,
+    "tests/course/test_grade_export.py": 15,
+    "tests/core/test_exact_rank.py": 15,
+    "tests/core/test_display.py": 14,
+    "tests/course/test_grade_verdicts.py": 14,
+    "tests/project/test_doctests.py": 14,
+    "tests/course/test_course_cli.py": 12,
+    "tests/core/test_singular_sets.py": 6,
+}
+# The groups that need the run's real handouts build (it starts in the background at the start of the run:
+# ``_start_handouts_build``) wait until about this much work (seconds, per worker) was handed out before them, so
+# that no worker starts by waiting for the build; after that, all groups go longest first.
+_BUILD_HEADSTART = 200
+
+
+def _group(item) -> str:
+    path = item.nodeid.split("::")[0]
+    part = _SPLIT[path](item) if path in _SPLIT and hasattr(item, "originalname") else ""
+    return f"{path}::{part}" if part else path
+
+
+def _needs_build(item) -> bool:
+    return "real_handouts" in getattr(item, "fixturenames", ()) or type(item).__name__ == "SharedCell"
+
+
+def _schedule(groups: list, needs_build: set, workers: int) -> list:
+    """The groups (in collection order) in the order to hand them out: longest first (``_SECONDS``), except that
+    the groups in ``needs_build`` come only after ``_BUILD_HEADSTART`` seconds per worker of the others.
+
+    >>> lite, lms, velocity = "tests/course/test_lite.py", "tests/course/test_grade_lms.py", "tests/core/test_velocity.py"
+    >>> _schedule(["a", lite, velocity, lms], {lite}, 1)  # lite waits for 190 + 68 s of others, then before "a"
+    ['tests/course/test_grade_lms.py', 'tests/core/test_velocity.py', 'tests/course/test_lite.py', 'a']
+    """
+    by_time = sorted(groups, key=lambda g: -_SECONDS.get(g, 1))  # stable: collection order among equals
+    free = [g for g in by_time if g not in needs_build]
+    held = [g for g in by_time if g in needs_build]
+    out, ahead = [], 0
+    while free or held:
+        released = ahead >= _BUILD_HEADSTART * workers or not free
+        if held and released and (not free or _SECONDS.get(held[0], 1) >= _SECONDS.get(free[0], 1)):
+            out.append(held.pop(0))
+        else:
+            g = free.pop(0)
+            out.append(g)
+            ahead += _SECONDS.get(g, 1)
+    return out
+
+
 @pytest.hookimpl(tryfirst=True)
 def pytest_collection_modifyitems(session, config, items):
-    """The modules that use the shared chromium run last, one after the other (a stable sort: each module's tests
-    keep their order), so that one playwright session serves them all and is stopped after the last one.
+    """Groups the items for pytest-xdist and orders them (see ``_SPLIT``, ``_SECONDS``, ``_schedule``).
 
-    Under pytest-xdist (``make test``: TEST_JOBS=2 by default, ``--dist loadgroup``) every file is a group, run whole by one
-    worker (its module fixtures are built once; nbval's cells of one notebook share one kernel, in order), and
-    the browser modules are one group together (one chromium, one worker)."""
+    Under pytest-xdist (``make test``: TEST_JOBS=2 by default, ``--dist loadgroup``) each group is run whole by one
+    worker, the groups handed out in the order of the items (xdist's own reordering, by number of tests, is off:
+    ``pytest_configure``). Each browser module is a group of its own: a worker starts its own chromium for it
+    (``shared_browser``), kept while its next test is in a browser module too, stopped before any other test.
+    Without xdist the same order is kept."""
     browser_modules = {item.module.__name__ for item in items if hasattr(item, "module") and _browser_module(item)}
     _BROWSER_MODULES.update(browser_modules)
+    group_of = {item: _group(item) for item in items}
     for item in items:
-        if hasattr(item, "module") and item.module.__name__ in browser_modules:
-            item.add_marker(pytest.mark.xdist_group("browser"))
-        else:
-            item.add_marker(pytest.mark.xdist_group(item.nodeid.split("::")[0]))
+        item.add_marker(pytest.mark.xdist_group(group_of[item]))
     if getattr(config.option, "loadgroup", False) and hasattr(items[0] if items else None, "_id"):
         # pytest-xdist 3.8 marks a group by appending "@group" to item._nodeid, which pytest 9 no longer reads
         # (Node.nodeid is str(item._id)): done here, as xdist would, so that --dist loadgroup groups
@@ -114,7 +199,19 @@ def pytest_collection_modifyitems(session, config, items):
             group = item.get_closest_marker("xdist_group").args[0]
             if not item.nodeid.endswith(f"@{group}"):
                 item._id = type(item._id).parse(f"{item.nodeid}@{group}")
-    items.sort(key=lambda item: hasattr(item, "module") and item.module.__name__ in browser_modules)
+    groups = list(dict.fromkeys(group_of.values()))
+    needs_build = {group_of[item] for item in items if _needs_build(item)}
+    if "tests/pictures/test_browser.py" in groups:  # its static pages read the build (``sites``: getfixturevalue)
+        needs_build.add("tests/pictures/test_browser.py")
+    workers = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+    rank = {g: i for i, g in enumerate(_schedule(groups, needs_build, workers))}
+    items.sort(key=lambda item: rank[group_of[item]])
+
+
+def pytest_collection_finish(session):
+    """The selected tests (after -k/-m) need the real handouts build: it starts now (``_start_handouts_build``)."""
+    if any(_needs_build(item) for item in session.items) and not session.config.option.collectonly:
+        _start_handouts_build(session.config)
 
 
 class _SharedChromium:
@@ -181,8 +278,9 @@ def _lock(path: Path):
 def _vendor_once(tmp_path_factory):
     """Under pytest-xdist: the npm packages of the pages (build/vendor, fetched once: kinlib.course.publish.npm)
     are fetched and unpacked by one worker at a time, before any test, so that two workers never unpack into one
-    folder. (A serial run needs nothing: the first build fetches them.)"""
-    if os.environ.get("PYTEST_XDIST_WORKER"):
+    folder, nor into the folder the background handouts build (``_start_handouts_build``) unpacks them into. (A
+    serial run without the background build needs nothing: the first build fetches them.)"""
+    if os.environ.get("PYTEST_XDIST_WORKER") or _BACKGROUND:
         from kinlib.course.publish.pages import build_assets
 
         with _lock(ROOT / "build" / ".vendor.lock"):
@@ -230,6 +328,60 @@ def _build_real_handouts() -> tuple[Path, frozenset]:
     return out, frozenset(mark["executed"])
 
 
+_BACKGROUND: list = []  # the background build's process (``_start_handouts_build``)
+
+
+def _start_handouts_build(config) -> None:
+    """Starts the run's real handouts build at once, in a process of its own (``python tests/conftest.py``:
+    ``_background_build``), so that it runs while both workers run the tests that do not need it: started by
+    one process per run (the first xdist worker, or a run without xdist). It takes the same lock and writes the
+    same mark as ``_build_real_handouts``: whoever asks for the build afterwards waits for it and reads it, and a
+    build the background process did not finish (failed, killed) is made by the next one who asks, with its
+    error. Ended at the end of the run if still running."""
+    if os.environ.get("KINLIB_HANDOUTS_DIR") or os.environ.get("PYTEST_XDIST_WORKER", "gw0") != "gw0" or _BACKGROUND:
+        return
+    import subprocess
+
+    log = ROOT / "build" / ".handouts-background.log"
+    log.parent.mkdir(parents=True, exist_ok=True)
+    with open(log, "w") as out:
+        _BACKGROUND.append(
+            subprocess.Popen(
+                [sys.executable, str(Path(__file__)), _RUN],
+                cwd=ROOT,
+                stdin=subprocess.DEVNULL,
+                stdout=out,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,  # its kernels and children end with it (``pytest_unconfigure``)
+            )
+        )
+
+
+def pytest_unconfigure(config):
+    for proc in _BACKGROUND:
+        if proc.poll() is None:
+            import signal
+
+            os.killpg(proc.pid, signal.SIGTERM)
+            try:
+                proc.wait(30)
+            except Exception:
+                os.killpg(proc.pid, signal.SIGKILL)
+                proc.wait()
+
+
+def _background_build() -> None:
+    """The background build (``_start_handouts_build``): the pages' npm packages first, under their lock
+    (``_vendor_once``), then the real handouts build under its lock."""
+    import tempfile
+
+    from kinlib.course.publish.pages import build_assets
+
+    with _lock(ROOT / "build" / ".vendor.lock"), tempfile.TemporaryDirectory() as tmp:
+        build_assets(Path(tmp) / "assets", ROOT / "build" / "vendor")
+    _build_real_handouts()
+
+
 @pytest.fixture(scope="session")
 def real_handouts() -> Path:
     """The handouts of notebooks/ with the in-browser site and the PDFs, built once per run into build/handouts by
@@ -261,3 +413,8 @@ def fixture_handouts(tmp_path_factory):
         log=log.append,
     )
     return out, entries[0], log
+
+
+if __name__ == "__main__":  # the background build: python tests/conftest.py RUN-ID
+    _RUN = sys.argv[1]
+    _background_build()
