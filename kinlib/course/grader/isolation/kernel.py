@@ -24,6 +24,7 @@ import dataclasses
 import json
 import os
 import queue
+import shutil
 import signal
 import stat
 import subprocess
@@ -37,6 +38,7 @@ from jupyter_client.connect import write_connection_file
 
 from ...schema import cell_source, is_plain_selfcheck
 from .reap import kill_group
+from .sandbox import font_cache
 
 __all__ = [
     "CellResult",
@@ -210,7 +212,10 @@ class Kernel:
             return argv, env, (wfd,), rfd
         if self.user is not None:  # the student's own user: its scratch folder (and nothing of root's) is its own
             home = os.path.join(self.conn_dir, "home")
-            os.makedirs(home, exist_ok=True)
+            os.makedirs(os.path.join(home, ".matplotlib"), exist_ok=True)
+            fonts = font_cache()  # matplotlib's font list: not rebuilt by every kernel (sandbox.font_cache)
+            if fonts:
+                shutil.copyfile(fonts, os.path.join(home, ".matplotlib", os.path.basename(fonts)))
             self.user.give(self.conn_dir)
             return argv, self.user.environment(home, extra), (), None
         env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
