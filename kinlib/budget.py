@@ -152,12 +152,24 @@ class within:
     >>> with within(None, "no limit"):
     ...     remaining()
     inf
+
+    A budget of 0 s runs nothing (the caller's fallback answers at once, whatever the machine's speed):
+
+    >>> try:
+    ...     with within(0, "no time"):
+    ...         print("never printed")
+    ... except OutOfTime as err:
+    ...     print(err)
+    no time: out of time after 0 s
     """
 
     def __init__(self, seconds: float | None, what: str):
         self.seconds, self.what = seconds, what
 
     def __enter__(self):
+        if self.seconds is not None and float(self.seconds) <= 0:
+            # no time at all: nothing runs (deterministic: a fast block must not win a race with the watchdog)
+            raise OutOfTime(self.what, self.seconds)
         self.exc = type("_Expired", (_Expired,), {})  # a class of its own: nested budgets tell theirs apart
         self.deadline = float("inf") if self.seconds is None else clock() + float(self.seconds)
         self.token, self.tid = object(), threading.get_ident()

@@ -211,6 +211,22 @@ _NOTEBOOK_READY = """(path) => {
 #: the panel of the notebook shown (the last one opened or activated: :func:`open_notebook`, :class:`Lab`)
 CURRENT = "[data-kinlib-current]"
 
+_MARK_CURRENT = """() => {
+  const w = window.jupyterapp && window.jupyterapp.shell.currentWidget;
+  if (!w || !w.node) return false;
+  document.querySelectorAll('[data-kinlib-current]').forEach(e => { if (e !== w.node) e.removeAttribute('data-kinlib-current'); });
+  w.node.setAttribute('data-kinlib-current', '');
+  return true;
+}"""
+
+
+def current(page) -> str:
+    """:data:`CURRENT`, after marking the notebook shown now (JupyterLab or JupyterLite: any page that exposes
+    ``window.jupyterapp``) as the panel every locator of this module looks in; a page opened by other means
+    (JupyterLite's workbook test) is marked here too, so no lookup silently finds nothing."""
+    assert page.evaluate(_MARK_CURRENT), "no notebook is shown (window.jupyterapp.shell.currentWidget)"
+    return CURRENT
+
 
 def open_notebook(browser, url: str, name: str, timeout: float = 120):
     """A new page showing notebook ``name`` (e.g. '05_singularities_planar') with its kernel idle.
@@ -340,7 +356,7 @@ def run_all(page, timeout: float = 300, details: bool = False):
         timeout=timeout * 1000,
         polling=200,
     )
-    errors = page.locator(f"{CURRENT} .jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
+    errors = page.locator(f"{current(page)} .jp-OutputArea-output[data-mime-type='application/vnd.jupyter.error']")
     if errors.count():
         raise CellFailed("a cell raised: " + errors.first.text_content()[:800])
     if run["aborted"]:
@@ -368,7 +384,7 @@ def widget_cells(page):
     """The output areas of the code cells whose output is a Jupyter widget or a kinlib explorer, animation or
     picker (its ``application/javascript``), in notebook order."""
     cells = page.evaluate(_MARK_WIDGET_CELLS)
-    return [page.locator(f"{CURRENT} [data-kinlib-cell='{i}'] .jp-OutputArea").first for i in cells]
+    return [page.locator(f"{current(page)} [data-kinlib-cell='{i}'] .jp-OutputArea").first for i in cells]
 
 
 _MARK_CELL_WITH = """(needle) => {
@@ -382,7 +398,7 @@ _MARK_CELL_WITH = """(needle) => {
 def output_of(page, needle: str):
     """The output area of the first code cell whose source contains ``needle`` (None if there is none)."""
     i = page.evaluate(_MARK_CELL_WITH, needle)
-    return page.locator(f"{CURRENT} [data-kinlib-cell='{i}'] .jp-OutputArea").first if i >= 0 else None
+    return page.locator(f"{current(page)} [data-kinlib-cell='{i}'] .jp-OutputArea").first if i >= 0 else None
 
 
 def explorers(page, timeout: float = 60):
@@ -399,7 +415,7 @@ def explorers(page, timeout: float = 60):
 
 def animations(page):
     """The outputs that hold a kinlib animation (``kinlib.widgets.animate_singularity``)."""
-    return page.locator(f"{CURRENT} .jp-OutputArea-output").filter(has=page.locator(".kinlib-animation"))
+    return page.locator(f"{current(page)} .jp-OutputArea-output").filter(has=page.locator(".kinlib-animation"))
 
 
 _PICTURE = """(root) => Array.from(root.querySelectorAll('img')).some(

@@ -312,9 +312,13 @@ def test_fallback_bases_carry_60_digits():
 
 
 def test_budget_runs_out_on_a_numeric_configuration_gives_the_fallback():
-    """No parameters left: past the budget the 60-digit SVD answers, flagged (Rank.exact False)."""
+    """No parameters left: past the budget the 60-digit SVD answers, flagged (Rank.exact False). A budget of 0 runs
+    no exact work at all, even when it would be fast (here: warmed by the same exact call just before; it used to
+    race the watchdog and sometimes answer exactly, depending on which tests had run before in the process)."""
     r = robots.ur5()
     q = [1, 2, 3, 4, 5, 6]
+    warm = column_space(task_rows(r.jacobian_space(), ["wx", "wy"]), q, r.thetas)
+    assert warm == sp.eye(2)  # exact: rows wx, wy are independent there, the canonical basis is the identity
     got = rank_at(r.jacobian_space(), q, r.thetas, time_budget=0)
     assert got == 6 and not got.exact and "time_budget=0" in got.note
     with pytest.warns(NumericFallbackWarning, match="time_budget=0"):
