@@ -109,35 +109,42 @@ _SPLIT = {
     ),
 }
 
-# Seconds per group on an idle machine (issue 24's baseline /work/brief/D.log: ``--durations=0`` summed per group,
-# less the handouts build that one of them waited for), rounded. Only the order of the groups is read from it:
-# heavy groups first (longest processing time first: the two workers end close together), the others after them in
-# collection order. Stale numbers cost packing, never correctness; a group not listed counts 1 s. Refresh after a
-# big change from ``make test PYTEST_ARGS=--durations=0``.
+# Seconds per group on an idle machine (``make test PYTEST_ARGS=--durations=0`` from a fresh clone, summed per group
+# with a few lines of code; refreshed after issue 24's second round: the handouts build runs in the
+# background, so no group carries it), rounded. Only the order of the groups is read from it: heavy groups first
+# (longest processing time first: the two workers end close together), the others after them in collection order.
+# Stale numbers cost packing, never correctness; a group not listed counts 1 s. Refresh after a big change.
 _SECONDS = {
-    "tests/course/test_grade_lms.py": 190,
-    "tests/course/test_lite.py": 155,
-    "tests/pictures/test_browser.py::lab": 115,
-    "tests/pictures/test_browser.py": 95,
-    "tests/core/test_singular_sets.py::test_random_bigger_arms": 85,
-    "tests/course/test_print.py": 75,
-    "tests/course/test_second_engine.py": 70,
-    "tests/core/test_velocity.py": 68,
-    "tests/course/test_handouts.py": 67,
-    "tests/course/test_grade_batch.py": 60,
-    "tests/core/test_singular_sets.py::test_random_arms_members_singular_nonmembers_not_and_nothing_missing": 43,
-    "tests/course/test_grade.py": 40,
-    "tests/course/test_grade_sandbox.py": 40,
-    "tests/core/test_exact_robustness.py": 33,
-    "tests/pictures/test_widgets.py": 29,
-    "tests/project/test_bench.py": 24,
-    "tests/course/test_grade_export.py": 15,
-    "tests/core/test_exact_rank.py": 15,
-    "tests/core/test_display.py": 14,
-    "tests/course/test_grade_verdicts.py": 14,
-    "tests/project/test_doctests.py": 14,
-    "tests/course/test_course_cli.py": 12,
-    "tests/core/test_singular_sets.py": 6,
+    "tests/course/test_grade_lms.py": 200,
+    "tests/pictures/test_browser.py::lab": 105,
+    "tests/pictures/test_browser.py": 70,
+    "tests/core/test_singular_sets.py::test_random_bigger_arms": 67,
+    "tests/course/test_lite.py": 65,
+    "tests/course/test_second_engine.py": 62,
+    "tests/course/test_print.py": 56,
+    "tests/course/test_grade_batch.py": 44,
+    "tests/course/test_handouts.py": 39,
+    "tests/core/test_velocity.py": 35,
+    "tests/course/test_grade.py": 31,
+    "tests/project/test_bench.py": 26,
+    "tests/core/test_singular_sets.py::test_random_arms_members_singular_nonmembers_not_and_nothing_missing": 25,
+    "tests/course/test_grade_sandbox.py": 24,
+    "tests/core/test_exact_robustness.py": 23,
+    "tests/pictures/test_widgets.py": 16,
+    "tests/core/test_conditioning.py": 15,
+    "tests/core/test_exact_rank.py": 11,
+    "tests/core/test_display.py": 9,
+    "tests/course/test_grade_export.py": 8,
+    "tests/pictures/test_plotting.py": 8,
+    "tests/project/test_doctests.py": 8,
+    "tests/core/test_codegen_speed.py": 8,
+    "tests/course/test_course_cli.py": 8,
+    "tests/pictures/test_figure_layout.py": 8,
+    "tests/notebooks/test_going_further.py": 7,
+    "tests/course/test_selfcheck.py": 7,
+    "tests/core/test_core_oracle.py": 7,
+    "tests/core/test_singularities.py": 6,
+    "tests/core/test_singular_sets.py": 5,
 }
 # The groups that need the run's real handouts build (it starts in the background at the start of the run:
 # ``_start_handouts_build``) wait until about this much work (seconds, per worker) was handed out before them, so
