@@ -167,8 +167,10 @@ def _schedule(groups: list, needs_build: set, workers: int) -> list:
     the groups in ``needs_build`` come only after ``_BUILD_HEADSTART`` seconds per worker of the others.
 
     >>> lite, lms, velocity = "tests/course/test_lite.py", "tests/course/test_grade_lms.py", "tests/core/test_velocity.py"
-    >>> _schedule(["a", lite, velocity, lms], {lite}, 1)  # lite waits for 190 + 68 s of others, then before "a"
-    ['tests/course/test_grade_lms.py', 'tests/core/test_velocity.py', 'tests/course/test_lite.py', 'a']
+    >>> _schedule(["a", lite, velocity, lms], {lite}, 1)  # one worker: lite waits for the LMS group's 200 s only
+    ['tests/course/test_grade_lms.py', 'tests/course/test_lite.py', 'tests/core/test_velocity.py', 'a']
+    >>> _schedule(["a", lite, velocity, lms], {lite}, 2)  # two: 2 × 200 s of others (fewer here: lite comes last)
+    ['tests/course/test_grade_lms.py', 'tests/core/test_velocity.py', 'a', 'tests/course/test_lite.py']
     """
     by_time = sorted(groups, key=lambda g: -_SECONDS.get(g, 1))  # stable: collection order among equals
     free = [g for g in by_time if g not in needs_build]

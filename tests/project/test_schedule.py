@@ -38,3 +38,12 @@ def test_longest_first_and_the_build_waits_for_its_head_start():
     ahead = sum(conftest._SECONDS.get(g, 1) for g in order[:first_held])
     assert ahead >= conftest._BUILD_HEADSTART * 2
     assert order[-1] == "tests/a.py"  # untimed groups last (they count 1 s)
+
+
+def test_the_schedule_examples_in_conftest_hold():
+    """conftest.py is not collected for doctests: its examples (``_schedule``'s) are run here, so a refreshed
+    ``_SECONDS`` table that changes them fails the suite instead of leaving a false example."""
+    import doctest
+
+    res = doctest.testmod(conftest, verbose=False)
+    assert res.attempted >= 2 and res.failed == 0, res
