@@ -14,8 +14,9 @@ configuration (SymPy's ``Matrix.rank()`` on the symbolic J gives only the generi
 
 How the singular set is found exactly: sin θ_i, cos θ_i are replaced by polynomial variables s_i, c_i,
 each entry is reduced modulo s_i² + c_i² − 1 (:class:`kinlib.trigpoly.TrigRing`), and the k×k minors of
-J (k = min(m, n); for square J only det J) are taken by fraction-free elimination in that polynomial
-ring (Σ minors² = det(J Jᵀ) or det(Jᵀ J) by Cauchy–Binet, so rank J < k ⇔ all minors vanish). With G
+J (k = min(m, n); for square J only det J) are taken in that polynomial ring by Laplace expansion along
+the rows, each smaller minor shared by every column set that contains it (no division; Σ minors² =
+det(J Jᵀ) or det(Jᵀ J) by Cauchy–Binet, so rank J < k ⇔ all minors vanish). With G
 their gcd and q_i = minor_i / G, the singular set is {G = 0} ∪ {all q_i = 0}. The factors of G that
 involve a single joint are solved on one period [0, 2π) and written as families {b + p k : k ∈ ℤ}
 (prismatic joint values enter polynomially and are solved over ℝ); the common zeros of the q_i are
@@ -244,33 +245,15 @@ def _mul(a, b, deadline: float):
     return a * b
 
 
-def _bareiss(rows: list, ring, deadline: float):
-    """det of a square matrix of ring elements, not reduced (so factors such as sin θ3 stay visible):
-    fraction-free elimination with exact divisions; the clock and the sizes are checked before each product."""
-    A = [list(r) for r in rows]
-    n = len(A)
-    R = ring.ring
-    sign, prev = 1, R.one
-    for k in range(n - 1):
-        piv = [i for i in range(k, n) if A[i][k]]
-        if not piv:
-            return R.zero
-        i0 = min(piv, key=lambda i: len(A[i][k].terms()))
-        if i0 != k:
-            A[k], A[i0] = A[i0], A[k]
-            sign = -sign
-        for i in range(k + 1, n):
-            for j in range(k + 1, n):
-                x = _mul(A[i][j], A[k][k], deadline) - _mul(A[i][k], A[k][j], deadline)
-                A[i][j] = x.exquo(prev) if prev != R.one else x
-        prev = A[k][k]
-    return A[n - 1][n - 1] * sign
-
-
-def _minors_reduced(rows: list, ring, deadline: float) -> list:
-    """All maximal minors of a k×n matrix (k ≤ n) of ring elements, reduced at every step: Laplace
-    expansion along the rows, sharing the minors of the first rows among the column sets (2ⁿ products
-    at most, every intermediate in normal form, so no expression swell); in combinations() order."""
+def _minors(rows: list, ring, deadline: float, reduce: bool) -> list:
+    """All maximal minors of a k×n matrix (k ≤ n) of ring elements, in combinations() order: Laplace expansion
+    along the rows, sharing the minors of the first r rows among the column sets (Σ_r C(n, r)·r products of
+    an entry by a smaller minor, no division: each minor is built once and never divided, where elimination
+    multiplies two large intermediates and divides them exactly, one column set at a time). Every
+    intermediate is itself a minor, so nothing swells beyond the answer. ``reduce=False``: the minors as
+    plain polynomials in s_i, c_i (factors such as sin θ3 stay visible); ``reduce=True``: each reduced modulo
+    s_i² + c_i² − 1 as it is made (smaller, but a factor may then hide inside a bigger one). The clock and
+    the sizes are checked before each product."""
     k, n = len(rows), len(rows[0])
     R = ring.ring
     prev = {(): R.one}
@@ -283,15 +266,15 @@ def _minors_reduced(rows: list, ring, deadline: float) -> list:
                 if a and sub:
                     term = _mul(a, sub, deadline)
                     acc = acc + term if (r + idx) % 2 == 0 else acc - term
-            cur[S] = ring.reduce(acc)
+            cur[S] = ring.reduce(acc) if reduce else acc
         prev = cur
     return [prev[S] for S in itertools.combinations(range(n), k)]
 
 
 def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float) -> list:
     """The k×k minors of J (k = min(m, n)): rank J < k ⇔ all of them vanish. First as plain polynomials in
-    s_i, c_i (Bareiss: factors stay visible); when those grow too large, reduced modulo s_i² + c_i² − 1
-    at every step (smaller, but a factor such as sin θ3 may then hide inside a bigger one)."""
+    s_i, c_i (factors stay visible); when those grow too large, reduced modulo s_i² + c_i² − 1 at every
+    step (:func:`_minors`)."""
     m, n = shape
     rows = [entries[i * n : (i + 1) * n] for i in range(m)]
     if m > n:
@@ -300,14 +283,11 @@ def _maximal_minors(entries: list, shape: tuple[int, int], ring, deadline: float
     start = clock()
     raw_deadline = min(deadline, start + max(1.0, (deadline - start) / 8))
     try:
-        return [
-            _bareiss([[r[j] for j in cols] for r in rows], ring, raw_deadline)
-            for cols in itertools.combinations(range(n), m)
-        ]
+        return _minors(rows, ring, raw_deadline, reduce=False)
     except _OutOfTime:
         if clock() > deadline:
             raise
-    return _minors_reduced(rows, ring, deadline)
+    return _minors(rows, ring, deadline, reduce=True)
 
 
 def _cheap_points(g_expr: sp.Expr, joint: sp.Symbol, revolute: bool):

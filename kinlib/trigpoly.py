@@ -16,6 +16,8 @@ makes it fast) and converts between SymPy expressions and ring elements. It is s
 
 from __future__ import annotations
 
+import itertools
+import math
 from collections.abc import Callable, Iterable, Sequence
 from typing import Any
 
@@ -176,6 +178,7 @@ class TrigRing:
         self.ring, *self.gens = _ring(syms, self.domain)
         self._table = dict(zip(self.atoms, self.gens))
         self._memo: dict = {}
+        self._binomials: dict = {}  # h -> the terms (c exponent, coefficient) of (1 − c²)^h
         self.relations = [self.gens[i] ** 2 + self.gens[k + i] ** 2 - 1 for i in range(k)]
         self._owner = {i: self.angles[i % k] for i in range(2 * k)}
         self._owner.update({2 * k + j: g for j, g in enumerate(rest)})
@@ -221,10 +224,45 @@ class TrigRing:
         return conv(e)
 
     def reduce(self, p):
-        """The normal form of the ring element p modulo s_i² + c_i² − 1 (degree ≤ 1 in every s_i)."""
+        """The normal form of the ring element p modulo s_i² + c_i² − 1 (degree ≤ 1 in every s_i).
+
+        Term by term: s_i^(2h+e) = s_i^e (1 − c_i²)^h, expanded by the binomial theorem. The relations are
+        a Gröbner basis, so this is the same unique remainder as SymPy's ``p.rem(relations)``, in one pass
+        over the terms (``rem`` looks for the leading term again after every step: quadratic in the terms,
+        most of the time of a wide Jacobian's singular set). Inexact (float) coefficients go through ``rem``,
+        whose order of operations the floats' last bits depend on.
+        """
         if not self.relations or not p:
             return p
-        return p.rem(self.relations)
+        if not self.domain.is_Exact:
+            return p.rem(self.relations)
+        k, dom, table = len(self.angles), self.domain, self._binomials
+        acc: dict = {}
+        get = acc.get
+        for monom, coeff in p.iterterms():
+            high = [i for i in range(k) if monom[i] >= 2]
+            if not high:
+                acc[monom] = get(monom, dom.zero) + coeff
+                continue
+            base = list(monom)
+            parts = []
+            for i in high:
+                h, base[i] = divmod(monom[i], 2)
+                if h not in table:
+                    table[h] = [(2 * j, dom.convert((-1) ** j * math.comb(h, j))) for j in range(h + 1)]
+                parts.append(table[h])
+            for choice in itertools.product(*parts):
+                m, c = base[:], coeff
+                for i, (e, b) in zip(high, choice):
+                    m[k + i] += e
+                    c = c * b
+                m = tuple(m)
+                acc[m] = get(m, dom.zero) + c
+        out = self.ring.zero
+        for m, c in acc.items():
+            if c:
+                out[m] = c
+        return out
 
     def normal_form(self, e: Any):
         """The reduced ring element of the expression e."""
