@@ -29,6 +29,7 @@ import sympy as sp
 from sympy.polys.constructor import construct_domain
 from sympy.polys.fields import field as _field
 from sympy.polys.matrices import DomainMatrix
+from sympy.polys.rings import ring as _ring
 
 from .trigpoly import normal_form_zero
 
@@ -242,6 +243,8 @@ class ExactField:
         """A field element back as SymPy (numerator, denominator), polynomials in sin g, cos g, the constants
         and the parameters: t = tan(g/2) written as sin g/(1 + cos g) (an identity, never a guess).
         :func:`kinlib.display.readable_ratio` makes one readable fraction of them."""
+        if self.g != 0 and self.K == sp.QQ and not self.extra and not self.params:
+            return self._ratio_in_sin_cos(x)
         gens = [self.t] + list(self.extra) + list(self.params)
         num, den = x.numer.as_expr(*gens), x.denom.as_expr(*gens)
         if self.g != 0:
@@ -250,6 +253,34 @@ class ExactField:
                 sp.together(sp.expand(num).subs(self.t, s / (1 + c)) / sp.expand(den).subs(self.t, s / (1 + c)))
             )
         return sp.expand(num), sp.expand(den)
+
+    def _ratio_in_sin_cos(self, x) -> tuple[sp.Expr, sp.Expr]:
+        """:meth:`to_ratio` for rational coefficients and no parameters, in polynomial arithmetic over
+        QQ[sin g, cos g]: the same pair as SymPy's route (t → sin g/(1 + cos g) in the expanded numerator and
+        denominator, ``together``, ``fraction``, ``expand``), which expands every power of 1 + cos g as an
+        expression (seconds per entry of a UR5's J⁺). With n(t) = Σ a_k t^k of degree N and lowest degree l,
+        n = Σ a_k s^k (1 + c)^(N−k) / (1 + c)^N; ``together`` takes out the content (gcd of the a_k) and s^l,
+        and the quotient of the two contents, s^(l_n − l_d) and (1 + c)^(N_d − N_n) go to the side where
+        their exponent is positive."""
+        s, c = sp.sin(self.g), sp.cos(self.g)
+        R, S, C = _ring([s, c], sp.QQ)
+        parts = []
+        for p in (x.numer, x.denom):
+            terms = {m[0]: sp.QQ.to_sympy(co) for m, co in p.terms()}
+            top, low = max(terms), min(terms)
+            content = sp.Rational(math.gcd(*[q.p for q in terms.values()]), math.lcm(*[q.q for q in terms.values()]))
+            powers = {0: R.one}
+            for e in range(1, top - low + 1):
+                powers[e] = powers[e - 1] * (1 + C)
+            poly = R.zero
+            for k, q in terms.items():
+                poly += R(sp.QQ.from_sympy(q / content)) * S ** (k - low) * powers[top - k]
+            parts.append((poly, content, low, top))
+        (A, c_num, l_num, n_num), (B, c_den, l_den, n_den) = parts
+        ratio, e, f = c_num / c_den, l_num - l_den, n_den - n_num
+        num = R(ratio.p) * S ** max(e, 0) * (1 + C) ** max(f, 0) * A
+        den = R(ratio.q) * S ** max(-e, 0) * (1 + C) ** max(-f, 0) * B
+        return num.as_expr(), den.as_expr()
 
     def __repr__(self) -> str:
         return f"ExactField(t = tan({self.g}/2), K = {self.K}, parameters {list(self.params)})"
