@@ -242,3 +242,33 @@ def test_normal_form_collects_and_has_two_modes():
     assert out.has(sp.Float) and sp.nsimplify(out) == sp.sqrt(L) + sp.sin(x) / 2
     with pytest.raises(NotTrigPolynomial):  # sin inside a root: not a polynomial
         TrigRing([sp.sqrt(sp.sin(x))], opaque=True)
+
+
+def test_one_pass_reduction_is_the_division_remainder():
+    """TrigRing.reduce (s_i^2 → 1 − c_i^2 term by term) against SymPy's own division by the relations (an
+    independent computation of the unique remainder), with rational and algebraic coefficients, high powers
+    and other generators; and degree ≤ 1 in every sine."""
+    from kinlib.trigpoly import TrigRing
+
+    L, d = sp.Symbol("L", positive=True), sp.Symbol("d")
+    angles = sp.symbols("t1:4", real=True)
+    atoms = [*map(sp.sin, angles), *map(sp.cos, angles), L, d]
+    rng = random.Random(5)
+    for unit in (1, sp.sqrt(2)):
+        exprs = [
+            sp.Add(
+                *[
+                    rng.randint(-5, 5)
+                    * unit ** rng.randint(0, 1)
+                    * sp.Mul(*[rng.choice(atoms) ** rng.randint(0, 5) for _ in range(4)])
+                    for _ in range(12)
+                ]
+            )
+            for _ in range(25)
+        ]
+        ring = TrigRing(exprs, angles)
+        for e in exprs:
+            p = ring.from_expr(e)
+            r = ring.reduce(p)
+            assert r == p.rem(ring.relations)
+            assert all(m[i] <= 1 for m in r.monoms() for i in range(len(angles)))

@@ -371,3 +371,26 @@ def test_non_real_joint_symbol_refused():
     z = sp.Symbol("z")
     with pytest.raises(ValueError, match="declared real"):
         rank_at(sp.Matrix([[sp.sin(z)]]), [1], thetas=[z])
+
+
+@settings(max_examples=30, **SETTINGS)
+@given(st.lists(st.integers(-40, 40), min_size=1, max_size=14), st.lists(st.integers(-40, 40), min_size=1, max_size=14))
+def test_exact_field_ratio_in_sin_cos_is_sympys_and_equal(a, b):
+    """ExactField.to_ratio (polynomial arithmetic over QQ[sin g, cos g]) gives the very pair SymPy's route gives
+    (t → sin g/(1 + cos g), together, fraction, expand: what the display was made from), and its value is the
+    field element's at t = tan(g/2) (60 digits)."""
+    from kinlib.exactfield import ExactField
+
+    assume(any(a) and any(b))
+    fld = ExactField([sp.sin(sp.Rational(1, 2)), sp.cos(3)])
+    tt = fld.ring.gens[0]
+    num = sum((sp.QQ(c, 1 + i % 3) * tt**i for i, c in enumerate(a)), fld.ring.zero)
+    den = sum((sp.QQ(c, 1 + i % 5) * tt**i for i, c in enumerate(b)), fld.ring.zero)
+    x = fld.F(num) / fld.F(den)
+    got = fld.to_ratio(x)
+    s, c = sp.sin(fld.g), sp.cos(fld.g)
+    n, dd = (p.as_expr(fld.t) for p in (x.numer, x.denom))
+    want = sp.fraction(sp.together(sp.expand(n).subs(fld.t, s / (1 + c)) / sp.expand(dd).subs(fld.t, s / (1 + c))))
+    assert got == tuple(sp.expand(w) for w in want)
+    value = (n / dd).subs(fld.t, sp.tan(fld.g / 2))
+    assert abs(sp.N(got[0] / got[1] - value, 60)) < 1e-50
