@@ -19,6 +19,9 @@ How the budget is enforced (both mechanisms, whichever stops the work first):
   ``SIGALRM``, main thread only), and stops pure-Python work inside SymPy too. The exception derives from
   ``BaseException``, so library code that catches ``Exception`` cannot swallow it, and it is raised again every
   50 ms until the budgeted block has ended. One C call (a huge integer product) finishes before it lands.
+  It is never fired into the budget's own entry and exit, and never cancelled (on CPython 3.11 a cancelled
+  interrupt left a profiled or traced thread spinning for ever), so budgets hold under cProfile, coverage and
+  debuggers too, and the watchdog's lock cannot be left held.
   Where threads are not available (Pyodide, i.e. JupyterLite in the browser) only the next mechanism applies.
 * **cooperative checks**: kinlib's own loops call :func:`check`, which raises the same exception when the
   deadline has passed.
