@@ -134,11 +134,13 @@ def _wake_watchdog() -> None:
 
 
 def _in_bookkeeping(tid: int) -> bool:
-    """True while thread ``tid`` runs this module's own bookkeeping (entering or leaving a budgeted block): an
-    interrupt landing there would leave a block armed or on the stack, so the watchdog fires a moment later."""
+    """True while thread ``tid`` enters or leaves a budgeted block (an interrupt there would leave the block
+    armed or on the stack) or imports a module (SymPy imports lazily; an interrupt inside importlib's own
+    bookkeeping left other threads a half-initialised module): the watchdog fires a moment later."""
     frame = sys._current_frames().get(tid)
     while frame is not None:
-        if frame.f_code in _BOOKKEEPING:
+        code = frame.f_code
+        if code in _BOOKKEEPING or code.co_filename.startswith("<frozen importlib"):
             return True
         frame = frame.f_back
     return False

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import cProfile
 import pstats
+import sys
 import threading
 import time
 import warnings
@@ -341,9 +342,30 @@ def test_an_interrupt_fired_as_a_block_ends_leaves_the_watchdog_working():
     t0 = time.thread_time()  # the watchdog still stops a block that never checks
     with pytest.raises(OutOfTime):
         with within(0.2, "after"):
-            while True:
+            while time.thread_time() - t0 < 60:  # a hang guard
                 pass
     assert time.thread_time() - t0 < 0.2 + MARGIN
+
+
+def test_an_expiry_during_an_import_lands_after_it(tmp_path, monkeypatch):
+    """SymPy imports lazily (Add.flatten imports sympy.tensor.tensor on first use). An interrupt landing inside
+    an import, in importlib's own bookkeeping, left other threads a half-initialised module: three threads with
+    random nested budgets got ImportError "cannot import name 'TensExpr'" (3 runs out of 3). The watchdog now
+    waits until the import is over; the module is complete and the budget still ends the block right after."""
+    (tmp_path / "kinlib_slow_import.py").write_text(
+        "import time\nt0 = time.thread_time()\nwhile time.thread_time() - t0 < 0.3:\n    pass\nDONE = True\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "kinlib_slow_import", raising=False)
+    with pytest.raises(OutOfTime):
+        with within(0.05, "an import"):
+            import kinlib_slow_import  # noqa: F401
+
+            t0 = time.thread_time()
+            while time.thread_time() - t0 < 60:  # the interrupt lands here, after the import (60 s: a hang guard)
+                pass
+    assert sys.modules["kinlib_slow_import"].DONE
+    monkeypatch.delitem(sys.modules, "kinlib_slow_import")
 
 
 def test_fallback_bases_carry_60_digits():
