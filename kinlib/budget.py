@@ -139,8 +139,7 @@ def _in_bookkeeping(tid: int) -> bool:
     bookkeeping left other threads a half-initialised module): the watchdog fires a moment later."""
     frame = sys._current_frames().get(tid)
     while frame is not None:
-        code = frame.f_code
-        if code in _BOOKKEEPING or code.co_filename.startswith("<frozen importlib"):
+        if frame.f_code in _BOOKKEEPING or frame.f_globals.get("__name__") in _IMPORTLIB:
             return True
         frame = frame.f_back
     return False
@@ -261,6 +260,9 @@ class within:
         return False
 
 
+_IMPORTLIB = frozenset(
+    ("_frozen_importlib", "_frozen_importlib_external", "importlib._bootstrap", "importlib._bootstrap_external")
+)
 _BOOKKEEPING = frozenset(f.__code__ for f in (within.__enter__, within.__exit__, within._drain, _tick))
 
 
