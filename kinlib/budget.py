@@ -19,6 +19,9 @@ How the budget is enforced (both mechanisms, whichever stops the work first):
   ``SIGALRM``, main thread only), and stops pure-Python work inside SymPy too. The exception derives from
   ``BaseException``, so library code that catches ``Exception`` cannot swallow it, and it is raised again every
   50 ms until the budgeted block has ended. One C call (a huge integer product) finishes before it lands.
+  It is never fired into the budget's own entry and exit, and never cancelled (on CPython 3.11 a cancelled
+  interrupt left a profiled or traced thread spinning for ever), so budgets hold under cProfile, coverage and
+  debuggers too, and the watchdog's lock cannot be left held.
   Where threads are not available (Pyodide, i.e. JupyterLite in the browser) only the next mechanism applies.
 * **cooperative checks**: kinlib's own loops call :func:`check`, which raises the same exception when the
   deadline has passed.
@@ -99,8 +102,13 @@ def _thread_clock(tid: int):
 
 
 _local = threading.local()
-_cond = threading.Condition()
-_armed: dict = {}  # token -> [deadline on the thread's clock, thread id, exception class, that clock]
+# The watchdog's state. Both locks are C locks (not threading.Condition, whose Python-level __enter__ can take an
+# interrupt between acquiring its lock and the with-statement's protection, leaving the lock held for ever: the
+# watchdog then waits for it, and no budget in the process is enforced any more).
+_lock = threading.Lock()  # guards _armed; the watchdog fires only while holding it
+_wake = threading.Lock()  # held while nobody needs the watchdog; released to wake it early
+_wake.acquire()
+_armed: dict = {}  # token -> [deadline on the thread's clock, thread id, exception class, that clock, times fired]
 _watchdog: threading.Thread | None = None
 
 
@@ -111,22 +119,52 @@ def _stack() -> list:
 
 
 def _async_raise(tid: int, exc) -> None:
-    ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), ctypes.py_object(exc) if exc else None)
+    # Never called with NULL to cancel: on CPython 3.11 that leaves the interpreter's "async exception" flag set
+    # with no exception behind it, and under a profiler or tracer (cProfile, coverage, a debugger) the next call
+    # of a Python function then spins at its first instruction for ever. An interrupt fired but not yet seen is
+    # taken at a safe place instead (within._drain).
+    ctypes.pythonapi.PyThreadState_SetAsyncExc(ctypes.c_ulong(tid), ctypes.py_object(exc))
+
+
+def _wake_watchdog() -> None:
+    try:
+        _wake.release()
+    except RuntimeError:  # already awake
+        pass
+
+
+def _in_bookkeeping(tid: int) -> bool:
+    """True while thread ``tid`` enters or leaves a budgeted block (an interrupt there would leave the block
+    armed or on the stack) or imports a module (SymPy imports lazily; an interrupt inside importlib's own
+    bookkeeping left other threads a half-initialised module): the watchdog fires a moment later."""
+    frame = sys._current_frames().get(tid)
+    while frame is not None:
+        if frame.f_code in _BOOKKEEPING or frame.f_globals.get("__name__") in _IMPORTLIB:
+            return True
+        frame = frame.f_back
+    return False
 
 
 def _watch() -> None:
-    with _cond:
-        while True:
-            wait = None
-            for entry in _armed.values():
-                left = entry[0] - entry[3]()
+    while True:
+        wait = None
+        with _lock:
+            for token, entry in list(_armed.items()):
+                try:
+                    left = entry[0] - entry[3]()
+                except OSError:  # the thread is gone
+                    del _armed[token]
+                    continue
                 if left <= 0:
-                    _async_raise(entry[1], entry[2])
-                    entry[0] = entry[3]() + _REARM
-                    left = _REARM
+                    if _in_bookkeeping(entry[1]):
+                        left = 0.001
+                    else:
+                        _async_raise(entry[1], entry[2])
+                        entry[4] += 1
+                        entry[0], left = entry[3]() + _REARM, _REARM
                 # CPU time runs no faster than wall time: waiting `left` wall seconds never overshoots
                 wait = left if wait is None else min(wait, left)
-            _cond.wait(None if wait is None else max(0.001, wait))
+        _wake.acquire(True, -1 if wait is None else max(0.001, wait))
 
 
 def _start_watchdog() -> bool:
@@ -141,6 +179,10 @@ def _start_watchdog() -> bool:
             _watchdog = None
             return False
     return True
+
+
+def _tick() -> None:
+    """A Python call: an interrupt set for this thread and not yet seen is raised at its start."""
 
 
 class within:
@@ -179,35 +221,49 @@ class within:
             deadline = self.deadline
             if read is None:  # no cross-thread CPU clock here: the watchdog counts wall time
                 read, deadline = time.monotonic, time.monotonic() + float(self.seconds)
-            with _cond:
-                _armed[self.token] = [deadline, self.tid, self.exc, read]
-                _cond.notify()
+            with _lock:
+                _armed[self.token] = [deadline, self.tid, self.exc, read, 0]
+            _wake_watchdog()
         return self
 
-    def _disarm(self) -> bool:
-        """Stop the watchdog for this block; True when an interrupt landed during this bookkeeping."""
-        landed = False
-        while True:
+    def _drain(self, fired: bool) -> _Expired | None:
+        """Take an interrupt fired into this thread but not seen yet (it is raised at the next Python call)."""
+        seen = None
+        for _ in range(3 if fired else 0):
             try:
-                with _cond:
-                    if _armed.pop(self.token, None) is not None:
-                        _async_raise(self.tid, None)  # clear an interrupt set but not yet delivered
-                break
-            except self.exc:
-                landed = True
-        return landed
+                _tick()
+            except _Expired as err:
+                seen = err
+        return seen
 
     def __exit__(self, et, ev, tb):
-        landed = self._disarm()
-        stack = _stack()
-        if self in stack:
-            stack.remove(self)
-        if (et is not None and issubclass(et, self.exc)) or landed:
+        late = None  # an interrupt that landed during this bookkeeping (the watchdog avoids it; a guard)
+        entry = None
+        while True:
+            try:
+                with _lock:
+                    entry = _armed.pop(self.token, entry)
+                late = self._drain(entry is not None and entry[4] > 0) or late
+                stack = _stack()
+                if self in stack:
+                    stack.remove(self)
+                break
+            except _Expired as err:
+                late = err
+        if (et is not None and issubclass(et, self.exc)) or isinstance(late, self.exc):
             from sympy.core.cache import clear_cache
 
             clear_cache()
             raise OutOfTime(self.what, self.seconds) from None
+        if late is not None:  # an outer block's interrupt: it ends that block too
+            raise late
         return False
+
+
+_IMPORTLIB = frozenset(
+    ("_frozen_importlib", "_frozen_importlib_external", "importlib._bootstrap", "importlib._bootstrap_external")
+)
+_BOOKKEEPING = frozenset(f.__code__ for f in (within.__enter__, within.__exit__, within._drain, _tick))
 
 
 def check() -> None:

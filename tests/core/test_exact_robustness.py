@@ -9,6 +9,9 @@ is that CPU time, with a generous margin (a guard against hangs, not a speed cla
 
 from __future__ import annotations
 
+import cProfile
+import pstats
+import sys
 import threading
 import time
 import warnings
@@ -266,7 +269,12 @@ def test_singular_configurations_keeps_its_budget():
     """A random 5R with time_budget=40 took 55–74 s: SymPy's factoring and solving were not watched. Now the
     budget counts the CPU time of the thread doing the work (kinlib.budget), in any thread: this arm's 5×5 minors
     take far longer than 40 s, so with 2 s the answer is the documented incomplete one, after ≈ 2 s of the worker
-    thread's CPU time (its wall time is longer by the machine's load: not asserted, a generous hang guard only)."""
+    thread's CPU time (its wall time is longer by the machine's load: not asserted, a generous hang guard only).
+
+    Run under cProfile: it never stopped there (nor under coverage or a debugger). Every budgeted block cancelled
+    the watchdog's interrupt with PyThreadState_SetAsyncExc(tid, NULL), which on CPython 3.11 leaves the
+    interpreter's "async exception" flag set with no exception behind it; with a profile or trace function the
+    next Python call then spins at its first instruction for ever (here in the budget's own bookkeeping)."""
     rng = np.random.default_rng(5)
     cols = []
     for _ in range(5):
@@ -278,11 +286,16 @@ def test_singular_configurations_keeps_its_budget():
     J, out = chain.jacobian_space(), {}
 
     def work():
-        t0 = time.thread_time()
+        t0, profiler = time.thread_time(), cProfile.Profile()
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            out["conds"] = singular_configurations(J, chain.thetas, time_budget=2)
+            profiler.enable()  # this thread only
+            try:
+                out["conds"] = singular_configurations(J, chain.thetas, time_budget=2)
+            finally:
+                profiler.disable()
         out["cpu"] = time.thread_time() - t0
+        out["profiled"] = pstats.Stats(profiler).total_calls
 
     th = threading.Thread(target=work)
     th.start()
@@ -291,6 +304,68 @@ def test_singular_configurations_keeps_its_budget():
     conds = out["conds"]
     assert not conds.complete and "time_budget=2" in conds.note
     assert 2 <= out["cpu"] < 2 + MARGIN
+    assert out["profiled"] > 1000  # the profiler did watch SymPy's work
+
+
+def test_an_interrupt_fired_as_a_block_ends_leaves_the_watchdog_working():
+    """The watchdog fires while holding its lock; a block ending at that moment waits for the lock in its exit,
+    and the interrupt landed there. With the old threading.Condition (a Python-level __enter__) it landed between
+    taking the lock and the with-statement's protection: the thread kept the lock for ever, the watchdog waited
+    for it, and every later budget in the process hung or ran unwatched (under load, where the watchdog is often
+    descheduled holding its lock, a later test's budget never stopped). Made deterministic here: this test holds
+    the lock as the block ends and fires the way the watchdog does."""
+    import kinlib.budget as budget
+
+    got, entered, go = {}, threading.Event(), threading.Event()
+
+    def work():
+        block = within(30, "a block ending as the watchdog fires")
+        try:
+            with block:
+                got["exc"] = block.exc
+                entered.set()
+                go.wait()
+        except OutOfTime as err:  # the interrupt fired before the block was disarmed: the budget ran out
+            got["out"] = err
+
+    th = threading.Thread(target=work)
+    th.start()
+    assert entered.wait(60)
+    with budget._lock:
+        go.set()
+        time.sleep(0.2)  # the block has ended; its thread waits for the lock in its exit (a longer wait: same)
+        budget._async_raise(th.ident, got["exc"])
+    th.join(60)  # hang guard
+    assert not th.is_alive() and isinstance(got.get("out"), OutOfTime)
+    assert budget._lock.acquire(timeout=60)  # nobody kept the watchdog's lock
+    budget._lock.release()
+    t0 = time.thread_time()  # the watchdog still stops a block that never checks
+    with pytest.raises(OutOfTime):
+        with within(0.2, "after"):
+            while time.thread_time() - t0 < 60:  # a hang guard
+                pass
+    assert time.thread_time() - t0 < 0.2 + MARGIN
+
+
+def test_an_expiry_during_an_import_lands_after_it(tmp_path, monkeypatch):
+    """SymPy imports lazily (Add.flatten imports sympy.tensor.tensor on first use). An interrupt landing inside
+    an import, in importlib's own bookkeeping, left other threads a half-initialised module: three threads with
+    random nested budgets got ImportError "cannot import name 'TensExpr'" (3 runs out of 3). The watchdog now
+    waits until the import is over; the module is complete and the budget still ends the block right after."""
+    (tmp_path / "kinlib_slow_import.py").write_text(
+        "import time\nt0 = time.thread_time()\nwhile time.thread_time() - t0 < 0.3:\n    pass\nDONE = True\n"
+    )
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "kinlib_slow_import", raising=False)
+    with pytest.raises(OutOfTime):
+        with within(0.05, "an import"):
+            import kinlib_slow_import  # noqa: F401
+
+            t0 = time.thread_time()
+            while time.thread_time() - t0 < 60:  # the interrupt lands here, after the import (60 s: a hang guard)
+                pass
+    assert sys.modules["kinlib_slow_import"].DONE
+    monkeypatch.delitem(sys.modules, "kinlib_slow_import")
 
 
 def test_fallback_bases_carry_60_digits():
