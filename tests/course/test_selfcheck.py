@@ -267,7 +267,7 @@ def _outputs_text(cell):
 
 @pytest.mark.slow
 def test_a_picture_cell_after_a_wrong_answer_says_fix_the_answer(tmp_path):
-    from nbclient import NotebookClient
+    from kinlib.course.publish.execute import notebook_client
 
     spec = fingerprint(sp.Matrix([[1, 2], [3, 4]]), salt="1.1:J")
     code = nbformat.v4.new_code_cell
@@ -284,7 +284,7 @@ def test_a_picture_cell_after_a_wrong_answer_says_fix_the_answer(tmp_path):
     ]
     nb = nbformat.v4.new_notebook(cells=cells)
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-    NotebookClient(nb, timeout=120, kernel_name="python3", allow_errors=True).execute(cwd=str(tmp_path))
+    notebook_client(nb, timeout=120, kernel_name="python3", allow_errors=True).execute(cwd=str(tmp_path))
     texts = [_outputs_text(c) for c in nb.cells]
     assert "✗ wrong form" in texts[2]
     assert "Fix `J` above first" in texts[3] and "ERROR" not in texts[3] and "Traceback" not in texts[3]

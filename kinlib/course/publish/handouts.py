@@ -70,6 +70,7 @@ from ..schema import (
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
 from .aids import stub, student_reading_aid
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
+from .execute import notebook_client
 from .incremental import Stamps, build_sections, build_site, code_key, key, print_changed_pdfs
 from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
 
@@ -123,10 +124,9 @@ def _capture_code(specs: dict) -> str:
 
 
 async def _execute(nb, path: Path, timeout: int, capture_after: dict) -> dict:
-    from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
-    client = NotebookClient(
+    client = notebook_client(
         nb,
         timeout=timeout,
         kernel_name="python3",
@@ -494,11 +494,10 @@ def run_workbook(path: Path, timeout: int = 120):
     >>> any(o.get("output_type") == "error" for c in nb.cells for o in c.get("outputs", []))  # doctest: +SKIP
     False
     """
-    from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError
 
     nb = nbformat.read(path, as_version=4)
-    client = NotebookClient(
+    client = notebook_client(
         nb,
         timeout=timeout,
         kernel_name="python3",
