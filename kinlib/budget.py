@@ -108,7 +108,8 @@ _local = threading.local()
 _lock = threading.Lock()  # guards _armed; the watchdog fires only while holding it
 _wake = threading.Lock()  # held while nobody needs the watchdog; released to wake it early
 _wake.acquire()
-_armed: dict = {}  # token -> [deadline on the thread's clock, thread id, exception class, that clock, times fired]
+_armed: dict = {}  # token -> [deadline on the thread's clock, thread id, exception class, that clock, times fired,
+#                             the frame that entered the block]
 _watchdog: threading.Thread | None = None
 
 
@@ -133,12 +134,14 @@ def _wake_watchdog() -> None:
         pass
 
 
-def _in_bookkeeping(tid: int) -> bool:
+def _in_bookkeeping(tid: int, base) -> bool:
     """True while thread ``tid`` enters or leaves a budgeted block (an interrupt there would leave the block
     armed or on the stack) or imports a module (SymPy imports lazily; an interrupt inside importlib's own
-    bookkeeping left other threads a half-initialised module): the watchdog fires a moment later."""
+    bookkeeping left other threads a half-initialised module): the watchdog fires a moment later. Only the
+    frames above ``base`` (the frame whose ``with`` entered the block) count: a block entered while a module
+    is being imported (work at a module's top level) is still stopped."""
     frame = sys._current_frames().get(tid)
-    while frame is not None:
+    while frame is not None and frame is not base:
         if frame.f_code in _BOOKKEEPING or frame.f_globals.get("__name__") in _IMPORTLIB:
             return True
         frame = frame.f_back
@@ -156,7 +159,7 @@ def _watch() -> None:
                     del _armed[token]
                     continue
                 if left <= 0:
-                    if _in_bookkeeping(entry[1]):
+                    if _in_bookkeeping(entry[1], entry[5]):
                         left = 0.001
                     else:
                         _async_raise(entry[1], entry[2])
@@ -222,7 +225,7 @@ class within:
             if read is None:  # no cross-thread CPU clock here: the watchdog counts wall time
                 read, deadline = time.monotonic, time.monotonic() + float(self.seconds)
             with _lock:
-                _armed[self.token] = [deadline, self.tid, self.exc, read, 0]
+                _armed[self.token] = [deadline, self.tid, self.exc, read, 0, sys._getframe(1)]
             _wake_watchdog()
         return self
 

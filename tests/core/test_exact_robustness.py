@@ -366,6 +366,17 @@ def test_an_expiry_during_an_import_lands_after_it(tmp_path, monkeypatch):
                 pass
     assert sys.modules["kinlib_slow_import"].DONE
     monkeypatch.delitem(sys.modules, "kinlib_slow_import")
+    # ... and a block entered at a module's top level (work done while the module is imported) is still stopped
+    (tmp_path / "kinlib_budget_at_import.py").write_text(
+        "import time\nfrom kinlib.budget import OutOfTime, within\nt0 = time.thread_time()\ntry:\n"
+        "    with within(0.05, 'at import'):\n        while time.thread_time() - t0 < 60:\n            pass\n"
+        "except OutOfTime:\n    STOPPED = time.thread_time() - t0\n"
+    )
+    monkeypatch.delitem(sys.modules, "kinlib_budget_at_import", raising=False)
+    import kinlib_budget_at_import
+
+    assert kinlib_budget_at_import.STOPPED < 0.05 + MARGIN
+    monkeypatch.delitem(sys.modules, "kinlib_budget_at_import")
 
 
 def test_fallback_bases_carry_60_digits():
