@@ -1,0 +1,243 @@
+"""Notebooks 01–04 (issue 30): statements true for the task they are applied to, nothing graded given away,
+and one exercise per section on a robot the notebook has not shown (1.4, 2.5, 3.5, 4.2).
+
+Every fact is computed here independently of the notebooks' own cells (modern_robotics, plane geometry,
+matrices typed by hand); the new parts' answer keys are read from the notebooks' solution cells and judged
+by the workbook self-check and by the instructor checker's comparison, with a right answer typed by hand,
+another valid form of it, and wrong answers.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import pathlib
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import modern_robotics as mr  # noqa: E402
+import nbformat  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+import sympy as sp  # noqa: E402
+
+from kinlib.course.answers.compare import compare  # noqa: E402
+from kinlib.course.answers.describe import describe  # noqa: E402
+from kinlib.course.grader.grade import make_points  # noqa: E402
+from kinlib.course.workbook.selfcheck import fingerprint, verdict  # noqa: E402
+
+NB_DIR = pathlib.Path(__file__).resolve().parents[2] / "notebooks"
+STEMS = {
+    "01": "01_properties_of_jacobians",
+    "02": "02_planar_robot_jacobian",
+    "03": "03_spatial_robot_jacobian",
+    "04": "04_interpreting_the_jacobian",
+}
+sin, cos, sqrt, pi = sp.sin, sp.cos, sp.sqrt, sp.pi
+th1, th2, th3 = sp.symbols("theta1 theta2 theta3", real=True)
+
+
+def _read(key):
+    return nbformat.read(NB_DIR / f"{STEMS[key]}.ipynb", as_version=4)
+
+
+def _cells(key):
+    return {c.get("id"): c for c in _read(key).cells}
+
+
+def _order(key):
+    return [c.get("id") for c in _read(key).cells]
+
+
+@functools.cache
+def answers(key):
+    """The notebook's namespace after its setup, given and solution cells (no figures, widgets, checks)."""
+    ns = {"display": lambda *a, **k: None}
+    for cell in _read(key).cells:
+        tags = cell.metadata.get("tags", [])
+        if cell.cell_type != "code" or "check" in tags or "nbval-ignore-output" in tags:
+            continue
+        if "solution" not in tags and ("plotting." in cell.source or "plt." in cell.source):
+            continue  # a figure
+        exec(compile(cell.source, f"{key}:{cell.id}", "exec"), ns)
+    return ns
+
+
+def _selfcheck(part, name, key, value, kind="default"):
+    salt = f"{part}:{name}"
+    return verdict(value, fingerprint(key, kind, salt), salt)[0]
+
+
+def _checker(kind, key, value):
+    """The instructor checker's verdict (describe both at random points, compare)."""
+    syms = {}
+    for obj in (key, value):
+        for s in getattr(sp.sympify(obj) if not isinstance(obj, (tuple, int)) else sp.Integer(0), "free_symbols", ()):
+            syms[s.name] = {"positive": bool(s.is_positive)}
+    pts = make_points(syms, seed=11, n=5)
+    return compare(kind, describe(kind, value, pts), describe(kind, key, pts), "answer")[0]
+
+
+def _judged(part, name, key, value, kind="expr"):
+    """(self-check status, checker says ok) for ``value`` against the key; the two must agree."""
+    status = _selfcheck(part, name, key, value, "default" if kind == "expr" else kind)
+    ok = _checker(kind, key, value)
+    assert (status == "correct") == ok, (part, name, value, status, ok)
+    return status
+
+
+def _rot(a):
+    return np.array([[math.cos(a), -math.sin(a)], [math.sin(a), math.cos(a)]])
+
+
+# ============================================================================================== notebook 01
+def test_01_predicts_come_before_what_they_ask_about_and_steps_are_hints():
+    order, cells = _order("01"), _cells("01")
+    # 1.1: the predict comes before det J is computed and explained
+    assert order.index("predict-1-1") < order.index("sol-1-1-det") < order.index("ans-1-1-det")
+    # 1.3: the predict about θ5 = 0 comes before the text that explains which axes are parallel
+    assert order.index("predict-1-3") < order.index("ur5-why") < order.index("sol-1-3-ur5")
+    assert "parallel to axis 4" not in cells["ur5-text"].source and "parallel to axis 4" in cells["ur5-why"].source
+    for cid in ("s3-1-2", "s4-1-2"):
+        assert "hint" in cells[cid].metadata["tags"] and cells[cid].metadata["jupyter"]["source_hidden"]
+    # the predict's answer states 1.1's answer: the workbook keeps it folded behind the part's self-check
+    assert cells["predict-answer-1-1"].metadata["kinlib"]["part"] == "1.1"
+    assert r"\pm\pi/2" not in cells["predict-1-1"].source and "vertical" not in cells["predict-1-1"].source
+
+
+def test_01_students_text_gives_no_graded_answer():
+    cells = _cells("01")
+    assert "six joints, rank 6" not in cells["objectives"].source
+    s = cells["summary"].metadata["kinlib"]
+    assert set(s["reveals"]) == {"1.1", "1.3"}
+    for leak in ("both singular", "six joints", "hanging"):
+        assert leak in cells["summary"].source or leak == "hanging"
+        assert leak not in s["students"], leak
+    e = cells["exp-1-1-text"].metadata["kinlib"]
+    assert e["reveals"] == ["1.1"] and "det" not in e["students"].split("**Units.**")[0].replace(r"\det J = 0$ does", "")
+    assert "reads 0" not in e["students"] and cells["exp-1-1"].metadata["kinlib"]["reveals"] == ["1.1"]
+
+
+def test_01_cart_pole_columns_have_units_and_det_zeros_do_not_depend_on_them():
+    """Column 1 (prismatic) is in m/s per m/s, column 2 (revolute) in m/s per rad/s: measuring the cart in cm
+    scales column 1 and so changes the velocity ellipse (the ratio of singular values), not where det J = 0."""
+    text = _cells("01")["exp-1-1-text"].source
+    assert "m/s per m/s" in text and "m/s per rad/s" in text and r"\lVert\dot\theta\rVert \le 1" in text
+    L = 1.0
+
+    def J(t2, k=1.0):  # k: tip metres per unit of θ1 (1 for metres, 0.01 for centimetres)
+        return np.array([[k, -L * math.sin(t2)], [0.0, L * math.cos(t2)]])
+
+    for t2 in (0.3, 1.0, 2.5):
+        s_m, s_cm = np.linalg.svd(J(t2), compute_uv=False), np.linalg.svd(J(t2, 0.01), compute_uv=False)
+        assert abs(s_m[1] / s_m[0] - s_cm[1] / s_cm[0]) > 1e-3  # another ellipse
+        assert np.linalg.det(J(t2)) != 0 and np.linalg.det(J(t2, 0.01)) != 0
+    for t2 in (math.pi / 2, -math.pi / 2):
+        assert abs(np.linalg.det(J(t2))) < 1e-15 and abs(np.linalg.det(J(t2, 0.01))) < 1e-15
+
+
+def test_01_full_jacobians_share_rank_row_subsets_do_not():
+    """The full 6×n J_s, J_b and J = blockdiag(R, R) J_b have one rank (random arms, modern_robotics); the
+    (v_x, v_y) rows of J_s of a planar 2R arm have det 0 everywhere, the ṗ rows of J and J_b L1 L2 sin θ2;
+    the planar triple (ω_z, v_x, v_y) of J_s and (ω_z, ṗ_x, ṗ_y) of J have the same determinant."""
+    rng = np.random.default_rng(30)
+    for _ in range(20):
+        n = int(rng.integers(2, 5))
+        S = np.column_stack([np.r_[a / np.linalg.norm(a), -np.cross(a / np.linalg.norm(a), rng.normal(size=3))]
+                             for a in rng.normal(size=(n, 3))])
+        M = mr.RpToTrans(mr.MatrixExp3(mr.VecToso3(rng.normal(size=3))), rng.normal(size=3))
+        B = mr.Adjoint(mr.TransInv(M)) @ S
+        q = rng.normal(size=n)
+        if rng.random() < 0.5:
+            S[:, -1] = S[:, 0]  # a repeated axis: rank-deficient at every θ
+            B = mr.Adjoint(mr.TransInv(M)) @ S
+        T = mr.FKinSpace(M, S, q)
+        Js, Jb = mr.JacobianSpace(S, q), mr.JacobianBody(B, q)
+        R = T[:3, :3]
+        Jg = np.block([[R, np.zeros((3, 3))], [np.zeros((3, 3)), R]]) @ Jb
+        ranks = {np.linalg.matrix_rank(X, tol=1e-9) for X in (Js, Jb, Jg)}
+        assert len(ranks) == 1
+    L1, L2 = 0.9, 0.6
+    S2r = np.array([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0]], dtype=float).T
+    M2r = np.array([[1, 0, 0, L1 + L2], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+    B2r = mr.Adjoint(mr.TransInv(M2r)) @ S2r
+    for q in rng.uniform(-3, 3, size=(10, 2)):
+        Js, Jb, T = mr.JacobianSpace(S2r, q), mr.JacobianBody(B2r, q), mr.FKinSpace(M2r, S2r, q)
+        p = T[:3, 3]
+        pdot = Js[3:] + np.cross(Js[:3].T, p).T  # ṗ = v_s + ω_s × p: the geometric J's ṗ rows
+        assert abs(np.linalg.det(Js[3:5])) < 1e-12
+        assert np.isclose(np.linalg.det(pdot[:2]), L1 * L2 * math.sin(q[1]))
+        assert np.isclose(abs(np.linalg.det(Jb[3:5])), abs(L1 * L2 * math.sin(q[1])))
+    S3r = np.array([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L1, 0], [0, 0, 1, 0, -L1 - L2, 0]], dtype=float).T
+    M3r = np.array([[1, 0, 0, L1 + L2 + 0.4], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+    for q in rng.uniform(-3, 3, size=(10, 3)):
+        Js, p = mr.JacobianSpace(S3r, q), mr.FKinSpace(M3r, S3r, q)[:3, 3]
+        pdot = Js[3:] + np.cross(Js[:3].T, p).T
+        assert np.isclose(np.linalg.det(Js[[2, 3, 4]]), np.linalg.det(np.vstack([Js[2], pdot[:2]])))
+    text = _cells("01")["ans-1-3"].source
+    assert "subset of rows" in text and r"(v_x, v_y)" in text
+
+
+def test_01_ur5_view_shows_the_pitch_axes_slanting():
+    """At matplotlib's default view (elev 30°, azim −60°) an axis along y_s projects on screen at some angle;
+    the notebook's view must draw the pitch axes (along y_s) far from vertical and far from the vertical axes."""
+    import matplotlib.pyplot as plt
+
+    ns = dict(answers("01"))
+    ns["plt"] = plt
+    src = _cells("01")["fig-1-3-ur5"].source.replace("plt.show()", "")
+    exec(compile(src, "01:fig-1-3-ur5", "exec"), ns)
+    fig = ns["fig"]
+    fig.canvas.draw()
+    from mpl_toolkits.mplot3d import proj3d
+
+    for ax in fig.axes:
+        M = ax.get_proj()
+
+        def screen(v):
+            x, y, _ = proj3d.proj_transform(*v, M)
+            return np.array(ax.transData.transform((x, y)))
+
+        o = screen((0.3, 0.0, 0.2))
+        dy, dz = screen((0.3, 0.1, 0.2)) - o, screen((0.3, 0.0, 0.3)) - o
+        ang = lambda u, w: math.degrees(math.acos(abs(u @ w) / np.linalg.norm(u) / np.linalg.norm(w)))  # noqa: E731
+        assert ang(dy, np.array([0.0, 1.0])) > 30 and ang(dy, dz) > 30
+    plt.close(fig)
+
+
+def test_1_4_offset_rp_arm_key_and_verdicts():
+    ns = answers("01")
+    d = sp.Symbol("d", positive=True)
+    M = sp.Matrix([[1, 0, 0, 0], [0, 1, 0, d], [0, 0, 1, 0], [0, 0, 0, 1]])
+    S = sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 0, 1, 0, 0]]).T
+    J = sp.Matrix([[-d * cos(th1) - th2 * sin(th1), cos(th1)], [-d * sin(th1) + th2 * cos(th1), sin(th1)]])
+    assert ns["M_rp"] == M and ns["S_rp"] == S and sp.simplify(ns["J_rp"] - J) == sp.zeros(2, 2)
+    assert sp.simplify(ns["detJ_rp"] + th2) == 0 and ns["detJ_rp_zero"] == 0
+    # independent: the tool position from plane geometry, differentiated numerically
+    dv = 0.7
+    for q in ([0.4, -0.3], [2.0, 1.1]):
+        p = lambda a, b: _rot(a) @ np.array([b, dv])  # noqa: E731
+        fd = np.column_stack([(p(q[0] + 1e-6, q[1]) - p(q[0] - 1e-6, q[1])) / 2e-6,
+                              (p(q[0], q[1] + 1e-6) - p(q[0], q[1] - 1e-6)) / 2e-6])
+        got = np.array(J.subs({d: dv, th1: q[0], th2: q[1]}), dtype=float)
+        assert np.allclose(got, fd, atol=1e-8) and np.isclose(np.linalg.det(fd), -q[1], atol=1e-7)
+    # right, other valid forms, wrong
+    assert _judged("1.4", "M_rp", ns["M_rp"], M) == "correct"
+    assert _judged("1.4", "S_rp", ns["S_rp"], S) == "correct"
+    assert _judged("1.4", "S_rp", ns["S_rp"], sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 0, -1, 0, 0]]).T) != "correct"
+    assert _judged("1.4", "S_rp", ns["S_rp"], sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 1, 0]]).T) != "correct"
+    assert _judged("1.4", "M_rp", ns["M_rp"], sp.eye(4)) != "correct"  # the tool is not at the origin
+    other_J = sp.Matrix([[-sqrt(d**2 + th2**2) * sin(th1 + sp.atan2(d, th2)), cos(th1)],
+                         [sqrt(d**2 + th2**2) * cos(th1 + sp.atan2(d, th2)), sin(th1)]])  # polar form: r, φ
+    assert _judged("1.4", "J_rp", ns["J_rp"], other_J) == "correct"
+    assert _judged("1.4", "J_rp", ns["J_rp"], J) == "correct"
+    assert _judged("1.4", "J_rp", ns["J_rp"], J.T) != "correct"
+    assert _judged("1.4", "J_rp", ns["J_rp"], J.subs(d, 0)) != "correct"  # forgot the offset
+    assert _judged("1.4", "detJ_rp", ns["detJ_rp"], -th2 * (sin(th1) ** 2 + cos(th1) ** 2)) == "correct"
+    assert _judged("1.4", "detJ_rp", ns["detJ_rp"], th2) != "correct"
+    assert _judged("1.4", "detJ_rp", ns["detJ_rp"], -th2 - d) != "correct"
+    assert _judged("1.4", "detJ_rp_zero", ns["detJ_rp_zero"], sp.Integer(0)) == "correct"
+    assert _judged("1.4", "detJ_rp_zero", ns["detJ_rp_zero"], 0.0) == "correct"
+    assert _judged("1.4", "detJ_rp_zero", ns["detJ_rp_zero"], -d) != "correct"  # "the tool on joint 1's axis"
