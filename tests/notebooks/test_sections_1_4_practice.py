@@ -53,15 +53,16 @@ def _order(key):
 
 @functools.cache
 def answers(key):
-    """The notebook's namespace after its setup, given and solution cells (no figures, widgets, checks)."""
+    """The notebook's namespace after its setup, given, figure and solution cells (no widgets, no checks)."""
+    import matplotlib.pyplot as plt
+
     ns = {"display": lambda *a, **k: None}
     for cell in _read(key).cells:
         tags = cell.metadata.get("tags", [])
         if cell.cell_type != "code" or "check" in tags or "nbval-ignore-output" in tags:
             continue
-        if "solution" not in tags and ("plotting." in cell.source or "plt." in cell.source):
-            continue  # a figure
         exec(compile(cell.source, f"{key}:{cell.id}", "exec"), ns)
+        plt.close("all")
     return ns
 
 
@@ -241,3 +242,92 @@ def test_1_4_offset_rp_arm_key_and_verdicts():
     assert _judged("1.4", "detJ_rp_zero", ns["detJ_rp_zero"], sp.Integer(0)) == "correct"
     assert _judged("1.4", "detJ_rp_zero", ns["detJ_rp_zero"], 0.0) == "correct"
     assert _judged("1.4", "detJ_rp_zero", ns["detJ_rp_zero"], -d) != "correct"  # "the tool on joint 1's axis"
+
+
+# ============================================================================================== notebook 04
+def _planar_3r_points(q, L=(1, 1, 1)):
+    """Joint points q1, q2, q3 and the tool p of the planar 3R arm, exact, from plane geometry."""
+    pts, a, x, y = [], 0, sp.Integer(0), sp.Integer(0)
+    for qi, Li in zip(q, L):
+        pts.append((x, y))
+        a = a + qi
+        x, y = x + Li * cos(a), y + Li * sin(a)
+    return pts, (x, y)
+
+
+def test_04_ties_are_equal_distances_same_x_or_mirrored():
+    """|ṗ_y| from joint i is |p_x − q_i,x| (per rad/s): at θ = (0, π/2, π/6), L = 1, the joints are at x = 0, 1, 1 and
+    the tool at x = 1/2: all three tie, although joint 1's x differs from the others'."""
+    from kinlib.manipulability import strongest_joints
+
+    q = [sp.Integer(0), pi / 2, pi / 6]
+    pts, (px, py) = _planar_3r_points(q)
+    dists = [sp.nsimplify(sp.simplify(px - qx)) for qx, _ in pts]
+    assert dists == [sp.Rational(1, 2), -sp.Rational(1, 2), -sp.Rational(1, 2)]
+    assert pts[0][0] != pts[1][0]  # not "the same x"
+    ns = answers("04")
+    row = [sp.simplify(v) for v in ns["evaluate_at"](ns["Jp_equal"], q, ns["arm"].thetas)[1, :]]
+    assert row == dists and strongest_joints(sp.Matrix([row])) == (1, 2, 3)
+    # the rule on random configurations: equal |entries| exactly when the distances are equal in size
+    rng = np.random.default_rng(7)
+    Jp = ns["Jp"].subs({ns["L1"]: 1, ns["L2"]: 1, ns["L3"]: 1})
+    f = sp.lambdify(ns["arm"].thetas, Jp[1, :])
+    for qn in rng.uniform(-3, 3, size=(20, 3)):
+        pts, (pxn, _) = _planar_3r_points([float(v) for v in qn])
+        assert np.allclose(np.abs(np.array(f(*qn), dtype=float).ravel()), [abs(float(pxn - qx)) for qx, _ in pts])
+    text = _cells("04")["summary"].source
+    assert r"|p_x - q_{1,x}| = |p_x - q_{2,x}|" in text and "mirrored" in text and r"(0, \pi/2, \pi/6)" in text
+    assert "same $x$ (for" not in text
+
+
+def test_04_check_of_c_follows_its_explanation_not_the_picker():
+    order = _order("04")
+    assert order.index("04-021") + 1 == order.index("04-023") < order.index("04-022")
+    assert "solution" in _cells("04")["04-021b"].metadata["tags"]
+
+
+def test_4_2_gantry_arm_key_and_verdicts():
+    from kinlib.manipulability import strongest_joints
+
+    ns = answers("04")
+    L = sp.Symbol("L", positive=True)
+    # typed by hand: a slide along x_s (column (1, 0)), then ẑ × (p − q_i) for the two revolute joints
+    q2 = (th1, 0)
+    q3 = (th1 + 2 * L * cos(th2), 2 * L * sin(th2))
+    p = (q3[0] + L * cos(th2 + th3), q3[1] + L * sin(th2 + th3))
+    Jp = sp.Matrix([[1, -(p[1] - q2[1]), -(p[1] - q3[1])], [0, p[0] - q2[0], p[0] - q3[0]]])
+    assert sp.simplify(ns["Jp_gantry"] - Jp) == sp.zeros(2, 3)
+    at = {th1: sp.Rational(1, 2), th2: 2 * pi / 3, th3: -pi / 3}
+    row_y, row_x = Jp[1, :].subs(at), Jp[0, :].subs(at).subs(L, sp.Rational(1, 4))
+    assert [sp.simplify(v) for v in row_y] == [0, -L / 2, L / 2]
+    assert strongest_joints(row_y / L) == (2, 3) and strongest_joints(row_x) == 1
+    assert strongest_joints(Jp[0, :].subs(at).subs(L, 1)) == 2  # the slide-vs-turn comparison depends on units
+    # independent: modern_robotics with the screw axes typed by hand (L = 1/4)
+    Lv = 0.25
+    S = np.array([[0, 0, 0, 1, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -2 * Lv, 0]], dtype=float).T
+    M = np.array([[1, 0, 0, 3 * Lv], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1.0]])
+    qn = np.array([0.5, 2 * math.pi / 3, -math.pi / 3])
+    Js, pn = mr.JacobianSpace(S, qn), mr.FKinSpace(M, S, qn)[:3, 3]
+    pdot = Js[3:] + np.cross(Js[:3].T, pn).T
+    assert np.allclose(pdot[:2], np.array(Jp.subs(at).subs(L, Lv), dtype=float))
+    assert (ns["joint_for_pdot_y"], ns["joint_for_pdot_x"]) == ((2, 3), 1)
+    # right, other valid, wrong
+    assert _judged("4.2", "Jp_gantry", ns["Jp_gantry"], Jp) == "correct"
+    other = sp.Matrix([[1, -2 * L * sin(th2) - L * sin(th2 + th3), -L * (sin(th2) * cos(th3) + cos(th2) * sin(th3))],
+                       [0, 2 * L * cos(th2) + L * cos(th2 + th3), L * (cos(th2) * cos(th3) - sin(th2) * sin(th3))]])
+    assert _judged("4.2", "Jp_gantry", ns["Jp_gantry"], other) == "correct"
+    assert _judged("4.2", "Jp_gantry", ns["Jp_gantry"], Jp.subs(L, 1)) != "correct"
+    assert _judged("4.2", "Jp_gantry", ns["Jp_gantry"], Jp[:, [1, 0, 2]]) != "correct"
+    wrong_units = Jp.copy()
+    wrong_units[0, 0] = 0  # "a slide does not turn anything": the prismatic column forgotten
+    assert _judged("4.2", "Jp_gantry", ns["Jp_gantry"], wrong_units) != "correct"
+    for name, right, others, wrongs in (
+        ("joint_for_pdot_y", (2, 3), [(3, 2), [2, 3]], [2, 3, (1, 2, 3), (1, 3)]),
+        ("joint_for_pdot_x", 1, [(1,)], [2, (1, 2), 3]),
+    ):
+        key = ns[name]
+        assert _judged("4.2", name, key, right, "choice") == "correct"
+        for v in others:
+            assert _judged("4.2", name, key, v, "choice") == "correct", v
+        for v in wrongs:
+            assert _judged("4.2", name, key, v, "choice") != "correct", v
