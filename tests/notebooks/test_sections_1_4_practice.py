@@ -331,3 +331,114 @@ def test_4_2_gantry_arm_key_and_verdicts():
             assert _judged("4.2", name, key, v, "choice") == "correct", v
         for v in wrongs:
             assert _judged("4.2", name, key, v, "choice") != "correct", v
+
+
+# ============================================================================================== notebook 02
+def test_02_students_text_and_figure():
+    cells = _cells("02")
+    assert cells["predict-answer-2-2"].metadata["kinlib"]["part"] == "2.2"
+    e = cells["exp-text"].metadata["kinlib"]
+    assert e["reveals"] == ["5.1"] and cells["explorer"].metadata["kinlib"]["reveals"] == ["5.1", "5.4"]
+    assert "determinant" not in e["students"] and "singular" not in e["students"]
+    assert "frames=False" in cells["fig-columns"].source  # no θ̇3 arrow on top of {b}'s y axis
+    assert "subset of their rows" in cells["summary"].source
+
+
+def test_2_5_lift_with_an_arm_key_and_verdicts():
+    ns = answers("02")
+    a, L = sp.Symbol("a", positive=True), sp.Symbol("L", positive=True)
+    M = sp.Matrix([[1, 0, 0, a + L], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]])
+    S = sp.Matrix([[0, 0, 0, 0, 1, 0], [0, 0, 1, 0, -a, 0]]).T
+    Js = sp.Matrix([[0, 0, 0, 0, 1, 0], [0, 0, 1, th1, -a, 0]]).T
+    J = sp.Matrix([[0, 0, 0, 0, 1, 0], [0, 0, 1, -L * sin(th2), L * cos(th2), 0]]).T
+    assert ns["M_pr"] == M and ns["S_pr"] == S
+    assert sp.simplify(ns["Js_pr"] - Js) == sp.zeros(6, 2) and sp.simplify(ns["J_pr"] - J) == sp.zeros(6, 2)
+    # independent: modern_robotics with the axes typed by hand; ṗ = v_s + ω_s × p
+    av, Lv = 0.6, 0.9
+    Sn, Mn = np.array(S.subs(a, av), dtype=float), np.array(M.subs({a: av, L: Lv}), dtype=float)
+    for q in ([0.5, -1.1], [-0.3, 2.4]):
+        q = np.array(q)
+        Jsn, p = mr.JacobianSpace(Sn, q), mr.FKinSpace(Mn, Sn, q)[:3, 3]
+        assert np.allclose(Jsn, np.array(Js.subs({a: av, th1: q[0], th2: q[1]}), dtype=float))
+        Jg = np.vstack([Jsn[:3], Jsn[3:] + np.cross(Jsn[:3].T, p).T])
+        assert np.allclose(Jg, np.array(J.subs({L: Lv, th1: q[0], th2: q[1]}), dtype=float))
+    assert _judged("2.5", "M_pr", ns["M_pr"], M) == "correct"
+    assert _judged("2.5", "M_pr", ns["M_pr"], M.subs(a, 0)) != "correct"
+    assert _judged("2.5", "S_pr", ns["S_pr"], S) == "correct"
+    assert _judged("2.5", "S_pr", ns["S_pr"], S.subs(a, -a)) != "correct"  # v = ω × q: the sign
+    assert _judged("2.5", "Js_pr", ns["Js_pr"], Js) == "correct"
+    assert _judged("2.5", "Js_pr", ns["Js_pr"], S) != "correct"  # joint 2's axis not raised by the lift
+    assert _judged("2.5", "Js_pr", ns["Js_pr"], J) != "correct"  # the tool's velocity is not the v of J_s
+    other = J.copy()
+    other[3, 1], other[4, 1] = -L * cos(th2 - pi / 2), L * sin(th2 + pi / 2)
+    assert _judged("2.5", "J_pr", ns["J_pr"], other) == "correct"
+    assert _judged("2.5", "J_pr", ns["J_pr"], J) == "correct"
+    assert _judged("2.5", "J_pr", ns["J_pr"], Js) != "correct"
+    assert _judged("2.5", "J_pr", ns["J_pr"], J[[3, 4, 5, 0, 1, 2], :]) != "correct"  # [v; ω] order
+
+
+# ============================================================================================== notebook 03
+def test_03_students_text_and_figures():
+    cells = _cells("03")
+    assert cells["predict-answer-3-4"].metadata["kinlib"]["part"] == "3.4"
+    s = cells["summary"].metadata["kinlib"]
+    assert set(s["reveals"]) >= {"3.3", "3.4"} and "(1, 0, 0, 0, 0, 0)" not in s["students"]
+    assert "(1, 0, 0, 0, 0, 0)" in cells["summary"].source
+    e = cells["exp-text"].metadata["kinlib"]
+    assert e["reveals"] == ["3.4"] and "vanishes" not in e["students"]
+    assert set(cells["explorer"].metadata["kinlib"]["reveals"]) >= {"6.1", "6.2"}
+    assert "frames=False" in cells["fig-columns"].source and "view_init" in cells["fig-columns"].source
+
+
+def test_03_labels_sit_next_to_their_joints():
+    """Each θi label of the 3-D pictures is drawn within 0.4 (data units, reach about 2) of its joint."""
+    import matplotlib.pyplot as plt
+
+    ns = dict(answers("03"))
+    ns["plt"] = plt
+    for cid in ("fig-home", "fig-columns", "fig-3-5"):
+        src = _cells("03")[cid].source.replace("plt.show()", "")
+        exec(compile(src, f"03:{cid}", "exec"), ns)
+        art, sk = ns["art"], ns["sk"]
+        for i, t in enumerate(art.labels):
+            x, y, z = t.get_position_3d()
+            assert np.linalg.norm(np.array([x, y, z], dtype=float) - sk[:, i + 1]) < 0.4, (cid, i)
+        plt.close("all")
+
+
+def test_3_5_spherical_rrp_arm_key_and_verdicts():
+    ns = answers("03")
+    H, L = sp.symbols("H L", positive=True)
+    c1, s1, c2, s2 = cos(th1), sin(th1), cos(th2), sin(th2)
+    M = sp.Matrix([[1, 0, 0, L], [0, 1, 0, 0], [0, 0, 1, H], [0, 0, 0, 1]])
+    S = sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 1, 0, -H, 0, 0], [0, 0, 0, 1, 0, 0]]).T
+    Js = sp.Matrix([[0, 0, 1, 0, 0, 0], [-s1, c1, 0, -H * c1, -H * s1, 0], [0, 0, 0, c1 * c2, s1 * c2, -s2]]).T
+    r = L + th3
+    J = sp.Matrix([[0, 0, 1, -r * s1 * c2, r * c1 * c2, 0], [-s1, c1, 0, -r * c1 * s2, -r * s1 * s2, -r * c2],
+                   [0, 0, 0, c1 * c2, s1 * c2, -s2]]).T
+    assert ns["M_rrp"] == M and ns["S_rrp"] == S
+    assert sp.simplify(ns["Js_rrp"] - Js) == sp.zeros(6, 3) and sp.simplify(ns["J_rrp"] - J) == sp.zeros(6, 3)
+    # independent: modern_robotics with the axes typed by hand
+    Hv, Lv = 1.1, 0.7
+    Sn, Mn = np.array(S.subs(H, Hv), dtype=float), np.array(M.subs({H: Hv, L: Lv}), dtype=float)
+    for q in ([0.4, -0.7, 0.25], [2.1, 1.2, -0.4]):
+        q = np.array(q)
+        Jsn, p = mr.JacobianSpace(Sn, q), mr.FKinSpace(Mn, Sn, q)[:3, 3]
+        sub = {H: Hv, L: Lv, th1: q[0], th2: q[1], th3: q[2]}
+        assert np.allclose(Jsn, np.array(Js.subs(sub), dtype=float))
+        assert np.allclose(np.vstack([Jsn[:3], Jsn[3:] + np.cross(Jsn[:3].T, p).T]), np.array(J.subs(sub), dtype=float))
+    assert _judged("3.5", "M_rrp", ns["M_rrp"], M) == "correct"
+    assert _judged("3.5", "S_rrp", ns["S_rrp"], S) == "correct"
+    wrong_S = S.copy()
+    wrong_S[3, 1] = H  # v = +ω × q: the sign
+    assert _judged("3.5", "S_rrp", ns["S_rrp"], wrong_S) != "correct"
+    assert _judged("3.5", "Js_rrp", ns["Js_rrp"], Js) == "correct"
+    assert _judged("3.5", "Js_rrp", ns["Js_rrp"], Js.applyfunc(lambda e: sp.expand_trig(e))) == "correct"
+    assert _judged("3.5", "Js_rrp", ns["Js_rrp"], S) != "correct"  # the axes not moved
+    assert _judged("3.5", "Js_rrp", ns["Js_rrp"], J) != "correct"
+    other_J = J.copy()
+    other_J[3, 0] = -r * sin(th1) * sin(th2 + pi / 2)  # c2 written as sin(θ2 + π/2)
+    assert _judged("3.5", "J_rrp", ns["J_rrp"], other_J) == "correct"
+    assert _judged("3.5", "J_rrp", ns["J_rrp"], J) == "correct"
+    assert _judged("3.5", "J_rrp", ns["J_rrp"], J.subs(th3, 0)) != "correct"  # forgot the slide in the radius
+    assert _judged("3.5", "J_rrp", ns["J_rrp"], Js) != "correct"
