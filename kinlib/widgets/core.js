@@ -113,6 +113,7 @@
     var cond = exactSingular(S, q);
     var rankLost = !S.complete && sLast <= S.near.rtol * smax;
     var state = cond >= 0 || rankLost ? "singular" : (wRatio < S.near.ratio ? "near" : "regular");
+    if (S.answers === false) state = "unmarked"; // the students' version: no state is told (kinlib.widgets.without_answers)
     // ellipses: ṗ (the drawn rows) with the task's orientation rows held, and with every joint free
     var Jp = rowsOf(J, n, S.ellRows), d = S.ellRows.length;
     function ellipse(A) {
@@ -131,7 +132,7 @@
     }
     var main = held || free, smin = main.s[d - 1], smx = main.s[0];
     var mratio = smx > 0 ? smin / smx : 0;
-    var block = (state !== "regular" && mratio < 0.35) ? main.U[d - 1] : null;
+    var block = (state !== "regular" && state !== "unmarked" && mratio < 0.35) ? main.U[d - 1] : null;
     var v = Jp.map(function (r) { var s = 0; for (var k = 0; k < n; k++) s += r[k] * qd[k]; return s; });
     var axes = []; // each joint's axis in space: ω_i (revolute) or the direction of ṗ_i (prismatic)
     for (i = 0; i < n; i++) {
@@ -283,6 +284,10 @@
 
   function words(S, st) {
     var parts = [];
+    if (st.state === "unmarked") { // the students' version: what the drawing shows, no state
+      var e = st.held || st.free;
+      return "Velocity ellipse semi-axes " + lengths(e.s) + ".";
+    }
     if (st.state === "singular") parts.push("Singular configuration: J loses rank (rank " + st.rank + " of " + st.full + ").");
     else if (st.state === "near") parts.push("Near a singular configuration: the manipulability is " + fmt(st.wRatio, 3) + " of its largest value, below " + S.near.ratio + ".");
     else parts.push("Regular configuration: full rank " + st.full + ".");
@@ -400,6 +405,7 @@
   }
   // the banner: the state (data-state) in words
   function banner(status, S, st) {
+    if (st.state === "unmarked") { status.setAttribute("data-state", "unmarked"); status.textContent = ""; return; }
     var msg = st.state === "singular"
       ? "SINGULAR configuration: J loses rank (rank " + st.rank + " of " + st.full + ")" + (st.block ? "; the tool cannot move along the red dash-dot line" : "")
       : st.state === "near" ? "near a singular configuration: some directions need large joint rates"
