@@ -69,7 +69,7 @@ from ..schema import (
     set_source_hidden,
 )
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
-from .aids import STUDENTS_OUTPUTS, show_students_version, students_cell, stub, student_reading_aid
+from .aids import STUDENTS_OUTPUTS, show_students_version, stub, student_reading_aid, students_cell
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
 from .execute import notebook_client
 from .incremental import Stamps, build_sections, build_site, code_key, key, print_changed_pdfs
