@@ -253,7 +253,7 @@ def test_cells_that_reveal_a_graded_answer_show_their_students_version(built):
     s_students = spec(js)
     assert s_students["answers"] is False and s_students["conditions"] == [] and s_students["wMax"] == 0
     assert s_students["showMaximum"] is False and s_students["complete"] is False
-    assert "\"period\"" not in json.dumps(s_students) and repr(s_full["wMax"]) not in js
+    assert '"period"' not in json.dumps(s_students) and repr(s_full["wMax"]) not in js
     assert "configuration" not in shown["text/plain"] and shown["image/png"]
     assert '"answers":false' in problems  # the page shows that output
     wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
