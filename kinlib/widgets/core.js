@@ -319,7 +319,12 @@
     ".kinlib-ui .kinlib-player{margin:6px 0}.kinlib-ui .kinlib-player input[type=range]{width:300px}" +
     ".kinlib-ui .kinlib-chart{display:block;margin-top:8px}.kinlib-ui table{border-collapse:collapse;margin-top:6px}" +
     ".kinlib-ui td,.kinlib-ui th{padding:0 8px;text-align:right;font-family:monospace}" +
-    "@media print{.kinlib-ui .kinlib-track,.kinlib-ui .kinlib-orbit,.kinlib-ui .kinlib-sr,.kinlib-ui .kinlib-player{display:none}}";
+    // narrow screens (a phone): the drawing scales to its container and comes first, the sliders just under it
+    ".kinlib-ui .kinlib-controls,.kinlib-ui .kinlib-side{max-width:100%}.kinlib-ui .kinlib-track{max-width:100%}.kinlib-ui input[type=range]{max-width:100%}" +
+    ".kinlib-ui figure.kinlib-figure{margin:0;min-width:0;max-width:100%}.kinlib-ui svg.kinlib-picture{width:100%;height:auto}" +
+    "@media (max-width:760px){.kinlib-ui figure.kinlib-figure{order:-1}}" +
+    // printed: no slider, so no slider legend either
+    "@media print{.kinlib-ui .kinlib-track,.kinlib-ui .kinlib-orbit,.kinlib-ui .kinlib-sr,.kinlib-ui .kinlib-player,.kinlib-ui .kinlib-mark-legend{display:none}}";
 
   function legendItem(ul, text, attrs, fill) {
     var li = el("li", {}, ul), s = svg("svg", {width: 30, height: 12, "aria-hidden": "true"}, li);
@@ -342,7 +347,7 @@
   }
   // the picture: an SVG of S.size px, its grid (2-D: ticks in world units) and the scene group that is redrawn
   function picture(X, parent, label) {
-    var S = X.S, fig = el("figure", {style: "margin:0"}, parent);
+    var S = X.S, fig = el("figure", {class: "kinlib-figure", style: "flex:0 1 " + S.size + "px"}, parent);
     var sv = svg("svg", {width: S.size, height: S.size, viewBox: "0 0 " + S.size + " " + S.size, role: "img",
       "aria-label": label + (S.planar ? "" : " (drag, or focus and use the arrow keys, to turn the view)"),
       class: "kinlib-picture", style: "background:#fff;outline:1px solid #ddd;touch-action:none;display:block", tabindex: S.planar ? null : 0}, fig);
