@@ -274,7 +274,11 @@ def _figure_alts(nb, section_default: str) -> dict:
     return alts
 
 
-_PICTURES = {"window.kinlibExplorer(": "explorer", "window.kinlibAnimation(": "animation", "window.kinlibPicker(": "picker"}
+_PICTURES = {
+    "window.kinlibExplorer(": "explorer",
+    "window.kinlibAnimation(": "animation",
+    "window.kinlibPicker(": "picker",
+}
 _PART = re.compile(r"^\s*(?:#+\s*)?\**\s*(\d+\.\d+)")
 _SKIP_CSS = (
     "<style>/* kinlib: skip links, the first Tab stops of a page */\n"
