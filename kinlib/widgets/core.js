@@ -405,7 +405,7 @@
         legendItem(ul, "ṗ with " + S.hold.map(function (r) { return ROWNAMES[r]; }).join(", ") + " held (×" + S.velScale + ")", {stroke: C.held}, C.heldFill);
         legendItem(ul, "ṗ, all joints free (×" + S.velScale + ")", {stroke: C.free, "stroke-width": 1.3, "stroke-dasharray": "5 3"});
       } else legendItem(ul, "velocity ellipse (×" + S.velScale + ")", {stroke: C.held}, C.heldFill);
-      legendItem(ul, "direction the tool cannot move", {stroke: C.block, "stroke-width": 2.5, "stroke-dasharray": "9 4 2 4"});
+      if (S.answers !== false) legendItem(ul, "direction the tool cannot move", {stroke: C.block, "stroke-width": 2.5, "stroke-dasharray": "9 4 2 4"}); // (never drawn in the students' version)
     }
   }
   // the banner: the state (data-state) in words
