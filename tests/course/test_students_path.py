@@ -116,3 +116,17 @@ def test_phone_shows_the_whole_drawing_with_its_sliders_just_under(real_handouts
         page.screenshot(path=str(SHOTS / "phone-05-problems-explorer.png"))
     finally:
         ctx.close()
+
+
+@pytest.mark.browser
+def test_printed_pages_have_no_slider_legend_nor_skip_links(real_handouts, shared_browser):
+    """The PDF prints the page with no sliders: the explorer's "▲ on a slider" legend and the skip links are not
+    printed (they are on screen)."""
+    ctx, page = _page(shared_browser, real_handouts / "solutions" / "05_singularities_planar.html")
+    try:
+        shown = "sel => getComputedStyle(document.querySelector(sel)).display"
+        assert page.evaluate(shown, ".kinlib-mark-legend") != "none" and page.evaluate(shown, ".kinlib-skip") != "none"
+        page.emulate_media(media="print")
+        assert page.evaluate(shown, ".kinlib-mark-legend") == "none" and page.evaluate(shown, ".kinlib-skip") == "none"
+    finally:
+        ctx.close()
