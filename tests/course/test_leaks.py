@@ -42,9 +42,6 @@ import sympy as sp
 ROOT = Path(__file__).resolve().parents[2]
 OUT = ROOT / "build" / "handouts-students"
 
-pytestmark = pytest.mark.slow
-
-
 # ---------------------------------------------------------------------------------------------------
 # One spelling for a formula
 
@@ -463,6 +460,7 @@ def test_forms_of_a_set_and_an_expression():
     assert not find_hits(fs, {"05.html": "Let θ = (π/4, −π/4, π/4): is it singular?"}, ["05"])  # 5.3's question
 
 
+@pytest.mark.slow
 def test_no_students_file_states_a_graded_answer(answer_key, students_build):
     """Every graded answer of the answer key, in every form above, in every file of the students' build: no hit
     outside :data:`ALLOWED`. The failure lists each hit (part, answer, form, file, the text around it)."""
