@@ -64,8 +64,13 @@ DET_63 = sp.Matrix.hstack(*[P_63.diff(t) for t in (t1, t2, t3)]).det()
 
 CASES = {
     # name: (part, kind, right, [other valid forms], {wrong: value})
-    "M_56": ("5.6", "expr", homog(2 * L, L, 0), [homog(L + L, L, 0)], {"tool at (2L, 0)": homog(2 * L, 0, 0),
-                                                                       "tool at (3L, L)": homog(3 * L, L, 0)}),
+    "M_56": (
+        "5.6",
+        "expr",
+        homog(2 * L, L, 0),
+        [homog(L + L, L, 0)],
+        {"tool at (2L, 0)": homog(2 * L, 0, 0), "tool at (3L, L)": homog(3 * L, L, 0)},
+    ),
     "S_56": (
         "5.6",
         "expr",
@@ -73,7 +78,9 @@ CASES = {
         [sp.Matrix.hstack(*[S_56[:, i] for i in range(3)])],
         {
             "v = +ω × q": sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, L, 0], [0, 0, 1, -L, L, 0]]).T,
-            "joint 3 at (2L, L) (05's arm)": sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0], [0, 0, 1, L, -2 * L, 0]]).T,
+            "joint 3 at (2L, L) (05's arm)": sp.Matrix(
+                [[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0], [0, 0, 1, L, -2 * L, 0]]
+            ).T,
         },
     ),
     "detJ_56": (
@@ -155,7 +162,9 @@ def test_the_notebooks_declare_these_answers(stem, part):
     assert declared == {(pt, n, kind) for n, (pt, kind, *_rest) in CASES.items() if pt == part}
     groups = {(pid, n, kind) for g in schema.answer_groups(nb) for pid, n, kind, _ in g.answers if pid == part}
     assert groups == declared
-    question = next(c for c in nb["cells"] if "question" in schema.cell_tags(c) and f"**{part} (" in schema.cell_source(c))
+    question = next(
+        c for c in nb["cells"] if "question" in schema.cell_tags(c) and f"**{part} (" in schema.cell_source(c)
+    )
     assert schema.points_in(schema.cell_source(question)) == 5
 
 
