@@ -52,6 +52,7 @@ def test_workbook_05_keeps_the_ellipse_the_near_rule_and_the_dls_set_up():
     [
         ("05_singularities_planar", ["05-005", "05-007", "05-009", "05-024", "05-026", "05-035", "05-037"]),
         ("06_singularities_spatial", ["06-005", "06-007", "06-009"]),
+        ("07_going_further", ["07-013", "07-015", "07-017"]),
     ],
 )
 def test_step_hints_are_kept_folded(stem, steps):
