@@ -280,3 +280,27 @@ def test_the_old_sentences_are_gone(stem, wrong):
     text = "\n".join("".join(c["source"]) for c in nb["cells"] if c["cell_type"] == "markdown")
     for s in wrong:
         assert s not in text
+
+
+def test_07_labels_sit_at_their_joints():
+    """07's 3-D picture of your own arm: the labels are placed at the joints' current points (chain.skeleton), not
+    where the default placement puts them (the edges of the 3-D box)."""
+    nb = json.loads((ROOT / "notebooks" / "07_going_further.ipynb").read_text())
+    src = next("".join(c["source"]) for c in nb["cells"] if c.get("id") == "07-067")
+    assert "labels=False" in src and "my_arm.skeleton(q_my)" in src and "art.ax.text(x + 0.03, y, z + 0.06" in src
+    from kinlib import robots
+
+    arm = robots.from_urdf_joints(
+        [
+            ("revolute", (0, 0, 0.4), (0, 0, 0), (0, 0, 1)),
+            ("revolute", (0.35, 0, 0), (0, 0, 0), (0, 0, 1)),
+            ("prismatic", (0.3, 0, 0), (0, 0, 0), (0, 0, -1)),
+            ("revolute", (0, 0, 0), (0, 0, 0), (0, 0, 1)),
+        ],
+        tool=((0, 0, -0.1), (0, 0, 0)),
+    )
+    q = [0.3, 1.2, 0.1, 0.0]
+    pts = np.asarray(arm.skeleton(q), dtype=float)[:3]
+    # column i + 1 is joint i + 1's point: joint 2 at 0.35 m from joint 1, joint 4 below joint 3 by the slide's 0.1 m
+    assert np.isclose(np.linalg.norm(pts[:2, 2] - pts[:2, 1]), 0.35)
+    assert np.allclose(pts[:2, 4], pts[:2, 3]) and np.isclose(pts[2, 3] - pts[2, 4], 0.1)
