@@ -162,10 +162,28 @@ def test_what_a_student_reads_states_no_graded_answer(stem):
 def test_the_cells_that_reveal_are_marked():
     nb = nbformat.read(NB["05_singularities_planar"], as_version=4)
     meta = {c.get("id"): c.metadata.get("kinlib", {}) for c in nb.cells}
-    assert meta["05-051"]["reveals"] == ["5.1"]  # the explorer marks 5.1's answer on θ2's track
+    assert meta["05-051"]["reveals"] == ["5.1", "5.4"]  # the explorer marks 5.1's answer on θ2's track
     assert set(meta["05-019"]["reveals"]) == {"5.1", "5.4"} and set(meta["05-cost"]["reveals"]) == {"5.1", "5.3"}
     solution_text = next(c.source for c in nb.cells if c.get("id") == "05-019")
     assert r"\sqrt2\,L^2" in solution_text  # the solutions keep the sentence as it is
     nb6 = nbformat.read(NB["06_singularities_spatial"], as_version=4)
     meta6 = {c.get("id"): c.metadata.get("kinlib", {}) for c in nb6.cells}
     assert meta6["06-mistake-flat"]["reveals"] == ["6.1"] and meta6["06-025"]["reveals"] == ["6.1"]
+
+
+@pytest.mark.parametrize(
+    "stem, cids",
+    [
+        ("05_singularities_planar", ["05-050", "05-predict-explore"]),
+        ("06_singularities_spatial", ["06-024", "06-predict-explore"]),
+    ],
+)
+def test_explorer_texts_have_students_versions_without_readouts(stem, cids):
+    """The students' explorer shows no status, det or w readout (INTERFACES.md): the text beside it says none."""
+    nb = nbformat.read(NB[stem], as_version=4)
+    for c in nb.cells:
+        if c.get("id") in cids:
+            meta = c.metadata["kinlib"]
+            assert meta["reveals"] and meta["students"] != c.source
+            for word in ("readout", "status", "reads 0", r"\det J"):
+                assert word not in meta["students"], (c.get("id"), word)
