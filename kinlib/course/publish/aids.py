@@ -210,7 +210,12 @@ def stub(cell, describe: dict) -> str:
     for name in answers:
         what = ", ".join(x for x in (words.get(name), describe.get(name)) if x)
         lines.append(f"{name} = ...  # TODO: {what or 'your answer'} (part {part})")
-    examples = [answer_kind(meta, name) for name in answers]
+    # a True/False answer of kind "choice" needs no joint-number example
+    examples = [
+        answer_kind(meta, name)
+        for name in answers
+        if not (answer_kind(meta, name) == "choice" and describe.get(name) == "True or False")
+    ]
     for kind in dict.fromkeys(examples):
         lines += [f"#   {line}" for line in ANSWER_FORM_EXAMPLES.get(kind, ())]
     return "\n".join(lines) + "\n"

@@ -43,6 +43,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import json
+import re
 import shutil
 import subprocess
 import time
@@ -315,9 +316,18 @@ def prune_widget_state(nb) -> None:
 
 
 def _used_names(cells) -> set | None:
-    """Every name the code ``cells`` read (None when one of them does not parse: then trim nothing)."""
+    """Every name the code ``cells`` read (None when one of them does not parse: then trim nothing), and every
+    name the markdown ``cells`` show as code (`` `rank_at` ``, `` `task_rows(J, "planar")` ``): a function the
+    student's text names is imported in the student's set-up (issue 30).
+
+    >>> import nbformat
+    >>> sorted(_used_names([nbformat.v4.new_markdown_cell("take the rank (`rank_at`), or `task_rows(J, 2)`")]))
+    ['rank_at', 'task_rows']
+    """
     used: set = set()
     for c in cells:
+        if c.cell_type == "markdown":
+            used |= set(re.findall(r"`([A-Za-z_][A-Za-z0-9_]*)\b", c.source))
         if c.cell_type == "code":
             names = loaded_names(c.source)
             if names is None:
