@@ -339,7 +339,8 @@ NODE_TREES = (
 def test_every_node_with_code_as_an_argument_runs_nothing(refs):
     before = _state()
     for tree in NODE_TREES:
-        _judge_everywhere(tree, refs)
+        verdicts = _judge_everywhere(tree, refs)
+        assert all(v.status == "fail" for v in verdicts), (tree, verdicts)  # wrong, never a grader "error"
     _same_state(before, _state())
 
 
@@ -371,6 +372,7 @@ def test_strings_in_containers_are_never_parsed(refs):
         tree = json.loads(json.dumps(ex.export(value)))
         verdicts = _judge_everywhere(tree, refs)
         assert not any(v.passed for v in verdicts[:3]), (value, verdicts)  # (expr, subspace, set: never right)
+        assert not any(v.status == "error" for v in verdicts), (value, verdicts)
     _same_state(before, _state())
 
 
