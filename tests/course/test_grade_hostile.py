@@ -497,3 +497,30 @@ def test_the_end_to_end_attack_runs_nothing_in_a_batch(tmp_path, sandbox, grader
     assert all(r["status"] == "fail" for r in attacker["rows"]), [(r["part"], r["status"]) for r in attacker["rows"]]
     assert all(r["status"] == "pass" for r in victim["rows"]), [(r["part"], r["message"]) for r in victim["rows"]]
     assert not list(out.rglob("overrides.csv"))
+
+
+@pytest.mark.slow
+def test_the_end_to_end_attack_runs_nothing_in_the_gradescope_bundle(tmp_path, grader_reference_cache):
+    """The Gradescope bundle's own entry point (:func:`kinlib.course.lms.bundles.run_platform`, what
+    ``run_autograder`` calls; in this process, not in a container: test_grade_lms runs the container): the
+    attacker's results.json scores 0 of the maximum, the key is not in its output, no code ran."""
+    from test_grade import FIX, WB
+
+    from kinlib.course.lms import bundles
+
+    marker = tmp_path / "trusted-side-ran-code"
+    root = tmp_path / "autograder"
+    cfg = bundles.build_bundle(root / "source", notebooks=FIX / "notebooks", cache=grader_reference_cache)
+    (root / "submission").mkdir(parents=True)
+    wb = json.loads(WB.read_text())
+    cell = {"cell_type": "code", "metadata": {}, "outputs": [], "execution_count": None}
+    nb = dict(wb, cells=wb["cells"] + [dict(cell, source=_attack_cell(marker))])
+    (root / "submission" / "90_grade_fixture.ipynb").write_text(json.dumps(nb))
+    out = bundles.run_platform("gradescope", root=root)
+    assert not marker.exists(), "a string in an answer ran as code on the trusted side"
+    results = json.loads((root / "results" / "results.json").read_text())
+    top = sum(t["max_score"] for t in results["tests"])
+    assert top > 0 and results["score"] == 0 == out["score"], results
+    assert all(t["score"] == 0 for t in results["tests"]), results["tests"]
+    key = (root / "source" / "grader-secret").read_bytes().strip().decode(errors="ignore")
+    assert key not in json.dumps(results) and cfg
