@@ -315,6 +315,27 @@ def _decimal_hit(f: float, text: str):
     return None
 
 
+#: characters that, next to a match, make it a piece of a larger formula or list rather than the answer itself
+_JOINED = {"expression": set("+-/^0123456789abcdefghijklmnopqrstuvwxyz_"), "tuple": set(",.0123456789-")}
+
+
+def _standalone(text: str, f: Form):
+    """The span of the first occurrence of ``f.text`` in ``text`` that stands alone: an expression not a term of a
+    longer sum or product (``p = θ1 + L cos θ2`` does not state det J = L cos θ2), a tuple not a run inside a longer
+    list of numbers (a URDF joint table); other forms at their first occurrence."""
+    joined = next((chars for key, chars in _JOINED.items() if key in f.label), None)
+    i = text.find(f.text)
+    while i >= 0:
+        j = i + len(f.text)
+        before, after = text[i - 1 : i], text[j : j + 1]
+        if joined is None or not (
+            before in joined or (after in joined and after not in "0123456789abcdefghijklmnopqrstuvwxyz")
+        ):
+            return i, j
+        i = text.find(f.text, i + 1)
+    return None
+
+
 @dataclass(frozen=True)
 class Hit:
     form: Form
@@ -335,8 +356,7 @@ def find_hits(all_forms: list, files: dict, stems: list) -> list[Hit]:
             if not f.strong and own is not None and own != f.notebook:
                 continue
             if f.text:
-                i = text.find(f.text)
-                m = (i, i + len(f.text)) if i >= 0 else None
+                m = _standalone(text, f)
             elif f.regex:
                 r = re.search(f.regex, text)
                 m = r.span() if r else None
@@ -358,6 +378,16 @@ ALLOWED: list[tuple[str, str, str, str, str, str]] = [
         "1.1", "detJ", r"expression", r"01_", r"p_x=theta1\+lcostheta2",
         "1.1 gives the cart-pole's tool position p_x = θ1 + L cos θ2 (the problem set's eq. 1) to differentiate; "
         "det J = L cos θ2 is spelled like its second term, but the question states no determinant",
+    ),
+    (
+        "1.1", "detJ_zeros", r"decimal", r"01_", r'"q0":',
+        "the UR5 explorer of 1.3 starts at the textbook's configuration (0, −π/4, π/2, −π/4, π/2, 0): its joint values "
+        "are the given pose, not the cart-pole's singular angles",
+    ),
+    (
+        "7.6", "singular_76", r"theta2 = pi/2", r"07_", r"poleupright\$?theta2=pi/2",
+        "7.4's question gives the cart-pole's configuration, the pole upright at θ2 = π/2: the question's own data, "
+        "about another robot than 7.6's slide-and-2R arm",
     ),
     *(
         (part, name, r"theta2 = (0|pi) ", r"07_", r"armstretched\$?theta2=0\$?,folded\$?theta2=pi",
