@@ -61,8 +61,6 @@ from __future__ import annotations
 import numbers
 import os
 import pickle
-import select
-import signal
 import struct
 import sys
 import threading
@@ -71,6 +69,12 @@ import traceback
 import warnings
 from collections.abc import Callable
 from typing import Any
+
+try:  # (Pyodide, i.e. JupyterLite in the browser, has no processes: only cooperative checks are used there)
+    import select
+    import signal
+except ImportError:  # pragma: no cover - platforms without them
+    select = signal = None
 
 __all__ = [
     "run",
@@ -88,7 +92,12 @@ __all__ = [
 
 #: True where :func:`run` does the work in a child process ended when its budget runs out (POSIX: fork and CPU
 #: timers); False in Pyodide (JupyterLite: no processes) and on Windows: cooperative checks only
-ISOLATED = hasattr(os, "fork") and hasattr(signal, "setitimer") and sys.platform not in ("emscripten", "wasi")
+ISOLATED = (
+    hasattr(os, "fork")
+    and hasattr(signal, "setitimer")
+    and hasattr(select, "select")
+    and sys.platform not in ("emscripten", "wasi")
+)
 THREADED = ISOLATED  # the former name
 #: wall seconds without CPU progress after which a child is taken as stuck and ended (a lock left held at fork)
 STALL = 30.0
@@ -397,7 +406,7 @@ def _forked(seconds: float, what: str, fn, args, kwargs, progress):
                 if frames and frames[-1][0] in ("ok", "err"):
                     _, status, usage = os.wait4(pid, 0)
                     break
-            if pidfd in ready or (pidfd is None and not ready):
+            if pidfd is None or pidfd in ready:  # (without a pidfd: asked at every turn, 20 ms apart at most)
                 done, st, ru = os.wait4(pid, os.WNOHANG)
                 if done:
                     status, usage = st, ru

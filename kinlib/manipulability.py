@@ -364,16 +364,16 @@ def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None, *, time_budge
         U, s, _ = np.linalg.svd(A, full_matrices=False)
         return s, U
     M = exact_jacobian(J)
-    return budgeted_axes(lambda: M * M.T, min(M.rows, M.cols), seconds, "velocity_ellipsoid")
+    return budgeted_axes(lambda: M * M.T, min(M.rows, M.cols), seconds, "velocity_ellipsoid", M.free_symbols)
 
 
 class _NoClosedForm(Exception):
     pass
 
 
-def budgeted_axes(gram, k: int, seconds, what: str):
+def budgeted_axes(gram, k: int, seconds, what: str, symbols=()):
     """:func:`_exact_axes` of ``gram()`` within ``seconds``; the 60-digit fallback for a constant Gram matrix
-    (with a NumericFallbackWarning), a clear ValueError for a symbolic one."""
+    (with a NumericFallbackWarning), a clear ValueError for a symbolic one (``symbols``: J's free symbols)."""
     why = ""
     grams: list = []
 
@@ -389,8 +389,10 @@ def budgeted_axes(gram, k: int, seconds, what: str):
     except _NoClosedForm as err:
         why = str(err)
     G = grams[-1] if grams else None
+    if G is None and not symbols:  # the budget ran out before G was formed: a product of constant matrices
+        G = gram()
     if G is None or G.free_symbols:
-        syms = ", ".join(sorted(map(str, G.free_symbols))) if G is not None else "J's symbols"
+        syms = ", ".join(sorted(map(str, G.free_symbols if G is not None else symbols), key=str))
         raise ExactTimeoutError(
             f"{what}: {why}; J has the free symbols {syms}: substitute numbers for them (floats: the fast numeric "
             "backend; exact values: this exact path), or give a larger time_budget (None: no limit)"
@@ -543,7 +545,11 @@ def _held_ellipsoid(J: Any, rows: Any, hold: Any, seconds):
         B = sp.Matrix.hstack(*B)
         d = B.cols
         return budgeted_axes(
-            lambda: A * (B * (B.T * B).inv() * B.T) * A.T, min(A.rows, d), seconds, "velocity_ellipsoid"
+            lambda: A * (B * (B.T * B).inv() * B.T) * A.T,
+            min(A.rows, d),
+            seconds,
+            "velocity_ellipsoid",
+            A.free_symbols | B.free_symbols,
         )
     A, H = M[list(r_idx)], M[list(h_idx)]
     _, s, Vt = np.linalg.svd(H)

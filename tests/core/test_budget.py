@@ -313,7 +313,7 @@ def _cases():
     def ellipsoid(force):
         def call(b):
             lengths, U = (force_ellipsoid if force else velocity_ellipsoid)(G3, time_budget=b)
-            want = 1 / ref["sv3"][::-1] if force else ref["sv3"]
+            want = 1 / ref["sv3"] if force else ref["sv3"]  # (force: 1/σ_i in the order of the σ_i)
             assert np.allclose(np.array([float(x) for x in lengths]), want, rtol=1e-12)
             assert U.shape == (3, 3)
             return None
@@ -427,6 +427,6 @@ def test_stress_random_expiries_leave_no_trace(monkeypatch):
     for t in threads:
         t.join(3600)  # hang guard
     assert not any(t.is_alive() for t in threads)
-    assert not errors, errors[:3]
+    assert not errors, errors[0][1][-3000:]
     assert count[0] >= EXPIRIES, (count[0], calls[0])
     assert _state_is_clean()
