@@ -32,14 +32,17 @@ private mpmath context per thread (:func:`kinlib.exactfield.mp_context`), never 
 never share one.
 
 **Why fork.** It copies the caller as it is: SymPy's warm caches, the function to run (closures included: no
-pickling of the work), monkeypatches in tests. Measured on this 2-core machine (loaded): a forked call costs
-~6 ms CPU for an empty function and 10–15 ms more for a small exact rank (copy-on-write page faults), against
-30–300 ms for the exact work itself; ``time_budget=None`` (no limit) runs in the caller, without a process.
-pebble (``concurrent.process``) was measured too: +20–25 ms wall per call over a plain fork (a thread and a
-``multiprocessing.Process`` per call), and its time limits are wall-clock, while a budget here counts CPU time;
-so it is not used. ``forkserver`` would lose the caches and need every argument pickled. Jupyter kernels have
-threads (heartbeat, IOPub); the child uses none of them (it never prints; its warnings travel back), and a
-child stuck on a lock another thread held at the fork is ended as stalled.
+pickling of the work), monkeypatches in tests. Measured (CPU of caller and child, medians of 9, a loaded
+2-core machine): a budgeted call costs 10–17 ms more than the same call in the caller (fork, copy-on-write page
+faults, exit): evaluate_at, rank_at, column_space, pseudoinverse of a 2×2 or 3×2 J 6–19 ms → 19–37 ms, a UR5
+rank_at or a closed-form ellipsoid 166–173 ms → 175–184 ms (+6 %); an empty function ~6 ms.
+``time_budget=None`` (no limit) runs in the caller, without a process. pebble (``concurrent.process``) was
+measured too: +20–25 ms wall per call over a plain fork (a thread and a ``multiprocessing.Process`` per call),
+and its time limits are wall-clock while a budget here counts CPU time, so it is not used (no new dependency).
+``forkserver`` would lose the caches and need every argument pickled. Jupyter kernels have threads (heartbeat,
+IOPub); the child uses none of them (it never prints; its warnings travel back), and a child stuck on a lock
+another thread held at the fork is ended as stalled. (Python ≥ 3.12 warns at such a fork: pyproject.toml's
+test configuration ignores that warning.)
 
 What is counted: **seconds of computation**, CPU time (the child's, set by the kernel timer; a thread's own
 ``time.thread_time`` for cooperative checks), so a budget gives the same answer on an idle laptop and on a
