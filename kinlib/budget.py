@@ -266,16 +266,31 @@ def run(seconds: float | None, what: str, fn: Callable, *args, progress: Callabl
     ...     print(err)
     a loop that never ends: out of time after 0.2 s
     """
+    outer = remaining()  # a run inside a budgeted block gets at most what that block has left
+    clamped = seconds is not None and outer < float(seconds)
     if seconds is not None:
-        seconds = min(float(seconds), remaining())
-        if seconds <= 0:
+        seconds = min(float(seconds), outer)
+    try:
+        if seconds is not None and seconds <= 0:
             raise OutOfTime(what, seconds)
-    if seconds is not None and ISOLATED:
-        try:
-            return _forked(seconds, what, fn, args, kwargs, progress)
-        except _NoFork:
-            pass
-    return _inline(seconds, what, fn, args, kwargs, progress)
+        if seconds is not None and ISOLATED:
+            try:
+                return _forked(seconds, what, fn, args, kwargs, progress)
+            except _NoFork:
+                pass
+        return _inline(seconds, what, fn, args, kwargs, progress)
+    except OutOfTime:
+        if clamped:  # the time that ran out was the enclosing block's: it ends that block
+            _outer_expired()
+        raise
+
+
+def _outer_expired() -> None:
+    if _child:  # this process is a budget's child and its budget is spent: end it as its timer would
+        os.kill(os.getpid(), signal.SIGPROF)
+    stack = _stack()
+    if stack:
+        raise _Expired(min(stack, key=lambda b: b.deadline))
 
 
 def _inline(seconds, what, fn, args, kwargs, progress):
@@ -486,7 +501,7 @@ def _charge(used: float) -> None:
     if not _child:
         return
     left, _ = signal.getitimer(signal.ITIMER_PROF)
-    if left - used <= 0:
+    if left - used <= 0.001:
         os.kill(os.getpid(), signal.SIGPROF)
     signal.setitimer(signal.ITIMER_PROF, left - used)
 
