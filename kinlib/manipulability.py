@@ -385,12 +385,10 @@ class _NoClosedForm(Exception):
 def budgeted_axes(gram, k: int, seconds, what: str, symbols=()):
     """:func:`_exact_axes` of ``gram()`` within ``seconds``; the 60-digit fallback for a constant Gram matrix
     (with a NumericFallbackWarning), a clear ValueError for a symbolic one (``symbols``: J's free symbols)."""
-    why = ""
-    grams: list = []
+    why, grams = "", []
 
-    def axes():
-        G = gram()
-        report(G)  # the caller keeps G for the fallback, even when the budget then runs out
+    def axes():  # G is reported: the caller keeps it for the fallback even when the budget then runs out
+        report(G := gram())
         return _exact_axes(G, k)
 
     try:
@@ -399,9 +397,7 @@ def budgeted_axes(gram, k: int, seconds, what: str, symbols=()):
         why = f"the exact eigen-decomposition did not finish within time_budget={seconds} s"
     except _NoClosedForm as err:
         why = str(err)
-    G = grams[-1] if grams else None
-    if G is None and not symbols:  # the budget ran out before G was formed: a product of constant matrices
-        G = gram()
+    G = grams[-1] if grams else None if symbols else gram()  # (G not formed in time: constant matrices' product)
     if G is None or G.free_symbols:
         syms = ", ".join(sorted(map(str, G.free_symbols if G is not None else symbols), key=str))
         raise ExactTimeoutError(
@@ -555,13 +551,8 @@ def _held_ellipsoid(J: Any, rows: Any, hold: Any, seconds):
             return [], sp.zeros(A.rows, 0)
         B = sp.Matrix.hstack(*B)
         d = B.cols
-        return budgeted_axes(
-            lambda: A * (B * (B.T * B).inv() * B.T) * A.T,
-            min(A.rows, d),
-            seconds,
-            "velocity_ellipsoid",
-            A.free_symbols | B.free_symbols,
-        )
+        P, syms = lambda: A * (B * (B.T * B).inv() * B.T) * A.T, M.free_symbols
+        return budgeted_axes(P, min(A.rows, d), seconds, "velocity_ellipsoid", syms)
     A, H = M[list(r_idx)], M[list(h_idx)]
     _, s, Vt = np.linalg.svd(H)
     rank = int(np.sum(s > max(H.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0))) if s[0] > 0 else 0
