@@ -29,7 +29,9 @@ unpickles a finished result, or learns that there is none. The kernel ends the c
 instructions; there is no "between a state change and the ``try`` that undoes it", because nothing is undone:
 the whole process goes. Precision set by kinlib itself (the 60-digit fallbacks, which run in the caller) uses a
 private mpmath context per thread (:func:`kinlib.exactfield.mp_context`), never ``mpmath.mp``, so two threads
-never share one.
+never share one (tests/core/test_budget.py reads kinlib's code for any other use). What is left is SymPy's own:
+some SymPy evaluations set ``mpmath.mp``'s precision for a moment (``evalf(2)`` in its assumptions); in budgeted
+work that happens in the child, in the caller's short steps (display, the fallback's input) as SymPy does it.
 
 **Why fork.** It copies the caller as it is: SymPy's warm caches, the function to run (closures included: no
 pickling of the work), monkeypatches in tests. Measured (CPU of caller and child, medians of 9, a loaded
