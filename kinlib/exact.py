@@ -40,7 +40,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
-from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
+from .budget import ExactTimeoutError, OutOfTime, budget_seconds, run
 from .display import readable
 from .exact_rank import RankAnalysis, canonical_rows, rank_conditions
 from .exactfield import FALLBACK_DIGITS, MAX_MULTIPLE, NotExact, decide_zero, exact_is_zero
@@ -292,17 +292,56 @@ def evaluate_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = N
     if numeric:
         return _as_float(M)
     try:
-        with within(seconds, "evaluate_at"):
-            try:
-                zero = [decide_zero(e) for e in M]
-            except NotExact:
-                zero = [e == 0 for e in M]
+        zero = run(seconds, "evaluate_at", _zero_entries, M)
     except OutOfTime:
         raise ExactTimeoutError(
             f"evaluate_at: {_late(seconds)} (deciding which entries are zero); give a larger time_budget "
             "(None: no limit), or float joint values for a numeric J"
         ) from None
     return sp.Matrix(M.rows, M.cols, [sp.S.Zero if z else readable(e) for e, z in zip(M, zero)])
+
+
+def _zero_entries(M: sp.Matrix) -> list:
+    """Which entries of M are zero, decided exactly (in a budget's process: kinlib.budget.run)."""
+    try:
+        return [decide_zero(e) for e in M]
+    except NotExact:
+        return [e == 0 for e in M]
+
+
+def _rank_exact(M: sp.Matrix):
+    """(Rank, "") proved exactly, or (None, why not)."""
+    an, why = _analyse(M, "rank_at")
+    if an is None:
+        return None, why
+    unless = rank_conditions(M, an)
+    return Rank(an.rank, unless=unless, note="exact elimination in K(tan(g/2), parameters)"), ""
+
+
+def _column_space_exact(A: sp.Matrix):
+    """(canonical basis of range Aᵀ as columns, "") proved exactly, or (None, why not)."""
+    an, why = _analyse(A, "column_space")
+    if an is None:
+        return None, why
+    unless = rank_conditions(A, an)
+    out = canonical_rows(A, an).T
+    _warn_conditions("column_space", unless)
+    return out, ""
+
+
+def _left_null_space_exact(A: sp.Matrix, m: int):
+    """(canonical basis of null A as columns, "") proved exactly, or (None, why not)."""
+    an, why = _analyse(A, "left_null_space")
+    if an is None:
+        return None, why
+    unless = rank_conditions(A, an)
+    if an.rank == m:
+        out = sp.zeros(m, 0)
+    else:
+        N = _null_from_rref(canonical_rows(A, an), m)
+        out = canonical_rows(N, RankAnalysis(N)).T if N.rows else sp.zeros(m, 0)
+    _warn_conditions("left_null_space", unless)
+    return out, ""
 
 
 def _analyse(M: sp.Matrix, what: str):
@@ -354,11 +393,9 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None,
     if numeric:
         return rank_at(_as_float(M))
     try:
-        with within(seconds, "rank_at"):
-            an, why = _analyse(M, "rank_at")
-            if an is not None:
-                unless = rank_conditions(M, an)
-                return Rank(an.rank, unless=unless, note="exact elimination in K(tan(g/2), parameters)")
+        got, why = run(seconds, "rank_at", _rank_exact, M)
+        if got is not None:
+            return got
     except OutOfTime:
         why = _late(seconds)
     r, _ = fallback_rank(_numbers_only(M, "rank_at", why, seconds))
@@ -399,13 +436,9 @@ def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = 
         return column_space(_as_float(M))
     A = M.T
     try:
-        with within(seconds, "column_space"):
-            an, why = _analyse(A, "column_space")
-            if an is not None:
-                unless = rank_conditions(A, an)
-                out = canonical_rows(A, an).T
-                _warn_conditions("column_space", unless)
-                return out
+        out, why = run(seconds, "column_space", _column_space_exact, A)
+        if out is not None:
+            return out
     except OutOfTime:
         why = _late(seconds)
     A = _numbers_only(A, "column_space", why, seconds)
@@ -437,17 +470,9 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
     A = M.T  # null(Mᵀ) = null(A)
     m = A.cols
     try:
-        with within(seconds, "left_null_space"):
-            an, why = _analyse(A, "left_null_space")
-            if an is not None:
-                unless = rank_conditions(A, an)
-                if an.rank == m:
-                    out = sp.zeros(m, 0)
-                else:
-                    N = _null_from_rref(canonical_rows(A, an), m)
-                    out = canonical_rows(N, RankAnalysis(N)).T if N.rows else sp.zeros(m, 0)
-                _warn_conditions("left_null_space", unless)
-                return out
+        out, why = run(seconds, "left_null_space", _left_null_space_exact, A, m)
+        if out is not None:
+            return out
     except OutOfTime:
         why = _late(seconds)
     A = _numbers_only(A, "left_null_space", why, seconds)

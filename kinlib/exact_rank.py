@@ -19,7 +19,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from .display import readable_fold, readable_ratio
-from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, decide_zero, mp_matrix, mp_value
+from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, decide_zero, mp_context, mp_matrix, mp_value
 from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = ["EXACT_BUDGET", "MAX_MINORS", "RankAnalysis", "ring_det", "canonical_rows", "rank_conditions"]
@@ -57,7 +57,7 @@ def _numeric_pivots(X, top) -> tuple:
     A column joins when the smallest singular value of the chosen columns plus it exceeds 10⁻²⁰·σ_max(X)
     (certified: the entries and the SVD are accurate to ~10⁻⁵⁵·σ_max, and σ moves by at most that much).
     A column that does not join is a "zero" decision, certain only once the pivots already span every row."""
-    import mpmath
+    mpmath = mp_context()
 
     m, n = X.rows, X.cols
     piv: list = []
@@ -88,7 +88,7 @@ def _certified_pivots(A: sp.Matrix):
     """(pivots, rows, top) when 60-digit numerics certify that A has full rank min(m, n) with the first
     independent columns and rows as pivots, else None. With parameters, A is looked at with the parameters at
     :data:`SPECIAL_VALUES` (cycled): a nonzero minor there is a nonzero rational function of them."""
-    import mpmath
+    mpmath = mp_context()
 
     if A.free_symbols:
         A = A.xreplace(_special(A.free_symbols))
@@ -120,7 +120,7 @@ def _rref(dA: DomainMatrix, fld: ExactField) -> tuple:
 def _independent_rows(A: sp.Matrix, pivots: list):
     """r = len(pivots) rows I with A[I, pivots] nonsingular, certified by 60-digit numerics (parameters at
     :data:`SPECIAL_VALUES`: nonsingular there is nonsingular), or None. Any such rows serve Cramer's rule."""
-    import mpmath
+    mpmath = mp_context()
 
     r = len(pivots)
     if r == 0:
@@ -185,11 +185,11 @@ class RankAnalysis:
     def is_zero(self, e: sp.Expr) -> bool:
         """Whether e (a number or expression in the parameters, built from A's sines and cosines) is 0, proved:
         nonzero when its value (parameters at :data:`SPECIAL_VALUES`) is above 10⁻³⁰ at 100 digits, else exactly."""
-        import mpmath
+        mpmath = mp_context()
 
         try:
             with mpmath.workdps(FALLBACK_DIGITS + 40):
-                if abs(mp_value(e.xreplace(_special(e.free_symbols)), {})) > mpmath.mpf(10) ** -30:
+                if abs(mp_value(e.xreplace(_special(e.free_symbols)), {}, mpmath)) > mpmath.mpf(10) ** -30:
                     return False
         except (TypeError, ValueError, ZeroDivisionError):
             pass
@@ -247,7 +247,7 @@ def _never_zero(factor: sp.Expr, params: list) -> bool:
     strict sign. A coefficient's sign is read from its value at ``FALLBACK_DIGITS + 40`` digits when that is above
     10⁻³⁰ (certified, as in :func:`kinlib.exactfield.decide_zero`); a smaller one is decided exactly: zero (left
     out) or "sign unknown" (the factor may vanish)."""
-    import mpmath
+    mpmath = mp_context()
 
     try:
         terms = sp.Poly(factor, *params, domain="EX").terms()
@@ -258,7 +258,7 @@ def _never_zero(factor: sp.Expr, params: list) -> bool:
         c = sp.sympify(getattr(coeff, "ex", coeff))
         try:
             with mpmath.workdps(FALLBACK_DIGITS + 40):
-                v = mp_value(c, memo)
+                v = mp_value(c, memo, mpmath)
             big = abs(v) > mpmath.mpf(10) ** -30
         except (TypeError, ValueError):
             big = False

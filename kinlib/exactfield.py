@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import functools
 import math
+import threading
 from typing import Any
 
 import sympy as sp
@@ -41,6 +42,7 @@ __all__ = [
     "decide_zero",
     "mp_value",
     "mp_matrix",
+    "mp_context",
     "MAX_MULTIPLE",
     "FALLBACK_DIGITS",
 ]
@@ -439,11 +441,10 @@ def decide_zero(e: Any, what: str = "an entry") -> bool:
     if e.is_Rational:
         return False
     if not e.free_symbols:
-        import mpmath
-
+        mpmath = mp_context()
         try:
             with mpmath.workdps(FALLBACK_DIGITS + 40):
-                if abs(mp_value(e, {})) > mpmath.mpf(10) ** -30:
+                if abs(mp_value(e, {}, mpmath)) > mpmath.mpf(10) ** -30:
                     return False
         except (TypeError, ValueError):  # e.g. a complex intermediate: the exact routes below decide
             pass
@@ -475,19 +476,47 @@ def decide_zero(e: Any, what: str = "an entry") -> bool:
     )
 
 
-def mp_value(e: sp.Expr, memo: dict):
-    """e to ``FALLBACK_DIGITS + 40`` digits (call inside mpmath.workdps), shared subexpressions evaluated once.
+_mp_local = threading.local()
+
+
+def mp_context():
+    """This thread's own mpmath context (``mpmath.MPContext``), created on first use: kinlib sets precision only
+    there (``with ctx.workdps(n):``), never on the global ``mpmath.mp``, so threads never share a precision
+    (two threads in ``mpmath.workdps(60)`` and ``workdps(100)`` saw each other's) and the user's is never changed.
+
+    >>> import mpmath
+    >>> ctx = mp_context()
+    >>> with ctx.workdps(60):
+    ...     print(ctx.nstr(ctx.pi, 40), mpmath.mp.dps)
+    3.141592653589793238462643383279502884197 15
+    >>> ctx is mp_context()   # the same one for this thread
+    True
+    """
+    ctx = getattr(_mp_local, "ctx", None)
+    if ctx is None:
+        import mpmath
+
+        ctx = _mp_local.ctx = mpmath.MPContext()
+    return ctx
+
+
+def mp_value(e: sp.Expr, memo: dict, ctx=None):
+    """e to ``FALLBACK_DIGITS + 40`` digits (call inside ``ctx.workdps``), shared subexpressions evaluated once.
+    ``ctx``: the mpmath context (:func:`mp_context`; None: the global ``mpmath.mp``).
 
     >>> import mpmath, sympy as sp
-    >>> memo = {}
-    >>> with mpmath.workdps(FALLBACK_DIGITS + 40):
-    ...     v = mp_value(sp.sin(10) - 2 * sp.sin(5) * sp.cos(5), memo)   # sin 2a − 2 sin a cos a = 0
-    ...     w = mp_value(sp.sqrt(2), memo)
-    >>> abs(v) < mpmath.mpf(10) ** -80, sp.sin(5) in memo, mpmath.nstr(w, 20)
+    >>> memo, ctx = {}, mp_context()
+    >>> with ctx.workdps(FALLBACK_DIGITS + 40):
+    ...     v = mp_value(sp.sin(10) - 2 * sp.sin(5) * sp.cos(5), memo, ctx)   # sin 2a − 2 sin a cos a = 0
+    ...     w = mp_value(sp.sqrt(2), memo, ctx)
+    >>> abs(v) < ctx.mpf(10) ** -80, sp.sin(5) in memo, ctx.nstr(w, 20)
     (True, True, '1.4142135623730950488')
     """
-    import mpmath
+    if ctx is None:
+        import mpmath
 
+        ctx = mpmath.mp
+    mpmath = ctx
     if e in memo:
         return memo[e]
     if e.is_Rational:
@@ -497,33 +526,34 @@ def mp_value(e: sp.Expr, memo: dict):
     elif e is sp.E:
         v = mpmath.e
     elif e.is_Add:
-        v = mpmath.fsum(mp_value(a, memo) for a in e.args)
+        v = mpmath.fsum(mp_value(a, memo, ctx) for a in e.args)
     elif e.is_Mul:
-        v = mpmath.fprod(mp_value(a, memo) for a in e.args)
+        v = mpmath.fprod(mp_value(a, memo, ctx) for a in e.args)
     elif e.is_Pow and e.exp.is_Rational:
-        b = mp_value(e.base, memo)
+        b = mp_value(e.base, memo, ctx)
         v = b ** int(e.exp) if e.exp.is_Integer else b ** (mpmath.mpf(e.exp.p) / e.exp.q)
     elif isinstance(e, sp.sin):
-        v = mpmath.sin(mp_value(e.args[0], memo))
+        v = mpmath.sin(mp_value(e.args[0], memo, ctx))
     elif isinstance(e, sp.cos):
-        v = mpmath.cos(mp_value(e.args[0], memo))
+        v = mpmath.cos(mp_value(e.args[0], memo, ctx))
     else:
-        v = mpmath.mpf(str(sp.N(e, mpmath.mp.dps)))
+        v = mpmath.mpf(str(sp.N(e, mpmath.dps)))
     memo[e] = v
     return v
 
 
-def mp_matrix(A: sp.Matrix):
-    """A as an mpmath matrix, entries to ~100 digits (the SVD then runs at ``FALLBACK_DIGITS``).
+def mp_matrix(A: sp.Matrix, ctx=None):
+    """A as an mpmath matrix of ``ctx`` (default: this thread's :func:`mp_context`), entries to ~100 digits
+    (the SVD then runs at ``FALLBACK_DIGITS``).
 
-    >>> import mpmath, sympy as sp
+    >>> import sympy as sp
+    >>> ctx = mp_context()
     >>> X = mp_matrix(sp.Matrix([[sp.cos(1), -sp.sin(1)], [sp.sin(1), sp.cos(1)]]))   # a rotation: det = 1
-    >>> with mpmath.workdps(FALLBACK_DIGITS):
-    ...     print(X.rows, X.cols, mpmath.nstr(mpmath.det(X), 50))
+    >>> with ctx.workdps(FALLBACK_DIGITS):
+    ...     print(X.rows, X.cols, ctx.nstr(ctx.det(X), 50))
     2 2 1.0
     """
-    import mpmath
-
+    mpmath = mp_context() if ctx is None else ctx
     if A.free_symbols:
         raise ValueError(
             "no exact decision is possible here and the numeric fallback needs numbers: J still has "
@@ -531,4 +561,4 @@ def mp_matrix(A: sp.Matrix):
         )
     memo: dict = {}
     with mpmath.workdps(FALLBACK_DIGITS + 40):
-        return mpmath.matrix([[mp_value(A[i, j], memo) for j in range(A.cols)] for i in range(A.rows)])
+        return mpmath.matrix([[mp_value(A[i, j], memo, mpmath) for j in range(A.cols)] for i in range(A.rows)])

@@ -15,7 +15,7 @@ import warnings
 
 import sympy as sp
 
-from .exactfield import FALLBACK_DIGITS, mp_matrix
+from .exactfield import FALLBACK_DIGITS, mp_context, mp_matrix
 
 __all__ = ["FALLBACK_ZERO_DIGITS", "NumericFallbackWarning", "fallback_rank", "fallback_rref", "fallback_warning"]
 
@@ -46,8 +46,7 @@ def fallback_rank(A: sp.Matrix) -> tuple:
     >>> r, float(sv[0])
     (1, 3.0)
     """
-    import mpmath
-
+    mpmath = mp_context()  # this thread's own context: never the global precision
     X = mp_matrix(A)
     with mpmath.workdps(FALLBACK_DIGITS):
         s = mpmath.svd_r(X, compute_uv=False)
@@ -66,8 +65,7 @@ def fallback_rref(A: sp.Matrix) -> sp.Matrix:
     >>> R.shape, abs(R[0, 1] - 2) < 1e-59, R[0, 1]._prec >= 199   # one row, 60 decimal digits (199 bits)
     ((1, 2), True, True)
     """
-    import mpmath
-
+    mpmath = mp_context()  # this thread's own context: never the global precision
     X = mp_matrix(A)
     r, sv = fallback_rank(A)
     with mpmath.workdps(FALLBACK_DIGITS + 20):

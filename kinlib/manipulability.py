@@ -23,9 +23,9 @@ import numpy as np
 import sympy as sp
 
 from ._backend import as_vector, describe, exact_jacobian, is_symbolic, nested_shape, numeric_jacobian, numeric_vectors
-from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
+from .budget import ExactTimeoutError, OutOfTime, budget_seconds, report, run
 from .exact import TIME_BUDGET, NumericFallbackWarning, exact_det
-from .exactfield import FALLBACK_DIGITS, decide_zero, mp_matrix
+from .exactfield import FALLBACK_DIGITS, decide_zero, mp_context, mp_matrix
 from .nearsingular import NEAR_SINGULAR, SINGULAR_RTOL, near_singular, peak_manipulability, singularity_state
 from .singularities import trig_simplify
 from .taskspace import task_row_indices, task_rows
@@ -375,28 +375,31 @@ def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None, *, time_budge
         U, s, _ = np.linalg.svd(A, full_matrices=False)
         return s, U
     M = exact_jacobian(J)
-    return budgeted_axes(lambda: M * M.T, min(M.rows, M.cols), seconds, "velocity_ellipsoid")
+    return budgeted_axes(lambda: M * M.T, min(M.rows, M.cols), seconds, "velocity_ellipsoid", M.free_symbols)
 
 
 class _NoClosedForm(Exception):
     pass
 
 
-def budgeted_axes(gram, k: int, seconds, what: str):
+def budgeted_axes(gram, k: int, seconds, what: str, symbols=()):
     """:func:`_exact_axes` of ``gram()`` within ``seconds``; the 60-digit fallback for a constant Gram matrix
-    (with a NumericFallbackWarning), a clear ValueError for a symbolic one."""
-    why = ""
-    G = None
+    (with a NumericFallbackWarning), a clear ValueError for a symbolic one (``symbols``: J's free symbols)."""
+    why, grams = "", []
+
+    def axes():  # G is reported: the caller keeps it for the fallback even when the budget then runs out
+        report(G := gram())
+        return _exact_axes(G, k)
+
     try:
-        with within(seconds, what):
-            G = gram()
-            return _exact_axes(G, k)
+        return run(seconds, what, axes, progress=grams.append)
     except OutOfTime:
         why = f"the exact eigen-decomposition did not finish within time_budget={seconds} s"
     except _NoClosedForm as err:
         why = str(err)
+    G = grams[-1] if grams else None if symbols else gram()  # (G not formed in time: constant matrices' product)
     if G is None or G.free_symbols:
-        syms = ", ".join(sorted(map(str, G.free_symbols))) if G is not None else "J's symbols"
+        syms = ", ".join(sorted(map(str, G.free_symbols if G is not None else symbols), key=str))
         raise ExactTimeoutError(
             f"{what}: {why}; J has the free symbols {syms}: substitute numbers for them (floats: the fast numeric "
             "backend; exact values: this exact path), or give a larger time_budget (None: no limit)"
@@ -412,8 +415,7 @@ def budgeted_axes(gram, k: int, seconds, what: str):
 
 def _numeric_axes(G: sp.Matrix, k: int):
     """(lengths, directions) of the k largest eigenvalues of the symmetric constant G, as 60-digit Floats."""
-    import mpmath
-
+    mpmath = mp_context()  # this thread's own context: never the global precision
     X = mp_matrix(G)
     with mpmath.workdps(FALLBACK_DIGITS + 20):
         X = (X + X.T) / 2
@@ -539,8 +541,7 @@ def _held_ellipsoid(J: Any, rows: Any, hold: Any, seconds):
     if symbolic:
         A, H = M.extract(list(r_idx), list(range(M.cols))), M.extract(list(h_idx), list(range(M.cols)))
         try:
-            with within(seconds, "velocity_ellipsoid"):
-                B = H.nullspace(simplify=True)
+            B = run(seconds, "velocity_ellipsoid", H.nullspace, simplify=True)
         except OutOfTime:
             raise ExactTimeoutError(
                 f"velocity_ellipsoid: the null space of the held rows did not finish within time_budget={seconds} "
@@ -550,9 +551,8 @@ def _held_ellipsoid(J: Any, rows: Any, hold: Any, seconds):
             return [], sp.zeros(A.rows, 0)
         B = sp.Matrix.hstack(*B)
         d = B.cols
-        return budgeted_axes(
-            lambda: A * (B * (B.T * B).inv() * B.T) * A.T, min(A.rows, d), seconds, "velocity_ellipsoid"
-        )
+        P, syms = lambda: A * (B * (B.T * B).inv() * B.T) * A.T, M.free_symbols
+        return budgeted_axes(P, min(A.rows, d), seconds, "velocity_ellipsoid", syms)
     A, H = M[list(r_idx)], M[list(h_idx)]
     _, s, Vt = np.linalg.svd(H)
     rank = int(np.sum(s > max(H.shape) * np.finfo(float).eps * (s[0] if s.size else 0.0))) if s[0] > 0 else 0

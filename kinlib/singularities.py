@@ -37,7 +37,7 @@ import numpy as np
 import sympy as sp
 
 from ._backend import as_jacobian, describe, exact_number, is_symbolic, joint_symbols
-from .budget import OutOfTime, budget_seconds, clock, within
+from .budget import OutOfTime, budget_seconds, clock, report, run
 from .exact import column_space, evaluate_at, left_null_space, rank_at
 from .taskspace import ROW_NAMES, task_rows
 from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
@@ -491,11 +491,17 @@ def singular_configurations(
 
     k = min(J.shape)
     what = "det J" if J.rows == J.cols else f"the {k}×{k} minors of J"
-    try:  # the clock is also enforced inside SymPy (kinlib.budget), not only at kinlib's own checks
-        with within(None if seconds is None else max(0.0, deadline - clock()), "singular_configurations"):
-            return _singular_set(
-                J, thetas, deadline, parameter_atom, bad_entry, conditions, key, lambda st: out_of_reach(st, 4), what
-            )
+    left = None if seconds is None else max(0.0, deadline - clock())
+
+    def work():  # in a process ended when the budget runs out (kinlib.budget.run); each condition found is
+        # reported at once, so the caller keeps them; the work's own deadline counts the clock of where it runs
+        here = float("inf") if left is None else clock() + left
+        return _singular_set(
+            J, thetas, here, parameter_atom, bad_entry, _Reported(conditions), key, lambda st: out_of_reach(st, 4), what
+        )
+
+    try:
+        return run(left, "singular_configurations", work, progress=conditions.append)
     except OutOfTime:
         return out_of_reach(f"computing {what}" if not conditions else "after the first conditions")
 
@@ -524,6 +530,18 @@ def _trig_ring(J: sp.Matrix, thetas, parameter_atom, bad_entry):
         if attempt == 1:
             raise bad_entry(next(e for e in M if mixed & set(TrigRing([e], thetas, opaque=parameter_atom).variables)))
     raise AssertionError  # pragma: no cover
+
+
+class _Reported(list):
+    """The conditions found so far: each one added is handed to the caller at once (kinlib.budget.report), whose
+    progress callback adds it to ``found`` (the list the caller's partial answer is made from)."""
+
+    def __init__(self, found: list):
+        super().__init__(found)
+
+    def append(self, cond):
+        super().append(cond)
+        report(cond)
 
 
 def _singular_set(J, thetas, deadline, parameter_atom, bad_entry, conditions, key, out_of_reach, what):

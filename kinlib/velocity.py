@@ -39,7 +39,7 @@ from ._backend import (
     numeric_vectors,
     within_float_range,
 )
-from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
+from .budget import ExactTimeoutError, OutOfTime, budget_seconds, run
 from .display import readable, readable_ratio
 from .exact import TIME_BUDGET
 from .exactfield import decide_zero
@@ -277,8 +277,7 @@ def _timeout(what: str, seconds, advice: str):
 
 def _budgeted_pinv(M: sp.Matrix, seconds, what: str):
     try:
-        with within(seconds, what):
-            return _exact_pinv(M)
+        return run(seconds, what, _exact_pinv, M)
     except OutOfTime:
         raise _timeout(what, seconds, "use float numbers for J (the SVD backend)") from None
 
@@ -355,12 +354,13 @@ def inverse_velocity(J: Any, V: Any, rtol: Any = None, full_output: bool = False
     >>> inverse_velocity(sp.Matrix([[0, 1], [1, 1]]), [1, 2]).T      # planar 2R at θ = (0, π/2), L = 1: ṗ = (1, 2)
     Matrix([[1, 1]])
     """
+    seconds = budget_seconds(time_budget)  # checked for numbers too (a garbage budget is never ignored)
     if is_symbolic(J, V):
         if rtol is not None:
             raise ValueError(f"rtol applies to numeric J only (the exact rank needs no tolerance), got rtol={rtol!r}")
         M = exact_jacobian(J)
         v = _exact_vector(V, "V", M.rows, "a twist (the rows of J)")
-        P, r = _budgeted_pinv(M, budget_seconds(time_budget), "inverse_velocity")
+        P, r = _budgeted_pinv(M, seconds, "inverse_velocity")
         out = (P * v).applyfunc(sp.radsimp)
         return (out, PinvReport(r, None, None)) if full_output else out
     A = numeric_jacobian(J)
@@ -402,8 +402,7 @@ def damped_least_squares(J: Any, V: Any, damping: Any, *, time_budget=TIME_BUDGE
         if lam == 0:
             return inverse_velocity(M, v, time_budget=time_budget)
         try:
-            with within(seconds, "damped_least_squares"):
-                return _exact_dls(M, lam, v)
+            return run(seconds, "damped_least_squares", _exact_dls, M, lam, v)
         except OutOfTime:
             raise _timeout(
                 "damped_least_squares",
@@ -533,6 +532,7 @@ def force_ellipsoid(J: Any, rows: Any = None, *, time_budget=TIME_BUDGET):
     [1, 0],
     [0, 1]]))
     """
+    budget_seconds(time_budget)  # checked for numbers too (a garbage budget is never ignored)
     if is_symbolic(J):
         lengths, U = velocity_ellipsoid(J, rows, time_budget=time_budget)
         out = []

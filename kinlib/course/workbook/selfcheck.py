@@ -170,11 +170,13 @@ def _evaluate(x, k: int):
 
 
 def _evaluate_mpmath(x, pt: dict):
-    import mpmath
+    from kinlib.exactfield import mp_context
 
+    mpmath = mp_context()  # this thread's own mpmath context: the global precision is never changed
     syms = sorted(pt, key=lambda s: s.name)
     entries = list(x) if isinstance(x, sp.MatrixBase) else [x]
-    f = sp.lambdify(syms, entries, modules="mpmath", cse=True)
+    names = {n: getattr(mpmath, n) for n in dir(mpmath) if not n.startswith("_")}
+    f = sp.lambdify(syms, entries, modules=[{**names, "mpmath": mpmath}, "mpmath"], cse=True)
     with mpmath.workdps(30):
         vals = f(*[mpmath.mpf(pt[s].p) / pt[s].q for s in syms])
         out = [
