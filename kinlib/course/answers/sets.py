@@ -24,6 +24,7 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
+from .mistakes import SET_VARIABLE
 from .base import is_bool, not_answered, subs_for, to_complex, type_name
 
 __all__ = [
@@ -467,6 +468,8 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
         if len(rc) == 1 and len(sc) == 1:
             r, s = rc[0], sc[0]
             if set(s) != set(r):
+                if len(s) == len(r) == 1 and _cond_match({next(iter(r)): next(iter(s.values()))}, r, periodic)[0]:
+                    return False, f"{name} {SET_VARIABLE.says}"  # the right set on the wrong variable
                 mine = ", ".join(sorted(map(str, (v for v in s if v is not None)))) or "one unnamed variable"
                 return False, (
                     f"{name} constrains {mine}: not the right joint variables (which joints does the "
