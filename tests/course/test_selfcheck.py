@@ -152,7 +152,8 @@ def test_an_unrelated_wrong_answer_gets_the_neutral_message(M, data):
     assume(not _same(other, M) and not _explained_by(M, other))
     status, message = verdict(other, fingerprint(M, salt=SALT), salt=SALT)
     assert status == "incorrect"
-    assert NEUTRAL in message, message
+    # neutral, or the grader's words on its variables (symbol_notes: "uses θ1, which the problem does not")
+    assert NEUTRAL in message or "which the problem does not" in message or "constant" in message, message
     assert not _leaks(message, M)
 
 
@@ -183,7 +184,13 @@ def test_a_wrong_scalar_reveals_no_factor():
         {"shape": [], "symbols": [], "values": [[[2.0, 0.0]]]},
         "d",
     )
-    assert not ok and "constant factor" in said and "0.5" not in said and "2" not in said
+    assert not ok and "constant" in said and "0.5" not in said and "2" not in said, said
+    ok, said = compare.compare_expr(  # a function of θ off by a factor: that is named, without the factor
+        {"tag": "scalar", "shape": [], "symbols": ["t"], "values": [[[1.0, 0.0]], [[3.0, 0.0]]]},
+        {"shape": [], "symbols": ["t"], "values": [[[2.0, 0.0]], [[6.0, 0.0]]]},
+        "d",
+    )
+    assert not ok and "constant factor" in said and "0.5" not in said and "2" not in said, said
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -207,9 +214,9 @@ def test_angle_sets_in_degrees_or_negated_are_named(ks, keyed):
     status, message = verdict(wrap(degrees), spec, salt=SALT)
     assert status == "incorrect" and "degrees" in message
     mod = {k % 24 for k in ks}
-    if {(-k) % 24 for k in ks} != mod:  # not symmetric: minus it is another set
-        status, message = verdict(wrap(negated), spec, salt=SALT)
-        assert status == "incorrect" and "wrong sign" in message
+    if {(-k) % 24 for k in ks} != mod:  # not symmetric: minus it is another set, and it is not named (issue 31:
+        status, message = verdict(wrap(negated), spec, salt=SALT)  # 5.4's maximisers are 5.1's set negated)
+        assert status == "incorrect" and "sign" not in message and "minus" not in message
     assert not any(f"{k}π" in message or f"{k}*pi" in message for k in ks if abs(k) > 1)
 
 
