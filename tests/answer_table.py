@@ -61,45 +61,108 @@ def rows() -> list[Row]:
     semi = sp.Matrix([L1 + L2, L1 - L2])  # the velocity ellipse's semi-axes at a configuration (σ)
     return [
         Row("2.1", "M", "expr", r3.M, [r3.M.tolist()], [(r3.M.T, "transposed"), (-r3.M, "wrong sign")]),
-        Row("2.1", "S2", "expr", r3.screws[:, 1], [list(r3.screws[:, 1])],
-            [(sp.Matrix([*r3.screws[3:, 1], *r3.screws[:3, 1]]), "[v; ω]")]),
-        Row("2.2", "Js", "expr", Js3, [Js3.applyfunc(sp.expand_trig), Js3.evalf(12)],
-            [(Js3.subs(L, 1), "does not depend on L"), (Js3.evalf(3), "round"), (Js3.T, "transposed"),
-             (Jb3, "")]),
+        Row(
+            "2.1",
+            "S2",
+            "expr",
+            r3.screws[:, 1],
+            [list(r3.screws[:, 1])],
+            [(sp.Matrix([*r3.screws[3:, 1], *r3.screws[:3, 1]]), "[v; ω]")],
+        ),
+        Row(
+            "2.2",
+            "Js",
+            "expr",
+            Js3,
+            [Js3.applyfunc(sp.expand_trig), Js3.evalf(12), Js3.evalf(3)],
+            [(Js3.subs(L, 1), "does not depend on L"), (Js3.T, "transposed"), (Jb3, "")],
+        ),
         Row("2.3", "Jb", "expr", Jb3, [], [(Js3, ""), (-Jb3, "wrong sign")]),
         Row("2.4", "J", "expr", Jg3, [], [(Js3, ""), (Jb3, "")]),
-        Row("5.1", "detJ", "expr", detJ, [sp.expand(sp.expand_trig(detJ)), L**2 * (sp.sin(th2) + sp.cos(th2))],
-            [(sp.Abs(detJ), "wrong sign at some configurations"), (-detJ, "wrong sign"),
-             (detJ.subs(L, 1), "does not depend on L"), (sp.sqrt(2) * sp.sin(th2 + 45), "degrees"),
-             (sp.Float(1.414) * L**2 * sp.sin(th2 + pi / 4), "round"), (sp.Integer(0), "constant")]),
-        Row("5.1", "singular_configs", "set", {th2: sp.FiniteSet(-pi / 4, 3 * pi / 4)},
-            [{th2: sp.FiniteSet(3 * pi / 4, 7 * pi / 4)}, sp.FiniteSet(3 * pi / 4, 7 * pi / 4),
-             [{th2: {-pi / 4, 3 * pi / 4}}]],
-            [({th2: sp.FiniteSet(pi / 4, 5 * pi / 4)}, ""), ({th1: sp.FiniteSet(-pi / 4, 3 * pi / 4)}, "another joint"),
-             ({th2: sp.FiniteSet(-45, 135)}, "degrees"), (sp.EmptySet, ""), ({th2: sp.FiniteSet(3 * pi / 4)}, "")]),
+        Row(
+            "5.1",
+            "detJ",
+            "expr",
+            detJ,
+            [sp.expand(sp.expand_trig(detJ)), L**2 * (sp.sin(th2) + sp.cos(th2))],
+            [
+                (sp.Abs(detJ), "wrong sign at some configurations"),
+                (-detJ, "wrong sign"),
+                (detJ.subs(L, 1), "does not depend on L"),
+                (sp.sqrt(2) * L**2 * sp.sin(th2 + 45), "degrees"),
+                (sp.Float(1.414) * L**2 * sp.sin(th2 + pi / 4), "round"),
+                (sp.Integer(0), "constant"),
+            ],
+        ),
+        Row(
+            "5.1",
+            "singular_configs",
+            "set",
+            {th2: sp.FiniteSet(-pi / 4, 3 * pi / 4)},
+            [
+                {th2: sp.FiniteSet(3 * pi / 4, 7 * pi / 4)},
+                sp.FiniteSet(3 * pi / 4, 7 * pi / 4),
+                [{th2: {-pi / 4, 3 * pi / 4}}],
+            ],
+            [
+                ({th2: sp.FiniteSet(pi / 4, 5 * pi / 4)}, ""),
+                ({th1: sp.FiniteSet(-pi / 4, 3 * pi / 4)}, "another joint"),
+                ({th2: sp.FiniteSet(-45, 135)}, "degrees"),
+                (sp.EmptySet, ""),
+                ({th2: sp.FiniteSet(3 * pi / 4)}, ""),
+            ],
+        ),
         Row("5.3", "rank53", "expr", sp.Integer(2), [2, 2.0], [(3, "generic rank"), (1, "generic rank")]),
-        Row("5.3", "can_move", "subspace", can_move, [[[1, 0, 0], [0, 1, -1]], can_move * 5],
-            [(cannot, "complement"), (sp.Matrix([[1, 0], [0, 1], [0, 1]]), "")]),
+        Row(
+            "5.3",
+            "can_move",
+            "subspace",
+            can_move,
+            [[[1, 0, 0], [0, 1, -1]], can_move * 5],
+            [(cannot, "complement"), (sp.Matrix([[1, 0], [0, 1], [0, 1]]), "")],
+        ),
         Row("5.3", "cannot_move", "subspace", cannot, [[0, 2, 2]], [(can_move, "complement")]),
-        Row("5.4", "w", "expr", w, [sp.sqrt(2 * L**4 * sp.sin(th2 + pi / 4) ** 2), sp.Abs(detJ)],
-            [(detJ, "wrong sign at some configurations"), (w.subs(L, 1), "does not depend on L"),
-             (w**2, "")]),
-        Row("5.4", "maximizers", "set", {th2: sp.FiniteSet(pi / 4, 5 * pi / 4)}, [sp.FiniteSet(pi / 4, -3 * pi / 4)],
-            [({th2: sp.FiniteSet(-pi / 4, 3 * pi / 4)}, ""), ({th2: sp.FiniteSet(45, 225)}, "degrees")]),
-        Row("5.4", "w_max", "expr", sp.sqrt(2) * L**2, [sp.Float(1.4142135624) * L**2],
-            [(sp.sqrt(2), "does not depend on L"), (sp.Float(1.41) * L**2, "round")]),
+        Row(
+            "5.4",
+            "w",
+            "expr",
+            w,
+            [sp.sqrt(2 * L**4 * sp.sin(th2 + pi / 4) ** 2), sp.Abs(detJ)],
+            [(detJ, "wrong sign at some configurations"), (w.subs(L, 1), "does not depend on L"), (w**2, "")],
+        ),
+        Row(
+            "5.4",
+            "maximizers",
+            "set",
+            {th2: sp.FiniteSet(pi / 4, 5 * pi / 4)},
+            [sp.FiniteSet(pi / 4, -3 * pi / 4)],
+            [({th2: sp.FiniteSet(-pi / 4, 3 * pi / 4)}, ""), ({th2: sp.FiniteSet(45, 225)}, "degrees")],
+        ),
+        Row(
+            "5.4",
+            "w_max",
+            "expr",
+            sp.sqrt(2) * L**2,
+            [sp.Float(1.4142135624) * L**2],
+            [(sp.sqrt(2), "depends on L"), (sp.Float(1.41) * L**2, "round")],
+        ),
         Row("6.1", "rank_J", "expr", sp.Integer(4), [4], [(3, "generic rank")]),
         Row("6.1", "singular_set", "set", sp.EmptySet, [[], set()], [({th3: sp.FiniteSet(-L2)}, "")]),
         Row("6.2", "JtJ_62", "expr", JtJ, [], [(sp.simplify(Jg4 * Jg4.T), "other order")]),
         Row("7.1", "A_v", "expr", A_v, [sp.expand(A_v)], [(A_v.subs({L1: L2, L2: L1}), "L1 and L2 swapped")]),
         Row("7.1", "length_ratio", "expr", L1 / L2, [L1 * L2**-1], [(L2 / L1, "upside down")]),
         Row("7.2", "removes_all", "choice", False, [0, sp.false], [(True, ""), (1, "")]),
-        Row("7.2", "singular_4r", "set", {th2: sp.FiniteSet(0, pi)}, [{th2: [0, pi, 2 * pi]}],
-            [(sp.EmptySet, ""), ({th3: sp.FiniteSet(0, pi)}, "another joint")]),
+        Row(
+            "7.2",
+            "singular_4r",
+            "set",
+            {th2: sp.FiniteSet(0, pi)},
+            [{th2: [0, pi, 2 * pi]}],
+            [(sp.EmptySet, ""), ({th3: sp.FiniteSet(0, pi)}, "another joint")],
+        ),
         Row("7.4", "tau", "expr", tau, [sp.expand(tau)], [(-tau, "wrong sign")]),
-        Row("7.4", "force_semi_axes", "expr", semi.applyfunc(lambda s: 1 / s), [],
-            [(semi, "upside down")]),
-        Row("4.1", "joint_a", "choice", (1, 3), [[3, 1], sp.Matrix([1, 3])], [((1,), "tie"), ((0, 2), "from 0")]),
+        Row("7.4", "force_semi_axes", "expr", semi.applyfunc(lambda s: 1 / s), [], [(semi, "upside down")]),
+        Row("4.1", "joint_a", "choice", (1, 3), [[3, 1], sp.Matrix([1, 3])], [((1,), ""), ((0, 2), "numbered from 1")]),
     ]
 
 
@@ -131,7 +194,7 @@ def graded_tokens(value) -> set[str]:
                 pass
 
     if isinstance(value, dict):
-        for k, v in value.items():
+        for v in value.values():
             add(v)
     elif isinstance(value, (list, tuple)) and value and all(isinstance(v, dict) for v in value):
         for d in value:
@@ -140,3 +203,34 @@ def graded_tokens(value) -> set[str]:
     elif isinstance(value, (sp.Basic, sp.MatrixBase)):
         add(value)
     return out
+
+
+def grader_verdict(value, row, seed):
+    """The grader's ``(ok, message)``: both answers exported as a kernel exports them, the reference read as
+    build_reference reads it, judged at secret points drawn as the grader draws them (make_points, from the
+    reference's symbols and their assumptions)."""
+    from kinlib.course.grader.grade import make_points
+    from kinlib.course.grader.in_kernel.export import exported
+    from kinlib.course.grader.judge import judge_answer, n_points
+    from kinlib.course.grader.refdata import Reference, reference_answers
+
+    entry = reference_answers({row.name: exported(row.right)}, {row.name: row.kind})
+    assert "error" not in entry[row.name], entry
+    kind = entry[row.name]["kind"]
+    pts = make_points(entry[row.name].get("symbols", {}), seed, max(n_points(kind), 1))
+    ref = Reference("t", "t", "p", "0" * 64, [], entry)
+    v = judge_answer(row.name, kind, exported(value), ref, pts, seed)
+    return v.passed, v.message
+
+
+_SPECS: dict = {}
+
+
+def home_verdict(value, row):
+    """The workbook self-check's ``(status, message)`` against the row's fingerprint (as the build makes it)."""
+    from kinlib.course.workbook.selfcheck import fingerprint, verdict
+
+    kind = "default" if row.kind == "expr" else row.kind
+    if row.salt not in _SPECS:
+        _SPECS[row.salt] = fingerprint(row.right, kind, salt=row.salt)
+    return verdict(value, _SPECS[row.salt], salt=row.salt)

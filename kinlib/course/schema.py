@@ -46,7 +46,7 @@ __all__ = [
     "FOLDED_TAGS",
     "is_source_hidden",
     "set_source_hidden",
-    "KINDS",
+    "KINDS",  # noqa: F822  (module __getattr__: from the table of kinds)
     "SELFCHECK_MODULES",
     "cell_tags",
     "cell_source",

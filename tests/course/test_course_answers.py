@@ -257,24 +257,15 @@ def test_the_selfcheck_and_the_checker_reject_the_same_mistakes(kind, ref, value
 
 
 def _grader(value, row, seed):
-    """The grader's verdict: both answers exported as a kernel exports them, the reference read as
-    build_reference reads it, judged at secret points drawn as the grader draws them (make_points, from the
-    reference's symbols and their assumptions)."""
-    from kinlib.course.grader.grade import make_points
-    from kinlib.course.grader.judge import n_points
+    from answer_table import grader_verdict
 
-    entry = reference_answers({row.name: exported(row.right)}, {row.name: row.kind})
-    assert "error" not in entry[row.name], entry
-    kind = entry[row.name]["kind"]
-    pts = make_points(entry[row.name].get("symbols", {}), seed, max(n_points(kind), 1))
-    ref = Reference("t", "t", "p", "0" * 64, [], entry)
-    v = judge_answer(row.name, kind, exported(value), ref, pts, seed)
-    return v.passed, v.message
+    return grader_verdict(value, row, seed)
 
 
 def _home(value, row):
-    kind = "default" if row.kind == "expr" else row.kind
-    return verdict(value, fingerprint(row.right, kind, salt=row.salt), salt=row.salt)
+    from answer_table import home_verdict
+
+    return home_verdict(value, row)
 
 
 def _table_cases():

@@ -511,3 +511,65 @@ def test_5_5_the_reference_robot_is_kept_as_data():
     ref = refdata.reference_answers({"redesign": {"tree": export(robots.planar_rpp())}}, {"redesign": PROP})
     assert "error" not in ref["redesign"], ref
     assert ref["redesign"]["kind"] == PROP and ref["redesign"]["srepr"].startswith("MutableDenseMatrix(")
+
+
+# ----------------------------------------------------------------------------------------- nothing revealed (issue 31)
+
+
+def _table():
+    from answer_table import rows
+
+    return rows()
+
+
+def test_no_message_states_a_graded_value_of_any_part():
+    """Every message both judges give, for every row of the shared table (tests/answer_table.py) given its right
+    answer, its typical wrong answers, and every other part's answer, states no graded value of any part that
+    the student did not type themselves (their own members may be echoed: "pi/4 is not in the set")."""
+    from answer_table import graded_tokens, grader_verdict, home_verdict
+
+    table = _table()
+    graded = {row.salt: graded_tokens(row.right) for row in table}
+    everything = set().union(*graded.values())
+    assert {"3*pi/4", "sqrt(2)*L**2"} <= everything  # the scan looks for the values the issue saw printed
+    seen = 0
+    for target in table:
+        given = [target.right] + [v for v, _ in target.wrong] + [r.right for r in table if r is not target]
+        for value in given:
+            own = graded_tokens(value)
+            forbidden = everything - own
+            for msg in (home_verdict(value, target)[1], grader_verdict(value, target, 5)[1]):
+                seen += 1
+                leaked = sorted(t for t in forbidden if t in msg)
+                assert not leaked, (target.salt, value, msg, leaked)
+    assert seen > 500
+
+
+def test_5_5_and_the_4r_arm_never_print_another_parts_singular_set():
+    """The original robot given for 5.5 printed 5.1's set ("= 0 where theta2 = 3*pi/4, 7*pi/4 (+ 2πk)"); the 4R
+    arm printed 7.2's. Now: "singular configurations", never where, by both judges."""
+    from kinlib.course.workbook.selfcheck import fingerprint
+    from kinlib.course.workbook.selfcheck import verdict as home
+
+    spec = fingerprint(robots.planar_rpp(), PROP)
+    four_r = _planar_robot([("R", 0, 0), ("R", 1, 0), ("R", 2, 0), ("R", 3, 0)])
+    for chain in (robots.planar_offset_3r(), four_r):
+        ok, msg = verdict(PROP, chain, robots.planar_rpp(), "redesign")
+        status, said = home(chain, spec)
+        assert not ok and status == "incorrect"
+        for m in (msg, said):
+            assert "singular configurations" in m and not re.search(r"pi|theta|π/|\d\*", m), m
+
+
+def test_a_matrix_or_a_number_is_not_a_robot_for_either_judge():
+    """`redesign = sp.eye(3)` was "✓ proved": any constant invertible matrix belongs to no robot."""
+    from kinlib.course.workbook.selfcheck import fingerprint
+    from kinlib.course.workbook.selfcheck import verdict as home
+
+    spec = fingerprint(robots.planar_rpp(), PROP)
+    for value in (sp.eye(3), 2 * sp.eye(3), np.eye(3), 1, sp.Integer(1), [[1, 0, 0], [0, 1, 0], [0, 0, 1]]):
+        ok, msg = verdict(PROP, value, robots.planar_rpp(), "redesign")
+        status, said = home(value, spec)
+        assert not ok and status == "incorrect", (value, msg, said)
+        assert "SerialChain" in msg and "SerialChain" in said, (msg, said)
+    assert home(robots.planar_rpp(), spec)[0] == "correct"

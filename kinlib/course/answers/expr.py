@@ -273,7 +273,7 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
                 f"{fmt_shape(rshape)}" + (" (one column per joint)" if rshape[0] == 6 else "")
             )
         square = len(sshape) == 2 == len(rshape) and sshape[0] == sshape[1] and rshape[0] == rshape[1]
-        hint = " (J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?)" if square else ""
+        hint = f" ({mistakes.PRODUCT_ORDER})" if square else ""
         return False, f"{name} has the wrong shape: yours is {fmt_shape(sshape)}, expected {fmt_shape(rshape)}{hint}"
     if stu.get("undefined"):
         return False, f"{name} contains undefined functions {', '.join(stu['undefined'])}"

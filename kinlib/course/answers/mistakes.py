@@ -51,6 +51,7 @@ __all__ = [
     "ROUNDED",
     "DECIMALS",
     "FLOAT_RTOL",
+    "PRODUCT_ORDER",
     "ROUNDED_RTOL",
     "exact_value",
     "exact_values",
@@ -422,6 +423,7 @@ SYMBOLIC_MISTAKES = (
 )
 
 ROUNDED_RTOL = 5e-3  # decimals this close to the answer (3 significant digits) are "right up to rounding"
+PRODUCT_ORDER = "J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?"
 FLOAT_RTOL = 5e-7  # decimals this close to exact values pass, with a note (the grader's RTOL is 1e-6 on values)
 ROUNDED = Mistake(
     "rounded",

@@ -24,8 +24,8 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
-from .mistakes import SET_VARIABLE
 from .base import is_bool, not_answered, subs_for, to_complex, type_name
+from .mistakes import SET_VARIABLE
 
 __all__ = [
     "to_set",

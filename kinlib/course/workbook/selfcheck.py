@@ -141,7 +141,9 @@ def sample_value(name: str, k: int, signed: bool = False) -> sp.Rational:
     """
     h = hashlib.sha256(f"kinlib-selfcheck-v2:{name}:{k}".encode()).digest()
     u = 0.1 + 0.8 * (int.from_bytes(h[:4], "big") / 2**32)  # where in its fifth: away from the fifth's ends
-    order = sorted(range(SAMPLE_POINTS), key=lambda j: hashlib.sha256(f"kinlib-selfcheck-bin:{name}:{j}".encode()).digest())
+    order = sorted(
+        range(SAMPLE_POINTS), key=lambda j: hashlib.sha256(f"kinlib-selfcheck-bin:{name}:{j}".encode()).digest()
+    )
     _, (lo, hi) = symbol_domain(name, positive=not signed and not is_angle_name(name))
     x = lo + (order[k % SAMPLE_POINTS] + u) * (hi - lo) / SAMPLE_POINTS
     return sp.Rational(round(x * 1_000_000), 1_000_000)
@@ -647,7 +649,7 @@ def _verdict_set(value, shape, right, named):
         for v in _JOINT_NAMES:
             if v != mine and right(_canon_condition(conds[0], keys={mine: v})):
                 return named(mistakes.SET_VARIABLE.says)
-    if canon is not _EMPTY and mine_shape != shape and not (mine_shape, shape) in (("dict", ""), ("", "dict")):
+    if canon is not _EMPTY and mine_shape != shape and (mine_shape, shape) not in (("dict", ""), ("", "dict")):
         want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(shape, "a single Set")
         raise WrongForm(f"it should be {want}")
     for m in mistakes.SET_MISTAKES:
@@ -672,9 +674,12 @@ def _verdict_expr(value, form, shape, right, salt, symhash):
 
     try:
         v = _default_value(value, shape)
-    except WrongForm:
+    except WrongForm as e:
         found = _default_mistake(value, form, shape, right)
         if found is None:
+            mine = _shape_of(_as_sympy_value(value)) if not isinstance(value, dict) and not is_bool(value) else ""
+            if "x" in mine and "x" in shape and len(set(mine.split("x"))) == 1 == len(set(shape.split("x"))):
+                raise WrongForm(f"{e} ({mistakes.PRODUCT_ORDER})") from None  # n×n for m×m: JᵀJ for JJᵀ?
             raise
         yours = _shape_words(_shape_of(_as_sympy_value(value)))
         return "incorrect", f"wrong form: it {found}: yours is {yours}, it should be {_shape_words(shape)}"
@@ -695,7 +700,9 @@ def _verdict_expr(value, form, shape, right, salt, symhash):
     notes = _symbol_notes(v, salt, symhash)
     found = _default_mistake(v, form, shape, right, arr)
     if found is None:
-        found = mistakes.concept_says(salt.rpartition(":")[2], constant=not _symbols_of(v), ref_constant=symhash is None)
+        found = mistakes.concept_says(
+            salt.rpartition(":")[2], constant=not _symbols_of(v), ref_constant=symhash is None
+        )
     said = "; ".join(notes + ([found] if found else []))
     if floats:
         said = "; ".join(x for x in (said, mistakes.DECIMALS.says) if x)
