@@ -29,7 +29,18 @@ from dataclasses import dataclass
 from . import choice, expr, properties, sets, subspace
 from .base import is_bool
 
-__all__ = ["Kind", "KINDS", "NAMES", "FORMS", "lookup", "resolve", "ANGLE_PREFIXES", "is_angle_name", "symbol_domain"]
+__all__ = [
+    "Kind",
+    "KINDS",
+    "NAMES",
+    "FORMS",
+    "lookup",
+    "resolve",
+    "ANGLE_PREFIXES",
+    "is_angle_name",
+    "symbol_domain",
+    "draw_points",
+]
 
 # Where the symbols of an answer are evaluated: the one rule for the grader's secret points
 # (kinlib.course.grader.grade.make_points) and the self-check's public ones (kinlib.course.workbook.selfcheck),
@@ -106,6 +117,31 @@ KINDS = {
 NAMES = ("default", *KINDS)  # the kind names a solution notebook may declare ("default" is "expr")
 # the self-check's spec forms (kinlib.course.workbook.selfcheck.fingerprint) -> the kind that judges them
 FORMS = {"matrix": "expr", "scalar": "expr", "bool": "expr", "choice": "choice", "set": "set", "subspace": "subspace"}
+
+
+def draw_points(symbols: dict, seed: int, n: int) -> list[dict]:
+    """``n`` points {symbol name: value}, each symbol over its :func:`symbol_domain` (``symbols``: {name:
+    {"positive": bool}}), *stratified*: each symbol has one value in each n-th of its domain, in an order drawn per
+    symbol, so that a sign change half a turn wide always holds a point (|sin θ| is never right by luck). The
+    grader's secret points (:func:`kinlib.course.grader.grade.make_points`); the same seed gives the same points.
+
+    >>> pts = draw_points({"theta1": {}, "L": {"positive": True}}, seed=7, n=5)
+    >>> sorted(int((p["theta1"] + math.pi) // (2 * math.pi / 5)) for p in pts)
+    [0, 1, 2, 3, 4]
+    >>> pts == draw_points({"theta1": {}, "L": {"positive": True}}, seed=7, n=5)
+    True
+    """
+    import random
+
+    rng = random.Random(seed)
+    pts: list[dict] = [{} for _ in range(n)]
+    for name in sorted(symbols):
+        _, (lo, hi) = symbol_domain(name, bool(symbols[name].get("positive")))
+        order = list(range(n))
+        rng.shuffle(order)
+        for k in range(n):
+            pts[k][name] = lo + (order[k] + rng.uniform(0.02, 0.98)) * (hi - lo) / n
+    return pts
 
 
 def lookup(kind: str) -> tuple[Kind, str]:
