@@ -2,9 +2,13 @@
 
 At build time (``kinlib handouts``) each reference answer is turned into a *fingerprint*:
 the answer evaluated at fixed sample values of its symbols (the same values for a symbol of the same
-name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA-256). The workbook
-holds only the fingerprint; the student's answer is fingerprinted the same way when the self-check
-cell runs, so a right answer in any equivalent form (simplified or not, floats or exact) passes::
+name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA-256). The sample values
+cover the domains the grader's secret points are drawn from (:func:`kinlib.course.answers.kinds.draw_points`:
+joint angles over a whole turn, one sample in each fifth, lengths in (0.5, 2), the reference's signed symbols
+across 0), so the two judges agree: |det J| for det J, a signed manipulability, fail at home as in the grade
+(tests/answer_table.py is the table both must agree on). The workbook holds only the fingerprint; the student's
+answer is fingerprinted the same way when the self-check cell runs, so a right answer in any equivalent form
+(simplified or not, exact, or decimals within the grader's tolerance: with a note) passes::
 
     from kinlib.course.workbook.selfcheck import check
     check("2.2", Js="matrix|6x3|3f0c1b9e5a7d2c44")
