@@ -305,10 +305,13 @@ def test_every_mistake_message_is_free_of_numbers_of_a_key():
     """The fixed words of every named mistake hold no digit but column/row numbers and 45° (the example)."""
     from kinlib.course.answers import mistakes
 
-    for m in mistakes.MATRIX_MISTAKES + mistakes.SUBSPACE_MISTAKES + mistakes.SET_MISTAKES:
-        words = m.message("")
+    named = mistakes.MATRIX_MISTAKES + mistakes.SUBSPACE_MISTAKES + mistakes.SET_MISTAKES + mistakes.CONCEPT_MISTAKES
+    named += (mistakes.SET_VARIABLE, mistakes.ROUNDED, mistakes.DECIMALS) + mistakes.SYMBOLIC_MISTAKES
+    for m in named:
+        words = m.message("") if isinstance(m, mistakes.Mistake) else m.says
         for tok in "".join(ch if ch.isdigit() else " " for ch in words).split():
-            assert tok in {"45", "4", "1", "3", "6", "180"}, (m.name, words)
+            assert tok in {"45", "4", "1", "2", "3", "6", "180"}, (m.name, words)  # 1, 2: L1, L2 and 1/σ
+    assert "pi/4" not in " ".join(m.message("") if isinstance(m, mistakes.Mistake) else m.says for m in named)
     assert math.isclose(float(sp.pi / 180), math.pi / 180)
 
 

@@ -286,7 +286,7 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     if close(S, R):
         extra = []
         if stu.get("has_float") and not ref.get("has_float"):
-            extra.append("contains decimals: use exact values (sp.pi, sp.sqrt(2), sp.Rational(1, 2))")
+            extra.append("contains decimals: use exact values (sp.pi, sp.sqrt, sp.Rational)")
         return True, "; ".join(extra)
     if stu.get("has_float"):
         if close_within(S, R, mistakes.ROUNDED_RTOL):
@@ -375,12 +375,12 @@ def _diagnose(S, R, shape, stu, name="", ref=None) -> str:
     ratio = _const_ratio(S, R)
     if ratio is not None:
         if abs(abs(ratio) - 180 / math.pi) < 1e-6 * 180 / math.pi or abs(abs(ratio) - math.pi / 180) < 1e-9:
-            return "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)"
+            return "looks like it is in degrees: SymPy and NumPy angles are radians (multiply degrees by sp.pi/180)"
         if abs(ratio - 1) < 1e-2:
             return "is close to the answer but not equal: rounded decimals? Use exact values (sp.sqrt(2), sp.pi)"
         return "is off by a constant factor (a factor missing or extra, e.g. a length or ½?)"
     if stu.get("degrees"):
-        return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
+        return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians: multiply degrees by sp.pi/180"
     if S.shape[1] > 1:
         return f"differs in entries {_entries(bad, shape)}"
     return "has the wrong value"

@@ -181,7 +181,7 @@ MATRIX_MISTAKES = (
     _VwMistake("vw-order", "", _vw_order),
     Mistake("columns", "has its columns swapped: {detail} (column i belongs to joint i)", _columns, simple=False),
     Mistake("rows", "has its rows swapped: {detail}", _rows_perm, simple=False),
-    Mistake("degrees", "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)", _degrees),
+    Mistake("degrees", "looks like it is in degrees: SymPy and NumPy angles are radians (multiply degrees by sp.pi/180)", _degrees),
 )
 
 
@@ -340,7 +340,7 @@ def map_set(s, f):
 SET_MISTAKES = (
     Mistake(
         "degrees",
-        "looks like degrees: angles are radians (45° = sp.pi/4)",
+        "looks like degrees: angles are radians (multiply degrees by sp.pi/180)",
         lambda s: iter([("", map_set(s, lambda x: x * sp.pi / 180))]),
     ),
 )
@@ -417,7 +417,7 @@ def _swap_lengths(v):
 
 SYMBOLIC_MISTAKES = (
     SymbolicMistake(
-        "degrees", "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4", trig_degrees
+        "degrees", "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians: multiply degrees by sp.pi/180", trig_degrees
     ),
     SymbolicMistake("lengths", "has L1 and L2 swapped: which link is L1?", _swap_lengths),
 )
@@ -427,7 +427,7 @@ PRODUCT_ORDER = "J Jᵀ is task × task, Jᵀ J joints × joints: the product in
 FLOAT_RTOL = 5e-7  # decimals this close to exact values pass, with a note (the grader's RTOL is 1e-6 on values)
 ROUNDED = Mistake(
     "rounded",
-    "is right up to rounding: its decimals are rounded; use exact values (sp.sqrt(2)/2, sp.pi/4, sp.Rational(1, 3))",
+    "is right up to rounding: its decimals are rounded; use exact values (sp.sqrt, sp.pi, sp.Rational)",
     lambda v: iter(()),
 )
 DECIMALS = Mistake(

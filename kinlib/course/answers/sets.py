@@ -444,7 +444,7 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
     (True, '')
     >>> bare = {"conditions": [[[{"var": None, "points": [-1.5707963267948966, 1.5707963267948966]}]]]}
     >>> compare_set({"tag": "set", "conditions": [[[{"var": None, "points": [90.0, 270.0]}]]]}, bare, "v")[1]
-    'v: these look like degrees (90, 270): angles are radians (90° = sp.pi/2)'
+    'v: these look like degrees (90, 270): angles are radians (multiply degrees by sp.pi/180)'
     """
     na = not_answered(stu)
     if na:
@@ -510,7 +510,7 @@ def _looks_like_degrees(pts) -> list:
 def _degrees_msg(pts) -> str:
     degs = _looks_like_degrees(pts)
     shown = ", ".join(str(d) for d in degs[:4]) + (" …" if len(degs) > 4 else "")
-    return f"these look like degrees ({shown}): angles are radians (90° = sp.pi/2)"
+    return f"these look like degrees ({shown}): angles are radians (multiply degrees by sp.pi/180)"
 
 
 def _compare_component(s, r, periodic):

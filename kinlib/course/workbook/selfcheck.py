@@ -562,7 +562,7 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     >>> verdict(-sp.Rational(1, 2), spec, salt="1.1:x")
     ('incorrect', 'not right yet: it has the wrong sign')
     >>> verdict(0.5, spec, salt="1.1:x")[1]
-    'correct; note: it contains decimals (floats): exact values (sp.Rational(1, 2), sp.sqrt(2), sp.pi) are safer'
+    'correct; note: it contains decimals (floats): exact values (sp.Rational, sp.sqrt, sp.pi) are safer'
     """
     form, shape, digest, symhash, signed = _parse_spec(spec)
     if is_unanswered(value):
@@ -669,7 +669,7 @@ def _floats(v) -> list:
     return sorted(v.atoms(sp.Float), key=float) if isinstance(v, (sp.Basic, sp.MatrixBase)) else []
 
 
-_DECIMALS_NOTE = "it contains decimals (floats): exact values (sp.Rational(1, 2), sp.sqrt(2), sp.pi) are safer"
+_DECIMALS_NOTE = "it contains decimals (floats): exact values (sp.Rational, sp.sqrt, sp.pi) are safer"
 
 
 def _verdict_expr(value, form, shape, right, salt, symhash):
