@@ -391,8 +391,8 @@ CONCEPT_MISTAKES = (
     ),
     Mistake(
         "reciprocal",
-        "is upside down (the reciprocal of the answer, entry by entry): a ratio inverted (L2/L1 for L1/L2), or the "
-        "velocity ellipse's semi-axes σ for the force ellipse's 1/σ?",
+        "is upside down (the reciprocal of the answer, entry by entry): a ratio of lengths taken the wrong way up, or "
+        "the velocity ellipse's semi-axes σ for the force ellipse's 1/σ?",
         _reciprocal,
     ),
 )
