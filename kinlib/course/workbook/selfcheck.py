@@ -257,8 +257,26 @@ def _default_value(value, shape: str | None = None):
     return v
 
 
+_SAMPLED: dict = {}  # (value, signed symbols) -> its samples: a self-check cell run again, the mistakes tried
+_SAMPLED_MAX = 64
+
+
 def _sampled(v):
-    """``v`` (Matrix or expression) at the sample points: an object array (points, rows, columns)."""
+    """``v`` (Matrix or expression) at the sample points: an object array (points, rows, columns); remembered for
+    the last :data:`_SAMPLED_MAX` values (each is evaluated once however many candidates and checks use it)."""
+    try:
+        key = (sp.ImmutableMatrix(v) if isinstance(v, sp.MatrixBase) else v, _SIGNED.get())
+        hash(key)
+    except Exception:  # noqa: BLE001  (an object SymPy cannot hash: not remembered)
+        return _sampled_now(v)
+    if key not in _SAMPLED:
+        if len(_SAMPLED) >= _SAMPLED_MAX:
+            _SAMPLED.pop(next(iter(_SAMPLED)))
+        _SAMPLED[key] = _sampled_now(v)
+    return _SAMPLED[key].copy()
+
+
+def _sampled_now(v):
     if isinstance(v, sp.MatrixBase):
         return np.array([_evaluate(v, k).tolist() for k in range(SAMPLE_POINTS)], dtype=object).reshape(
             SAMPLE_POINTS, *v.shape
