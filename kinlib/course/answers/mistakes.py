@@ -181,7 +181,11 @@ MATRIX_MISTAKES = (
     _VwMistake("vw-order", "", _vw_order),
     Mistake("columns", "has its columns swapped: {detail} (column i belongs to joint i)", _columns, simple=False),
     Mistake("rows", "has its rows swapped: {detail}", _rows_perm, simple=False),
-    Mistake("degrees", "looks like it is in degrees: SymPy and NumPy angles are radians (multiply degrees by sp.pi/180)", _degrees),
+    Mistake(
+        "degrees",
+        "looks like it is in degrees: SymPy and NumPy angles are radians (multiply degrees by sp.pi/180)",
+        _degrees,
+    ),
 )
 
 
@@ -417,7 +421,9 @@ def _swap_lengths(v):
 
 SYMBOLIC_MISTAKES = (
     SymbolicMistake(
-        "degrees", "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians: multiply degrees by sp.pi/180", trig_degrees
+        "degrees",
+        "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians: multiply degrees by sp.pi/180",
+        trig_degrees,
     ),
     SymbolicMistake("lengths", "has L1 and L2 swapped: which link is L1?", _swap_lengths),
 )
