@@ -390,7 +390,7 @@ CONCEPT_MISTAKES = (
     Mistake(
         "branch",
         "has the right size but the wrong sign at some configurations: an absolute value |·| missing or extra? "
-        "(det J is signed; the manipulability √det(J Jᵀ) is ≥ 0 everywhere)",
+        "(det J is signed; the manipulability √det(J Jᵀ) is never negative)",
         _sign_patterns,
     ),
     Mistake(

@@ -119,7 +119,7 @@ class WrongForm(Exception):
         ...
     kinlib.course.workbook.selfcheck.WrongForm: it should be a SymPy Matrix, expression or number, yours is a list of ...
     >>> check("1.1", _namespace={"J": sp.eye(3)}, J=fingerprint(sp.eye(2), salt="1.1:J"))
-    part 1.1 · J: ✗ wrong form: it should be a 2×2 matrix, yours is a 3×3 matrix
+    part 1.1 · J: ✗ wrong form: it should be a 2×2 matrix, yours is a 3×3 matrix (J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?)
     """
 
 
