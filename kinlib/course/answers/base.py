@@ -12,6 +12,7 @@ It imports only the standard library, NumPy and SymPy (it runs in the student's 
 from __future__ import annotations
 
 import math
+import numbers
 import random
 
 import numpy as np
@@ -20,6 +21,7 @@ import sympy as sp
 __all__ = [
     "is_unanswered",
     "is_bool",
+    "as_sympy",
     "type_name",
     "close",
     "values_array",
@@ -68,6 +70,33 @@ def is_bool(value) -> bool:
     return isinstance(value, (bool, np.bool_)) or value is sp.true or value is sp.false
 
 
+def as_sympy(value):
+    """``value`` as a SymPy object **without parsing anything**: SymPy objects as they are (a matrix as an
+    immutable one), Python and NumPy numbers and bools converted (``sympify(strict=True)``), tuples and lists
+    as SymPy ``Tuple`` s of the same; anything else, above all a string (which ``sympify`` would parse, i.e.
+    ``eval``), raises TypeError. Every conversion of a container's entries on the trusted side goes through it.
+
+    >>> as_sympy(np.float64(0.5)), as_sympy((1, sp.pi)), as_sympy(sp.Symbol("x"))
+    (0.500000000000000, (1, pi), x)
+    >>> as_sympy("__import__('os').system('id')")
+    Traceback (most recent call last):
+    ...
+    TypeError: expected a number or SymPy value, not a str
+    """
+    if isinstance(value, sp.Basic):
+        return value
+    if isinstance(value, sp.MatrixBase):
+        return value.as_immutable()
+    if isinstance(value, (bool, np.bool_, numbers.Number, np.number)) and not isinstance(value, (str, bytes)):
+        try:
+            return sp.sympify(value.item() if isinstance(value, np.generic) else value, strict=True)
+        except (sp.SympifyError, TypeError, ValueError) as exc:
+            raise TypeError(f"expected a number or SymPy value, not a {type(value).__name__}") from exc
+    if isinstance(value, (tuple, list)):
+        return sp.Tuple(*[as_sympy(v) for v in value])
+    raise TypeError(f"expected a number or SymPy value, not a {type(value).__name__}")
+
+
 def type_name(value) -> str:
     """The type of ``value`` as students know it (``Matrix``'s module spelled out, builtins bare; an object that
     crossed from a kernel as its type name only, :class:`kinlib.course.answers.wire.Other`, by that name).
@@ -114,7 +143,7 @@ def to_complex(e):
     >>> to_complex(sp.sqrt(-4)), to_complex(sp.oo), to_complex(sp.Symbol("x"))
     ([0.0, 2.0], None, None)
     """
-    e = sp.sympify(e)
+    e = as_sympy(e)
     if not e.is_number:
         e = e.evalf(20)
         if not e.is_number:

@@ -13,6 +13,9 @@ import math
 
 import sympy as sp
 
+from .base import as_sympy
+from .wire import safe_name
+
 __all__ = ["expr_tree", "from_tree", "exact_ranks"]
 
 _TREE_FUNCS = ("sin", "cos", "tan")
@@ -56,12 +59,13 @@ def expr_tree(obj, max_nodes=_TREE_MAX_NODES):
 
     if isinstance(obj, sp.MatrixBase):
         return ["matrix", obj.rows, obj.cols, *[walk(x) for x in obj]]
-    return walk(sp.sympify(obj))
+    return walk(as_sympy(obj))
 
 
 def from_tree(t, syms: dict | None = None, budget: list | None = None):
     """Rebuild a student's expression from its JSON tree (:func:`expr_tree`) by a whitelist, never ``eval``:
-    numbers (at most 60 digits), symbols (real, or positive as declared), π, +, ×, powers with small exact
+    numbers (at most 60 digits), symbols (real, or positive as declared; named by a
+    :func:`~kinlib.course.answers.wire.safe_name`), π, +, ×, powers with small exact
     exponents, sin/cos/tan. Anything else raises ValueError. ``syms`` collects the symbols made (one per name and
     assumption), ``budget`` ([nodes left]) bounds the size.
 
@@ -100,7 +104,7 @@ def from_tree(t, syms: dict | None = None, budget: list | None = None):
         return sp.Rational(x)  # its exact binary value (as kinlib.trigpoly takes floats)
     if op == "pi" and not args:
         return sp.pi
-    if op == "sym" and len(args) == 2 and isinstance(args[0], str) and 0 < len(args[0]) <= 40:
+    if op == "sym" and len(args) == 2 and safe_name(args[0]) and len(args[0]) <= 40:
         key = (args[0], bool(args[1]))
         if key not in syms:
             syms[key] = sp.Symbol(args[0], positive=True) if args[1] else sp.Symbol(args[0], real=True)
@@ -150,7 +154,7 @@ def exact_ranks(stu_tree, ref_tree):
     unsure = []
 
     def iszero(x):
-        z = sp.sympify(x).equals(0)
+        z = as_sympy(x).equals(0)
         if z is None:
             unsure.append(x)
         return bool(z)

@@ -25,6 +25,7 @@ import sympy as sp
 
 from . import mistakes
 from .base import (
+    as_sympy,
     close,
     extra_value,
     fmt_shape,
@@ -60,35 +61,55 @@ def _is_matrix_like(x) -> bool:
 
 
 def _from_sequence(items: list, vectors: bool):
-    """:func:`to_sympy` of a list or tuple: columns side by side, rows, or a column of numbers."""
+    """:func:`to_sympy` of a list or tuple: columns side by side, rows, or a column of numbers. Entries are
+    converted by :func:`~.base.as_sympy` (a string, or anything else that is not a number or SymPy value, makes
+    the answer "other": it is never parsed)."""
     if not items:
         return "empty", None
-    if all(_is_vector(v) for v in items) or (
-        vectors
-        and all(
-            isinstance(v, (list, tuple, sp.Tuple)) and not any(isinstance(e, (list, tuple)) for e in v) for v in items
-        )
-    ):
-        cols = [sp.Matrix([sp.sympify(e) for e in _flat(v)]) for v in items]
-        if len({c.shape for c in cols}) != 1:
-            return "ragged", None
-        return "matrix", sp.Matrix.hstack(*cols)
-    if vectors and all(_is_matrix_like(v) for v in items):
-        try:
-            return "matrix", sp.Matrix.hstack(
-                *[sp.Matrix(v.tolist() if isinstance(v, np.ndarray) else v) for v in items]
-            )
-        except Exception:  # noqa: BLE001  (blocks of different heights)
-            return "ragged", None
-    if all(isinstance(v, (list, tuple, sp.Tuple)) for v in items):
-        try:
-            return "matrix", sp.Matrix([[sp.sympify(e) for e in row] for row in items])
-        except Exception:  # noqa: BLE001
-            return "ragged", None
     try:
-        return "matrix", sp.Matrix([sp.sympify(e) for e in items])
-    except Exception:  # noqa: BLE001
+        if all(_is_vector(v) for v in items) or (
+            vectors
+            and all(
+                isinstance(v, (list, tuple, sp.Tuple)) and not any(isinstance(e, (list, tuple)) for e in v)
+                for v in items
+            )
+        ):
+            cols = [sp.Matrix([_scalar(e) for e in _flat(v)]) for v in items]
+            if len({c.shape for c in cols}) != 1:
+                return "ragged", None
+            return "matrix", sp.Matrix.hstack(*cols)
+        if vectors and all(_is_matrix_like(v) for v in items):
+            try:
+                return "matrix", sp.Matrix.hstack(*[_matrix_of(v) for v in items])
+            except (ValueError, sp.ShapeError, IndexError):  # blocks of different heights
+                return "ragged", None
+        if all(isinstance(v, (list, tuple, sp.Tuple)) for v in items):
+            rows = [[_scalar(e) for e in row] for row in items]
+            if len({len(r) for r in rows}) != 1:
+                return "ragged", None
+            return "matrix", sp.Matrix(rows)
+        return "matrix", sp.Matrix([_scalar(e) for e in items])
+    except TypeError:  # an entry that is not a number or SymPy value (a string, a dict, None...)
         return "other", None
+    except (ValueError, sp.ShapeError, IndexError):
+        return "ragged", None
+
+
+def _scalar(e):
+    """A matrix entry: a number or SymPy value (:func:`~.base.as_sympy`, never parsed); a list or tuple there is
+    a ragged answer (ValueError), anything else TypeError."""
+    if isinstance(e, (list, tuple, sp.MatrixBase)):
+        raise ValueError("a matrix entry that is itself a list or matrix")
+    return as_sympy(e)
+
+
+def _matrix_of(v):
+    """A SymPy Matrix of a SymPy matrix or a 1-D/2-D NumPy array, its entries by :func:`~.base.as_sympy`."""
+    if isinstance(v, sp.MatrixBase):
+        return sp.Matrix(v)
+    if v.ndim == 1:
+        return sp.Matrix([_scalar(e) for e in v.tolist()])
+    return sp.Matrix([[_scalar(e) for e in row] for row in v.tolist()])
 
 
 def to_sympy(value, vectors: bool = False):
@@ -121,10 +142,13 @@ def to_sympy(value, vectors: bool = False):
     if isinstance(value, np.ndarray):
         if value.ndim == 0:
             return to_sympy(value.item())
-        if value.ndim == 1:
-            return "matrix", sp.Matrix([sp.sympify(e) for e in value.tolist()])
-        if value.ndim == 2:
-            return "matrix", sp.Matrix([[sp.sympify(e) for e in row] for row in value.tolist()])
+        if value.ndim in (1, 2):
+            try:
+                return "matrix", _matrix_of(value)
+            except TypeError:  # an entry that is not a number or SymPy value (a string...): never parsed
+                return "other", None
+            except (ValueError, sp.ShapeError, IndexError):
+                return "ragged", None
         return "array", None
     if isinstance(value, (sp.Tuple, list, tuple)):
         return _from_sequence(list(value), vectors)
@@ -133,8 +157,7 @@ def to_sympy(value, vectors: bool = False):
     if isinstance(value, sp.Basic):
         return "other", None
     if isinstance(value, (numbers.Number, np.number)):
-        v = value.item() if isinstance(value, np.generic) else value
-        return "scalar", sp.sympify(v)
+        return "scalar", as_sympy(value)
     if isinstance(value, (str, bytes, dict, set, frozenset)):
         return "other", None
     try:  # mpmath numbers, objects with a _sympy_ method, ...
@@ -433,7 +456,7 @@ def exact_equal(value, ref, budget=5.0):
     if len(a) != len(b):
         return "not proved"
     for x, y in zip(a, b):
-        d = sp.sympify(x - y)
+        d = as_sympy(x - y)
         if d == 0:
             continue
         d = sp.expand(sp.expand_trig(d))

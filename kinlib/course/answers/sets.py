@@ -24,7 +24,7 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
-from .base import is_bool, not_answered, subs_for, to_complex, type_name
+from .base import as_sympy, is_bool, not_answered, subs_for, to_complex, type_name
 from .mistakes import SET_VARIABLE
 
 __all__ = [
@@ -52,9 +52,9 @@ def to_set(value):
     if isinstance(value, np.ndarray):
         value = value.ravel().tolist()
     if isinstance(value, (set, frozenset, list, tuple)):
-        return sp.FiniteSet(*[sp.sympify(v) for v in value])
+        return sp.FiniteSet(*[as_sympy(v) for v in value])  # never parsed: a string member raises TypeError
     if isinstance(value, (numbers.Number, np.number, sp.Expr)) and not is_bool(value):
-        return sp.FiniteSet(value.item() if isinstance(value, np.generic) else value)
+        return sp.FiniteSet(as_sympy(value))
     raise TypeError(f"a set should be a SymPy Set (or a dict {{symbol: Set}}), not a {type(value).__name__}")
 
 
@@ -144,7 +144,7 @@ def _finite(S, subs, window):
     _cap(S.args)
     pts = []
     for e in S.args:
-        x = _real(sp.sympify(e), subs)
+        x = _real(as_sympy(e), subs)
         if x is None:
             raise ValueError(f"member {e} is not a real number")
         pts.append(x)
@@ -226,7 +226,7 @@ def _component(key, S, p, seed, window):
             for a in S.args if isinstance(S, sp.FiniteSet) else S:
                 t = []
                 for e in a:
-                    x = _real(sp.sympify(e), subs)
+                    x = _real(as_sympy(e), subs)
                     if x is None:
                         raise ValueError(f"member {a} is not real")
                     t.append(x)

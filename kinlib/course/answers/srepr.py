@@ -11,6 +11,8 @@ trusted side only; answers from a kernel are read by :mod:`kinlib.course.answers
 
 import ast
 
+from .wire import safe_name
+
 __all__ = ["parse_srepr"]
 
 _SREPR_NAMES = {}
@@ -88,10 +90,29 @@ def _call(node, names):
         if f.id == "Float" and not all(c in "0123456789.eE+-" for c in s):
             raise _bad("a Float that is not a number")
         first = [s]
+    if first and f.id != "Float" and not safe_name(first[0]):
+        raise _bad(f"a name that is not an identifier ({first[0][:40]!r})")
     kw = {k.arg: _num(k.value) for k in node.keywords if k.arg is not None}
     if len(kw) != len(node.keywords):
         raise _bad("**keywords")
-    return fn(*first, *[_build(a, names) for a in args], **kw)
+    built = [_build(a, names) for a in args]
+    if any(_has_string(b) for b in built):  # a string SymPy would sympify (parse): only names take one
+        raise _bad(f"a string inside the arguments of {ast.unparse(f)[:40]}")
+    return fn(*first, *built, **kw)
+
+
+def _has_string(value) -> bool:
+    """Whether a built argument holds a plain string anywhere (a dict key too)."""
+    stack = [value]
+    while stack:
+        v = stack.pop()
+        if isinstance(v, (str, bytes)):
+            return True
+        if isinstance(v, dict):
+            stack += [*v.keys(), *v.values()]
+        elif isinstance(v, (list, tuple)):
+            stack += list(v)
+    return False
 
 
 def parse_srepr(text, max_len=2_000_000):

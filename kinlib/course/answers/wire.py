@@ -12,7 +12,8 @@ Nodes (``T`` a tree):
 ``["none"]``, ``["ellipsis"]``          None, ``...``
 ``["bool", b]``                         a bool (also NumPy's)
 ``["int", "digits"]``                   an int (also NumPy's); ``["float", repr]``, ``["complex", re, im]``
-``["str", s]``                          a string (at most :data:`MAX_STR` characters)
+``["str", s]``                          a string (at most :data:`MAX_STR` characters): plain data, never
+                                        an expression (no SymPy node takes one, see below)
 ``["list"|"tuple"|"set"|"frozenset",    Python containers; ``["dict", [T, T], ...]`` a dict
 T, ...]``
 ``["ndarray", [shape], T, ...]``        a NumPy array (entries flattened, row-major)
@@ -23,18 +24,33 @@ T, ...]``
 ``["Integer", "digits"]``,              SymPy numbers (a Float by its decimal digits and precision in bits)
 ``["Rational", p, q]``,
 ``["Float", "digits", prec]``
-``["Symbol", name, {a: b}]``            a symbol with its assumptions (known assumption names only)
+``["Symbol", name, {a: b}]``            a symbol with its assumptions (known assumption names only; the
+                                        name a :func:`safe_name`)
 ``["Dummy", name, {a: b}, index]``      a dummy symbol: one per (name, index) within the answer
-``["UndefinedFunction", name, T...]``   ``Function(name)(T, ...)``
+``["UndefinedFunction", name, T...]``   ``Function(name)(T, ...)`` (the name a :func:`safe_name`, not a builtin's)
 ``["Matrix", rows, cols, T, ...]``      a SymPy matrix (entries row-major)
 ``["<SymPy class>", T, ...]``           one of :data:`CLASSES` applied to its arguments, or one of
                                         :data:`SINGLETONS` (``["Pi"]``, ``["Reals"]``, ``["BooleanTrue"]``)
 ====================================  =================================================================
 
+**Typed, never evaluated.** SymPy's constructors ``sympify`` their arguments, and ``sympify`` of a string is
+``parse_expr``, i.e. ``eval``. So a SymPy node (``Matrix``, ``UndefinedFunction`` and every one of
+:data:`CLASSES`) is built only from arguments that are already SymPy objects made by this parser (numbers,
+symbols, singletons, other SymPy nodes; a matrix inside a set as an immutable matrix): a string, a Python number,
+list, dict or any other plain value as an argument is refused (the kernel's exporter never writes one there).
+Names (of symbols, dummies and undefined functions) are :func:`safe_name` s, so whatever later prints,
+lambdifies or reports them sees an identifier, never code, a quote or a newline. Plain strings stay plain
+``str`` values in plain containers; the kinds' normalisers convert container entries with
+:func:`kinlib.course.answers.base.as_sympy` (``strict``: a string raises, it is never parsed).
+
 >>> load(["Matrix", 1, 2, ["Symbol", "L", {"positive": True}], ["Rational", "1", "2"]])
 Matrix([[L, 1/2]])
 >>> load(["other", "os.system"])
 <other: os.system>
+>>> load(["sin", ["str", "__import__('os').system('id')"]])
+Traceback (most recent call last):
+...
+kinlib.course.answers.wire.WireError: sin takes SymPy values, not a str
 >>> load(["Pow", ["Integer", "10"], ["Integer", "100000000"]])
 Traceback (most recent call last):
 ...
@@ -43,9 +59,25 @@ kinlib.course.answers.wire.WireError: a power too large to compute (exponent 100
 
 from __future__ import annotations
 
+import builtins
 import json
+import keyword
+import re
+import unicodedata
 
-__all__ = ["load", "WireError", "Other", "Robot", "MAX_NODES", "MAX_DEPTH", "MAX_DIGITS", "CLASSES", "SINGLETONS"]
+__all__ = [
+    "load",
+    "safe_name",
+    "WireError",
+    "Other",
+    "Robot",
+    "MAX_NODES",
+    "MAX_DEPTH",
+    "MAX_DIGITS",
+    "MAX_NAME",
+    "CLASSES",
+    "SINGLETONS",
+]
 
 MAX_NODES = 100_000  # nodes in one answer (a 250,000-point set is refused, not compared for minutes)
 MAX_DEPTH = 200  # nesting depth
@@ -55,6 +87,7 @@ MAX_POWER = 1000  # |exponent| of a power of an exact number (of anything else: 
 MAX_STR = 10_000
 MAX_ENTRIES = 40_000  # entries of one matrix or array
 MAX_PREC = 4000  # bits of a Float
+MAX_NAME = 64  # characters of a symbol's or function's name
 
 CLASSES = (
     # arithmetic and elementary functions
@@ -80,6 +113,31 @@ class WireError(ValueError):
     >>> str(WireError("nested more than 200 levels deep"))
     'nested more than 200 levels deep'
     """
+
+
+_NAME = re.compile(r"\\?[^\W\d][\w\\{}^]*")  # (\)letter-or-_ then word characters, LaTeX's \ { } ^
+
+
+def safe_name(name) -> bool:
+    r"""Whether ``name`` may name a symbol or an undefined function in an answer: at most :data:`MAX_NAME`
+    characters; a letter or ``_`` (optionally after one ``\``), then letters, digits, ``_`` and LaTeX's
+    ``\ { } ^`` (``theta_1``, ``θ2``, ``\theta_{2}``, ``x^T``); no ``__`` (no dunder), no keyword, no quote,
+    space, newline, dot or bracket, and unchanged by Unicode NFKC (what Python does to identifiers), so it
+    prints as one token that is never code.
+
+    >>> [safe_name(n) for n in ("theta1", "θ_2", r"\theta_{2}", "_x0", "L")]
+    [True, True, True, True, True]
+    >>> [safe_name(n) for n in ("__class__", "x'", "a b", "x\n", "lambda", "os.system", "f()", "", "ｅｘｅｃ")]
+    [False, False, False, False, False, False, False, False, False]
+    """
+    return (
+        isinstance(name, str)
+        and 0 < len(name) <= MAX_NAME
+        and _NAME.fullmatch(name) is not None
+        and "__" not in name
+        and not keyword.iskeyword(name)
+        and unicodedata.normalize("NFKC", name) == name
+    )
 
 
 class Robot:
@@ -291,6 +349,32 @@ def _assumptions(d):
     return d
 
 
+def _name(x, function=False):
+    if not safe_name(x):
+        raise WireError("a name that is not an identifier (letters, digits and _ only)")
+    if function and x in _BUILTIN_NAMES:  # (printed as a call, "exit(x)" would be Python's)
+        raise WireError(f"a function named like Python's own {x}()")
+    return x
+
+
+_BUILTIN_NAMES = frozenset(dir(builtins))
+
+
+def _basic_args(op, items):
+    """The arguments of a SymPy node: every one a SymPy object already (a matrix as an immutable one), never a
+    string or other plain value that SymPy's constructor would ``sympify`` (parse, i.e. evaluate)."""
+    import sympy as sp
+
+    out = []
+    for a in items:
+        if isinstance(a, sp.MatrixBase):
+            a = a.as_immutable()
+        if not isinstance(a, sp.Basic):
+            raise WireError(f"{op[:40]} takes SymPy values, not a {type(a).__name__}")
+        out.append(a)
+    return out
+
+
 def _sympy(op, args, build, text, integer, small, classes, dummies):
     import sympy as sp
 
@@ -303,36 +387,49 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
         return sp.Rational(p, q)
     if op == "Float" and len(args) == 2:
         digits = text(args[0], 1300)
-        if not all(c in "0123456789.eE+-infa" for c in digits):
+        if not digits or not all(c in "0123456789.eE+-infa" for c in digits):
             raise WireError("malformed Float")
-        return sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
+        try:  # mpmath's number syntax (never eval); malformed digits are a ValueError
+            return sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
+        except (ValueError, TypeError):
+            raise WireError("malformed Float") from None
     if op == "Symbol" and len(args) == 2:
-        return sp.Symbol(text(args[0], 100), **_assumptions(args[1]))
+        return sp.Symbol(_name(args[0]), **_assumptions(args[1]))
     if op == "Dummy" and len(args) == 3:
-        key = (text(args[0], 100), json.dumps(_assumptions(args[1]), sort_keys=True), small(args[2], 2**31))
+        key = (_name(args[0]), json.dumps(_assumptions(args[1]), sort_keys=True), small(args[2], 2**31))
         if key not in dummies:
             dummies[key] = sp.Dummy(key[0], **args[1])
         return dummies[key]
     if op == "UndefinedFunction" and args:
-        return sp.Function(text(args[0], 100))(*[build(a) for a in args[1:]])
+        name = _name(args[0], function=True)
+        fargs = _basic_args(op, [build(a) for a in args[1:]])
+        try:
+            return sp.Function(name)(*fargs)
+        except (TypeError, ValueError):
+            raise WireError("UndefinedFunction could not be rebuilt") from None
     if op == "Matrix" and len(args) >= 2:
         r, c = small(args[0], MAX_ENTRIES), small(args[1], MAX_ENTRIES)
         if r * c != len(args) - 2 or r * c > MAX_ENTRIES:
             raise WireError("malformed matrix (shape and entries disagree, or too many entries)")
-        return sp.Matrix(r, c, [build(a) for a in args[2:]])
+        entries = [build(a) for a in args[2:]]
+        if not all(isinstance(e, sp.Basic) for e in entries):
+            raise WireError("a Matrix's entries are SymPy values")
+        return sp.Matrix(r, c, entries)
     if op in SINGLETONS and not args:
         return getattr(sp.S, _SINGLETON_ATTR.get(op, op))
     cls = classes.get(op)
     if cls is None:
         raise WireError(f"{op[:40]} is not an answer the grader reads")
-    items = [build(a) for a in args]
+    items = _basic_args(op, [build(a) for a in args])
     if op == "Pow" and len(items) == 2:
         _check_power(*items)
     if op == "Dict":
+        if not all(isinstance(kv, sp.Tuple) and len(kv) == 2 for kv in items):
+            raise WireError("malformed Dict")
         return sp.Dict(*items)
     try:
         return cls(*items)
-    except (TypeError, ValueError, AttributeError, NotImplementedError) as exc:
+    except (TypeError, ValueError, AttributeError, NotImplementedError, IndexError, KeyError, ArithmeticError) as exc:
         raise WireError(f"{op} could not be rebuilt ({type(exc).__name__})") from None
 
 
