@@ -46,7 +46,7 @@ __all__ = [
     "FOLDED_TAGS",
     "is_source_hidden",
     "set_source_hidden",
-    "KINDS",
+    "KINDS",  # noqa: F822  (module __getattr__: from the table of kinds)
     "SELFCHECK_MODULES",
     "cell_tags",
     "cell_source",
@@ -80,7 +80,6 @@ ANSWER_TAGS = frozenset({SOLUTION, CHECK})
 OBJECTIVES, SUMMARY, PREDICT, PREDICT_ANSWER = "objectives", "summary", "predict", "predict-answer"
 HINT, MISTAKE, GIVEN = "hint", "mistake", "given"
 FOLDED_TAGS = frozenset({PREDICT_ANSWER, HINT, CHECK})
-KINDS = ("default", "expr", "choice", "set", "subspace")
 # the module a workbook's self-check cells import ``check`` from: today's, and those of workbooks handed out
 # before kinlib.course was laid out in folders (kinlib.course.selfcheck) or existed (kinlib.selfcheck)
 SELFCHECK_MODULES = ("kinlib.course.workbook.selfcheck", "kinlib.course.selfcheck", "kinlib.selfcheck")
@@ -603,3 +602,13 @@ def match_notebook(nb, references: dict) -> str | None:
     if not scored or (len(scored) > 1 and scored[0][0] == scored[1][0]):
         return None
     return scored[0][1]
+
+
+def __getattr__(name: str):
+    """``KINDS``: the answer kinds a solution notebook may declare, from the table of kinds
+    (:data:`kinlib.course.answers.kinds.NAMES`; imported on first use: it loads SymPy)."""
+    if name == "KINDS":
+        from .answers.kinds import NAMES
+
+        return NAMES
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -251,3 +251,42 @@ DIFFERENT = [
 def test_the_selfcheck_and_the_checker_reject_the_same_mistakes(kind, ref, value):
     assert _selfcheck(value, ref, kind)[0] == "incorrect"
     assert not _checker(value, ref, kind)[0]
+
+
+# ----------------------------------------------------------------------------------------- the shared table (issue 31)
+
+
+def _grader(value, row, seed):
+    from answer_table import grader_verdict
+
+    return grader_verdict(value, row, seed)
+
+
+def _home(value, row):
+    from answer_table import home_verdict
+
+    return home_verdict(value, row)
+
+
+def _table_cases():
+    from answer_table import rows
+
+    for row in rows():
+        yield pytest.param(row, row.right, True, "", id=f"{row.salt}-right")
+        for i, v in enumerate(row.valid):
+            yield pytest.param(row, v, True, "", id=f"{row.salt}-valid{i}")
+        for i, (v, words) in enumerate(row.wrong):
+            yield pytest.param(row, v, False, words, id=f"{row.salt}-wrong{i}")
+
+
+@pytest.mark.parametrize("row, value, right, words", list(_table_cases()))
+def test_the_selfcheck_and_the_grader_agree_on_the_table(row, value, right, words):
+    """Every row of the shared table (tests/answer_table.py): the same verdict at home (public points) and in
+    the grade (secret points, two seeds), and the mistake named in both."""
+    status, home = _home(value, row)
+    for seed in (3, 11):
+        ok, graded = _grader(value, row, seed)
+        assert ok == right, (seed, graded)
+    assert (status == "correct") == right, home
+    if words:
+        assert words in home and words in graded, (home, graded)

@@ -349,11 +349,11 @@ def test_5_5_the_students_own_robot_is_judged_by_its_property():
         # as the grader receives it: exported in the student's kernel, read by the whitelist parser
         crossed = wire.load(json.loads(json.dumps(export(chain))))
         assert verdict(PROP, crossed, robots.planar_rpp(), "redesign")[0], label
-    ok, msg = verdict(PROP, Jr, robots.planar_rpp(), "redesign")  # its task Jacobian J
-    assert ok, msg
     c1, s1 = sp.cos(TH[0]), sp.sin(TH[0])
     J_alt = sp.Matrix([[1, 0, 0], [0, c1 / sp.sqrt(2), -s1], [0, s1 / sp.sqrt(2), c1]])
-    assert verdict(PROP, J_alt, robots.planar_rpp(), "redesign")[0]
+    for J in (Jr, J_alt, sp.eye(3), 2 * sp.eye(3)):  # a matrix alone (its J, any invertible one) is no robot
+        ok, msg = verdict(PROP, J, robots.planar_rpp(), "redesign")
+        assert not ok and "SerialChain" in msg and "no robot" in msg, msg
 
 
 def test_5_5_a_value_with_no_robot_and_singular_designs_fail():
@@ -386,7 +386,8 @@ def test_5_5_a_value_with_no_robot_and_singular_designs_fail():
         assert not ok, label
         assert "R-P-P" not in msg and "prismatic" not in msg and "= 1" not in msg and "factor" not in msg, msg
     ok, msg = verdict(PROP, original, robots.planar_rpp(), "redesign")
-    assert "3*pi/4, 7*pi/4" in msg  # where *the student's* det vanishes (their own answer), θ2 = −π/4 + kπ
+    # never where: the original robot's singular set is 5.1's answer (θ2 = 3π/4, 7π/4), the 4R arm's 7.2's
+    assert not ok and "singular configurations" in msg and "pi" not in msg and "theta" not in msg, msg
 
 
 def test_5_5_hostile_trees_are_rejected_not_evaluated():
@@ -401,12 +402,12 @@ def test_5_5_hostile_trees_are_rejected_not_evaluated():
     ok, msg = C.compare(PROP, {"tag": "scalar", "tree": deep}, {}, "d")
     assert not ok
     ok, msg = C.compare(PROP, {"tag": "matrix", "tree": ["matrix", 1, 1, deep]}, {}, "d")
-    assert not ok and "could not" in msg
+    assert not ok and ("could not" in msg or "no robot" in msg)
     ok, msg = C.compare(PROP, {"tag": "robot", "tree": ["matrix", 6, 1, *[deep] * 6]}, {}, "d")
     assert not ok and "could not" in msg
     big = (sp.sin(TH[0]) + sp.cos(TH[1]) + sp.sin(TH[2]) + 2) ** 12
     ok, msg = verdict(PROP, sp.diag(big, 1, 1), 1, "d")
-    assert not ok and "too large" in msg
+    assert not ok and "no robot" in msg  # a matrix is refused before it is read
     assert not verdict(PROP, sp.exp(TH[0]), 1, "d")[0]
 
 
@@ -510,3 +511,65 @@ def test_5_5_the_reference_robot_is_kept_as_data():
     ref = refdata.reference_answers({"redesign": {"tree": export(robots.planar_rpp())}}, {"redesign": PROP})
     assert "error" not in ref["redesign"], ref
     assert ref["redesign"]["kind"] == PROP and ref["redesign"]["srepr"].startswith("MutableDenseMatrix(")
+
+
+# ----------------------------------------------------------------------------------------- nothing revealed (issue 31)
+
+
+def _table():
+    from answer_table import rows
+
+    return rows()
+
+
+def test_no_message_states_a_graded_value_of_any_part():
+    """Every message both judges give, for every row of the shared table (tests/answer_table.py) given its right
+    answer, its typical wrong answers, and every other part's answer, states no graded value of any part that
+    the student did not type themselves (their own members may be echoed: "pi/4 is not in the set")."""
+    from answer_table import graded_tokens, grader_verdict, home_verdict
+
+    table = _table()
+    graded = {row.salt: graded_tokens(row.right) for row in table}
+    everything = set().union(*graded.values())
+    assert {"3*pi/4", "sqrt(2)*L**2"} <= everything  # the scan looks for the values the issue saw printed
+    seen = 0
+    for target in table:
+        given = [target.right] + [v for v, _ in target.wrong] + [r.right for r in table if r is not target]
+        for value in given:
+            own = graded_tokens(value)
+            forbidden = everything - own
+            for msg in (home_verdict(value, target)[1], grader_verdict(value, target, 5)[1]):
+                seen += 1
+                leaked = sorted(t for t in forbidden if t in msg)
+                assert not leaked, (target.salt, value, msg, leaked)
+    assert seen > 500
+
+
+def test_5_5_and_the_4r_arm_never_print_another_parts_singular_set():
+    """The original robot given for 5.5 printed 5.1's set ("= 0 where theta2 = 3*pi/4, 7*pi/4 (+ 2πk)"); the 4R
+    arm printed 7.2's. Now: "singular configurations", never where, by both judges."""
+    from kinlib.course.workbook.selfcheck import fingerprint
+    from kinlib.course.workbook.selfcheck import verdict as home
+
+    spec = fingerprint(robots.planar_rpp(), PROP)
+    four_r = _planar_robot([("R", 0, 0), ("R", 1, 0), ("R", 2, 0), ("R", 3, 0)])
+    for chain in (robots.planar_offset_3r(), four_r):
+        ok, msg = verdict(PROP, chain, robots.planar_rpp(), "redesign")
+        status, said = home(chain, spec)
+        assert not ok and status == "incorrect"
+        for m in (msg, said):
+            assert "singular configurations" in m and not re.search(r"pi|theta|π/|\d\*", m), m
+
+
+def test_a_matrix_or_a_number_is_not_a_robot_for_either_judge():
+    """`redesign = sp.eye(3)` was "✓ proved": any constant invertible matrix belongs to no robot."""
+    from kinlib.course.workbook.selfcheck import fingerprint
+    from kinlib.course.workbook.selfcheck import verdict as home
+
+    spec = fingerprint(robots.planar_rpp(), PROP)
+    for value in (sp.eye(3), 2 * sp.eye(3), np.eye(3), 1, sp.Integer(1), [[1, 0, 0], [0, 1, 0], [0, 0, 1]]):
+        ok, msg = verdict(PROP, value, robots.planar_rpp(), "redesign")
+        status, said = home(value, spec)
+        assert not ok and status == "incorrect", (value, msg, said)
+        assert "SerialChain" in msg and "SerialChain" in said, (msg, said)
+    assert home(robots.planar_rpp(), spec)[0] == "correct"

@@ -62,7 +62,7 @@ def test_wrong_answers_fail_with_a_reason():
     r = robots.planar_offset_3r()
     Js, Jb = r.jacobian_space(), r.jacobian_body()
     status, msg = verdict(Jb, fingerprint(Js))
-    assert status == "incorrect" and "differ" in msg
+    assert status == "incorrect" and ("differ" in msg or "depend on" in msg)  # J_b's angles are not J_s's
     status, msg = verdict(Js.T, fingerprint(Js))
     assert status == "incorrect" and "6×3" in msg and "3×6" in msg
     status, msg = verdict(sp.Symbol("x"), fingerprint(Js))
@@ -84,7 +84,9 @@ def test_kinds_sets_subspaces_choices():
     assert _v(sp.solveset(sp.sin(th), th, sp.S.Reals), every_pi, "set") == "correct"
     assert _v(sp.FiniteSet(0), every_pi, "set") == "incorrect"
     assert _v({th: sp.FiniteSet(-sp.pi, 0)}, {th: every_pi}, "set") == "correct"
-    assert _v(sp.FiniteSet(0, sp.pi), {th: every_pi}, "set") == "incorrect"  # a dict was asked for
+    # a bare set for a one-variable dict: the grader reads it as that variable's set, so does the self-check
+    assert _v(sp.FiniteSet(0, sp.pi), {th: every_pi}, "set") == "correct"
+    assert _v(sp.FiniteSet(0), {th: every_pi}, "set") == "incorrect"
     A = sp.Matrix([[1, 0], [0, 1], [0, 0]])
     assert _v(sp.Matrix([[1, 1], [1, -1], [0, 0]]), A, "subspace") == "correct"
     assert _v([sp.Matrix([2, 0, 0]), sp.Matrix([0, 3, 0]), sp.Matrix([1, 1, 0])], A, "subspace") == "correct"

@@ -124,6 +124,14 @@ def compare_choice(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
         return False, f"{name}: {exc}"
     if a == choice_key(ref["value"]):
         return True, ""
+    sv = stu["value"]
+    if (
+        isinstance(ref["value"], bool)
+        and type(sv) is int
+        and sv in (0, 1)
+        and choice_key(bool(sv)) == choice_key(ref["value"])
+    ):
+        return True, ""  # 0 / 1 for a yes/no answer: False / True (Python's own reading; the self-check's too)
     items = _choice_items(stu["value"])
     rv = ref["value"]
     if items and (not isinstance(rv, list) or all(not isinstance(e, list) for e in rv)):

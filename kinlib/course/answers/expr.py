@@ -233,11 +233,23 @@ def describe_expr(value, points, seed=0, vectors=False):
         degrees=_degrees_hint(obj),
         undefined=sorted({str(f.func) for f in obj.atoms(sp.core.function.AppliedUndef)}),
     )
+    out["values"] = _values(obj, points, seed)
+    variants = {}
+    for m in mistakes.SYMBOLIC_MISTAKES[1:]:  # (degrees: the "degrees" flag above)
+        undone = m.undo(obj)
+        if undone is not None:
+            variants[m.name] = _values(undone, points, seed)
+    if variants:
+        out["variants"] = variants
+    return out
+
+
+def _values(obj, points, seed):
+    """``obj``'s entries at ``points`` as ``[re, im]`` pairs (None: not a finite number)."""
     entries = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
     fast = _lambdified_values(obj, entries, points, seed)
     if fast is not None:
-        out["values"] = fast
-        return out
+        return fast
     values = []
     for p in points:
         subs = subs_for(obj, p, seed)
@@ -248,8 +260,7 @@ def describe_expr(value, points, seed=0, vectors=False):
             except Exception:
                 row.append(None)
         values.append(row)
-    out["values"] = values
-    return out
+    return values
 
 
 def _entries(idx, shape):
@@ -284,7 +295,9 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
                 f"{name} is transposed: yours is {fmt_shape(sshape)}, expected "
                 f"{fmt_shape(rshape)}" + (" (one column per joint)" if rshape[0] == 6 else "")
             )
-        return False, f"{name} has the wrong shape: yours is {fmt_shape(sshape)}, expected {fmt_shape(rshape)}"
+        square = len(sshape) == 2 == len(rshape) and sshape[0] == sshape[1] and rshape[0] == rshape[1]
+        hint = f" ({mistakes.PRODUCT_ORDER})" if square else ""
+        return False, f"{name} has the wrong shape: yours is {fmt_shape(sshape)}, expected {fmt_shape(rshape)}{hint}"
     if stu.get("undefined"):
         return False, f"{name} contains undefined functions {', '.join(stu['undefined'])}"
     S, R = values_array(stu["values"]), values_array(ref["values"])
@@ -296,9 +309,13 @@ def compare_expr(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     if close(S, R):
         extra = []
         if stu.get("has_float") and not ref.get("has_float"):
-            extra.append("contains decimals: use exact values (sp.pi, sp.sqrt(2), sp.Rational(1, 2))")
+            extra.append("contains decimals: use exact values (sp.pi, sp.sqrt, sp.Rational)")
         return True, "; ".join(extra)
-    return False, f"{name} " + "; ".join(notes + [_no_key(_diagnose(S, R, rshape, stu))])
+    if stu.get("has_float"):
+        if close_within(S, R, mistakes.ROUNDED_RTOL):
+            return False, f"{name} " + "; ".join(notes + [mistakes.ROUNDED.says])
+        return False, f"{name} " + "; ".join(notes + [_no_key(_diagnose(S, R, rshape, stu)), mistakes.DECIMALS.says])
+    return False, f"{name} " + "; ".join(notes + [_no_key(_diagnose(S, R, rshape, stu, name, ref))])
 
 
 def _compare_dict(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
@@ -339,15 +356,39 @@ def _no_key(msg: str) -> str:
     return msg
 
 
-def _diagnose(S, R, shape, stu) -> str:
+def close_within(S, R, rtol) -> bool:
+    """S and R equal within a relative tolerance (finite values only)."""
+    if not (np.isfinite(S).all() and np.isfinite(R).all()):
+        return False
+    return bool(np.all(np.abs(S - R) <= 1e-9 + rtol * np.maximum(np.abs(S), np.abs(R))))
+
+
+def _diagnose(S, R, shape, stu, name="", ref=None) -> str:
     """What is wrong with values S (points × entries) against R: a named mistake of
     :mod:`kinlib.course.answers.mistakes` (the self-check's too), else which entries differ; never a value."""
     P = S.shape[0]
     r, c = (shape + [1, 1])[:2] if len(shape) == 2 else (1, 1)
     S3, R3 = S.reshape(P, r, c), R.reshape(P, r, c)
-    found = mistakes.search(S3, lambda X: X.shape == R3.shape and close(X, R3), exhaustive=True)
+
+    def matches(X):
+        return X.shape == R3.shape and close(X, R3)
+
+    found = mistakes.search(S3, matches, exhaustive=True)
+    if found is None:
+        found = mistakes.search(S3, matches, mistakes.CONCEPT_MISTAKES, pairs=False)
     if found is not None:
         return found.says
+    for m in mistakes.SYMBOLIC_MISTAKES:
+        alt = (stu.get("variants") or {}).get(m.name)
+        if alt is not None:
+            try:
+                if close(values_array(alt).reshape(R.shape), R):
+                    return m.says
+            except (ValueError, TypeError, IndexError):
+                pass
+    said = mistakes.concept_says(name, constant=not stu.get("symbols"), ref_constant=not (ref or {}).get("symbols"))
+    if said:
+        return said
     neg = [k for k in range(S.shape[1]) if close(S[:, k], -R[:, k]) and not close(S[:, k], R[:, k])]
     bad = [k for k in range(S.shape[1]) if not close(S[:, k], R[:, k])]
     if neg and len(neg) == len(bad):
@@ -357,12 +398,12 @@ def _diagnose(S, R, shape, stu) -> str:
     ratio = _const_ratio(S, R)
     if ratio is not None:
         if abs(abs(ratio) - 180 / math.pi) < 1e-6 * 180 / math.pi or abs(abs(ratio) - math.pi / 180) < 1e-9:
-            return "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)"
+            return "looks like it is in degrees: SymPy and NumPy angles are radians (multiply degrees by sp.pi/180)"
         if abs(ratio - 1) < 1e-2:
             return "is close to the answer but not equal: rounded decimals? Use exact values (sp.sqrt(2), sp.pi)"
         return "is off by a constant factor (a factor missing or extra, e.g. a length or ½?)"
     if stu.get("degrees"):
-        return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
+        return "looks like it uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians: multiply degrees by sp.pi/180"
     if S.shape[1] > 1:
         return f"differs in entries {_entries(bad, shape)}"
     return "has the wrong value"

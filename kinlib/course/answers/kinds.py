@@ -22,13 +22,53 @@ The grader (:mod:`kinlib.course.grader.judge`, through :func:`kinlib.course.answ
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from . import choice, expr, properties, sets, subspace
 from .base import is_bool
 
-__all__ = ["Kind", "KINDS", "lookup", "resolve"]
+__all__ = [
+    "Kind",
+    "KINDS",
+    "NAMES",
+    "FORMS",
+    "lookup",
+    "resolve",
+    "ANGLE_PREFIXES",
+    "is_angle_name",
+    "symbol_domain",
+    "draw_points",
+]
+
+# Where the symbols of an answer are evaluated: the one rule for the grader's secret points
+# (kinlib.course.grader.grade.make_points) and the self-check's public ones (kinlib.course.workbook.selfcheck),
+# so that a wrong answer cannot be right at home and wrong in the grade (|sin θ| for sin θ, a signed
+# manipulability): joint angles over a whole turn, across every sign change; lengths (positive symbols) in
+# (0.5, 2); other signed quantities (forces, velocities) on both sides of 0.
+ANGLE_PREFIXES = ("theta", "q", "phi", "alpha", "beta", "gamma")
+DOMAINS = {"angle": (-math.pi, math.pi), "positive": (0.5, 2.0), "signed": (-1.5, 1.5)}
+
+
+def is_angle_name(name: str) -> bool:
+    """Whether a symbol of this name is a joint angle (evaluated over a whole turn).
+
+    >>> is_angle_name("theta2"), is_angle_name("thetadot1"), is_angle_name("L1")
+    (True, True, False)
+    """
+    return str(name).startswith(ANGLE_PREFIXES)
+
+
+def symbol_domain(name: str, positive: bool) -> tuple[str, tuple[float, float]]:
+    """The domain a symbol is evaluated over by both judges: ``("positive", (0.5, 2))`` for a symbol the reference
+    declares positive (a length), ``("angle", (-π, π))`` for a joint angle's name, else ``("signed", (-1.5, 1.5))``.
+
+    >>> symbol_domain("L", True)[0], symbol_domain("theta1", False)[0], symbol_domain("F_x", False)
+    ('positive', 'angle', ('signed', (-1.5, 1.5)))
+    """
+    key = "positive" if positive else "angle" if is_angle_name(name) else "signed"
+    return key, DOMAINS[key]
 
 
 @dataclass(frozen=True)
@@ -72,6 +112,36 @@ KINDS = {
         properties.reference_property,
     ),
 }
+
+
+NAMES = ("default", *KINDS)  # the kind names a solution notebook may declare ("default" is "expr")
+# the self-check's spec forms (kinlib.course.workbook.selfcheck.fingerprint) -> the kind that judges them
+FORMS = {"matrix": "expr", "scalar": "expr", "bool": "expr", "choice": "choice", "set": "set", "subspace": "subspace"}
+
+
+def draw_points(symbols: dict, seed: int, n: int) -> list[dict]:
+    """``n`` points {symbol name: value}, each symbol over its :func:`symbol_domain` (``symbols``: {name:
+    {"positive": bool}}), *stratified*: each symbol has one value in each n-th of its domain, in an order drawn per
+    symbol, so that a sign change half a turn wide always holds a point (|sin θ| is never right by luck). The
+    grader's secret points (:func:`kinlib.course.grader.grade.make_points`); the same seed gives the same points.
+
+    >>> pts = draw_points({"theta1": {}, "L": {"positive": True}}, seed=7, n=5)
+    >>> sorted(int((p["theta1"] + math.pi) // (2 * math.pi / 5)) for p in pts)
+    [0, 1, 2, 3, 4]
+    >>> pts == draw_points({"theta1": {}, "L": {"positive": True}}, seed=7, n=5)
+    True
+    """
+    import random
+
+    rng = random.Random(seed)
+    pts: list[dict] = [{} for _ in range(n)]
+    for name in sorted(symbols):
+        _, (lo, hi) = symbol_domain(name, bool(symbols[name].get("positive")))
+        order = list(range(n))
+        rng.shuffle(order)
+        for k in range(n):
+            pts[k][name] = lo + (order[k] + rng.uniform(0.02, 0.98)) * (hi - lo) / n
+    return pts
 
 
 def lookup(kind: str) -> tuple[Kind, str]:

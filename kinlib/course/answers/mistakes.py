@@ -45,6 +45,17 @@ __all__ = [
     "SUBSPACE_MISTAKES",
     "SET_MISTAKES",
     "CHOICE_MISTAKES",
+    "CONCEPT_MISTAKES",
+    "SYMBOLIC_MISTAKES",
+    "SET_VARIABLE",
+    "ROUNDED",
+    "DECIMALS",
+    "FLOAT_RTOL",
+    "PRODUCT_ORDER",
+    "ROUNDED_RTOL",
+    "exact_value",
+    "exact_values",
+    "concept_says",
     "search",
     "map_set",
     "trig_degrees",
@@ -170,7 +181,11 @@ MATRIX_MISTAKES = (
     _VwMistake("vw-order", "", _vw_order),
     Mistake("columns", "has its columns swapped: {detail} (column i belongs to joint i)", _columns, simple=False),
     Mistake("rows", "has its rows swapped: {detail}", _rows_perm, simple=False),
-    Mistake("degrees", "looks like it is in degrees: SymPy and NumPy angles are radians (45° = sp.pi/4)", _degrees),
+    Mistake(
+        "degrees",
+        "looks like it is in degrees: SymPy and NumPy angles are radians (multiply degrees by sp.pi/180)",
+        _degrees,
+    ),
 )
 
 
@@ -323,17 +338,20 @@ def map_set(s, f):
     return sp.imageset(sp.Lambda(x, f(x)), s)
 
 
+# Not a set mistake: "each value is minus a right one". Another part's answer is often the negation of this
+# one's (5.4's maximisers are 5.1's singular angles negated, modulo 2π), and naming it would state one part's
+# answer in the feedback on another: a negated set is just "not the right set".
 SET_MISTAKES = (
     Mistake(
         "degrees",
-        "looks like degrees: angles are radians (45° = sp.pi/4)",
+        "looks like degrees: angles are radians (multiply degrees by sp.pi/180)",
         lambda s: iter([("", map_set(s, lambda x: x * sp.pi / 180))]),
     ),
-    Mistake(
-        "negated",
-        "has the wrong sign: each value is minus a right one",
-        lambda s: iter([("", map_set(s, lambda x: -x))]),
-    ),
+)
+SET_VARIABLE = Mistake(  # the right set on the wrong variable (both judges re-key a one-variable condition)
+    "variable",
+    "holds the right values, but as a condition on another joint variable: which joint does the condition restrict?",
+    lambda s: iter(()),
 )
 
 
@@ -341,6 +359,148 @@ def _plus_one(x):
     if isinstance(x, list):
         return [_plus_one(e) for e in x]
     return x + 1 if isinstance(x, int) and not isinstance(x, bool) else x
+
+
+# ----------------------------------------------------------------------------- the course's conceptual mistakes
+# Each names a mistake the course is about, in words that hold no value of any answer (of this part or another):
+# tests/course/test_grade_verdicts.py renders them for every answer of the table and scans them.
+
+
+def _reciprocal(A):
+    vals = np.asarray(A)
+    try:
+        nonzero = bool(np.all(np.abs(vals.astype(complex)) > 1e-12))
+    except (TypeError, ValueError):
+        nonzero = all(x != 0 for x in vals.ravel())
+    if nonzero:
+        yield "", (1 / A if vals.dtype != object else np.vectorize(lambda x: 1 / x, otypes=[object])(A))
+
+
+def _sign_patterns(A):
+    """A scalar answer negated at some of the points only (not all, not none): |·| missing or extra."""
+    P = A.shape[0]
+    if A.shape[-2:] != (1, 1) or P < 2 or P > 8:
+        return
+    for signs in itertools.product((1, -1), repeat=P):
+        if len(set(signs)) == 2:
+            yield "", A * np.array(signs, dtype=A.dtype).reshape(P, 1, 1)
+
+
+CONCEPT_MISTAKES = (
+    Mistake(
+        "branch",
+        "has the right size but the wrong sign at some configurations: an absolute value |·| missing or extra? "
+        "(det J is signed; the manipulability √det(J Jᵀ) is never negative)",
+        _sign_patterns,
+    ),
+    Mistake(
+        "reciprocal",
+        "is upside down (the reciprocal of the answer, entry by entry): a ratio of lengths taken the wrong way up, or "
+        "the velocity ellipse's semi-axes σ for the force ellipse's 1/σ?",
+        _reciprocal,
+    ),
+)
+
+
+@dataclass(frozen=True)
+class SymbolicMistake:
+    """A mistake undone on the answer itself (a SymPy expression or matrix), before it is evaluated:
+    ``undo(value)`` is the candidate right answer, or None when the mistake cannot be in it."""
+
+    name: str
+    says: str
+    undo: Callable
+
+
+def _swap_lengths(v):
+    by_name = {s.name: s for s in getattr(v, "free_symbols", ()) if isinstance(s, sp.Symbol)}
+    if "L1" in by_name and "L2" in by_name:
+        return v.xreplace({by_name["L1"]: by_name["L2"], by_name["L2"]: by_name["L1"]})
+    return None
+
+
+SYMBOLIC_MISTAKES = (
+    SymbolicMistake(
+        "degrees",
+        "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians: multiply degrees by sp.pi/180",
+        trig_degrees,
+    ),
+    SymbolicMistake("lengths", "has L1 and L2 swapped: which link is L1?", _swap_lengths),
+)
+
+ROUNDED_RTOL = 5e-3  # decimals this close to the answer (3 significant digits) are "right up to rounding"
+PRODUCT_ORDER = "J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?"
+FLOAT_RTOL = 5e-7  # decimals this close to exact values pass, with a note (the grader's RTOL is 1e-6 on values)
+ROUNDED = Mistake(
+    "rounded",
+    "is right up to rounding: its decimals are rounded; use exact values (sp.sqrt, sp.pi, sp.Rational)",
+    lambda v: iter(()),
+)
+DECIMALS = Mistake(
+    "decimals",
+    "contains decimals (floats): if they are rounded values, write them exactly (sp.sqrt(2), sp.pi, sp.Rational)",
+    lambda v: iter(()),
+)
+_EXACT_BASES = (sp.Integer(1), sp.pi, sp.sqrt(2), sp.sqrt(3), sp.sqrt(6), 1 / sp.pi)
+
+
+def exact_value(f: float, rtol: float = 5e-3):
+    """The simplest exact value p/q·c (c ∈ 1, π, √2, √3, √6, 1/π; q ≤ 12) within ``rtol`` of ``f``, or None:
+    what a rounded decimal in an answer stood for.
+
+    >>> exact_value(0.707), exact_value(2.356), exact_value(0.333), exact_value(0.1234567)
+    (sqrt(2)/2, 3*pi/4, 1/3, None)
+    """
+    f = float(f)
+    if f == 0 or not math.isfinite(f):
+        return sp.Integer(0) if f == 0 else None
+    best = None
+    for c in _EXACT_BASES:
+        cv = float(c)
+        for q in range(1, 13):
+            p = round(f * q / cv)
+            if p == 0 or abs(p) > 1000:
+                continue
+            err = abs(p * cv / q - f) / abs(f)
+            if err <= rtol and (best is None or err < best[0] - 1e-12):
+                best = (err, sp.Rational(p, q) * c)
+        if best is not None and best[0] < 1e-9:
+            break
+    return None if best is None else best[1]
+
+
+def exact_values(v):
+    """``(v with each Float replaced by its exact value, the largest relative rounding error)``, or
+    ``(None, inf)`` when some decimal stands for no simple exact value.
+
+    >>> exact_values(sp.Float(0.7071068) * sp.Symbol("x"))
+    (sqrt(2)*x/2, ...)
+    """
+    reps, err = {}, 0.0
+    for f in v.atoms(sp.Float):
+        e = exact_value(float(f))
+        if e is None:
+            return None, math.inf
+        reps[f] = e
+        if e != 0:
+            err = max(err, abs(float(f) - float(e)) / abs(float(e)))
+    return v.xreplace(reps), err
+
+
+def concept_says(name: str, constant: bool, ref_constant: bool) -> str:
+    """Words for a wrong constant answer (a rank, a count, a ratio): about constants, never a value.
+
+    >>> concept_says("rank53", True, True)
+    'is not the rank asked: the rank at the configuration the question gives, not the generic rank (the largest rank, reached almost everywhere)'
+    """
+    if not (constant and ref_constant):
+        return ""
+    if "rank" in name.lower():
+        return (
+            "is not the rank asked: the rank at the configuration the question gives, not the generic rank "
+            "(the largest rank, reached almost everywhere)"
+        )
+    return "is a constant, and not the right one"
 
 
 CHOICE_MISTAKES = (

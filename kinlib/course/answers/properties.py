@@ -13,10 +13,12 @@ has no singular configuration").
   ``(ok, message)``, on the tree rebuilt by a whitelist (:func:`~.exacttree.from_tree`, never ``eval``); the
   message talks about the student's own answer only. The reference is not used (:func:`reference_property`).
 
-* ``nonsingular`` (problem 5.5): the student's redesigned robot (the judge computes its J from its screw axes) or
-  its task Jacobian J has det(J Jᵀ) ≠ 0 for every joint value, proved exactly by
+* ``nonsingular`` (problem 5.5): the student's redesigned robot (the judge computes its J from its screw axes)
+  has det(J Jᵀ) ≠ 0 for every joint value, proved exactly by
   :func:`kinlib.singularities.singular_configurations` (trigonometric normal forms, :mod:`kinlib.trigsign`
-  proofs of non-vanishing). A bare value of det(J Jᵀ) belongs to no robot and is refused.
+  proofs of non-vanishing). A bare value of det(J Jᵀ), or a bare matrix (``sp.eye(3)``: any constant invertible
+  matrix), belongs to no robot and is refused, saying so; a failing design is told it has singular
+  configurations, never where (its singular set may be another part's answer: 5.1's, 7.2's).
 
 The same judges serve the workbook self-check (:func:`kinlib.course.workbook.selfcheck.verdict`, spec
 ``property|nonsingular|-``: :func:`property_spec`, :func:`property_verdict`) and the grader.
@@ -70,32 +72,6 @@ def _terms_estimate(e) -> float:
     return min(float(2 ** min(weight, 1000)), 1e300)
 
 
-def _where(conds) -> str:
-    """Singular conditions as text: one-joint families merged (θ2 = 0, π (+ 2πk)), others as given."""
-    from kinlib.singularities import representatives
-
-    merged: dict = {}
-    texts = []
-    for c in conds:
-        if isinstance(c, dict) and len(c) == 1:
-            ((v, S),) = c.items()
-            try:
-                reps = representatives(S) if isinstance(S, (sp.ImageSet, sp.Union)) else None
-            except (TypeError, ValueError):
-                reps = None
-            if reps:
-                merged.setdefault(v, []).extend(r for r in reps if r not in merged.get(v, []))
-                continue
-        if isinstance(c, dict):
-            texts.append(" and ".join(f"{v} ∈ {sp.sstr(S)}" for v, S in c.items()))
-        else:
-            texts.append(f"{sp.sstr(c)} = 0")
-    for v, reps in merged.items():
-        reps = sorted(reps, key=float)
-        texts.insert(0, f"{v} = {', '.join(sp.sstr(x) for x in reps[:6])} (+ 2πk)")
-    return "; or ".join(texts[:3])
-
-
 def _never_zero(M, what: str):
     """(True, None) when det M ≠ 0 for every real value of M's non-positive symbols (its joint values) is
     proved by :func:`kinlib.singularities.singular_configurations` (no condition, complete); else
@@ -115,17 +91,24 @@ def _never_zero(M, what: str):
             f"{what} could not be decided exactly: give it as a polynomial in the sines and cosines of the "
             "joint angles and in the joint values (no θ·sin θ, √θ, exp …)"
         )
-    if conds:
-        return False, f"{what} = 0 where {_where(conds)}: your design still has singular configurations"
+    if conds:  # where, never: the original robot's singular set is 5.1's answer, the 4R arm's 7.2's
+        return False, (
+            f"{what} is 0 at some joint values: your design still has singular configurations (find them with "
+            "kinlib.singular_configurations on your robot's task Jacobian)"
+        )
     if not conds.complete:
         return False, f"{what} could not be proved nonzero within the time limit (an instructor will check it)"
     return True, None
 
 
 _NOT_A_ROBOT = (
-    "{name} is a number or an expression: give your redesigned robot itself (a kinlib SerialChain, e.g. "
-    "SerialChain(screws, M)) or its task Jacobian J (rows ω_z, v_x, v_y) as a Matrix; a value of det(J Jᵀ) "
-    "alone does not say which robot it belongs to"
+    "{name} is a number or an expression: the answer is your redesigned robot itself, a kinlib SerialChain (its "
+    "screw axes and M: SerialChain(screws, M)); a value of det(J Jᵀ) alone belongs to no robot"
+)
+_A_MATRIX = (
+    "{name} is a matrix: the answer is your redesigned robot itself, a kinlib SerialChain (its screw axes and M: "
+    "SerialChain(screws, M)); a matrix (a Jacobian, sp.eye(3)) alone belongs to no robot: the judge computes J "
+    "from your robot's screw axes"
 )
 MAX_ROBOT_JOINTS = 6  # a redesign with more joints is not decided here (the proof's cost grows fast)
 
@@ -180,8 +163,8 @@ def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
     """The student's own redesign has no singular configuration: det(J Jᵀ) ≠ 0 for every joint value, decided
     exactly for **their robot**. The answer (:func:`property_answer`) is the robot (tag
     "robot": its space screw axes, 6×n; the judge computes J_s from them, :func:`kinlib.jacobians.jacobian_space`,
-    and takes its task rows ω_z, v_x, v_y; the robot must be planar) or its task Jacobian J (a 3×n matrix). A
-    number or expression alone (a claimed det(J Jᵀ), e.g. 1) is refused: it belongs to no robot. Proofs by
+    and takes its task rows ω_z, v_x, v_y; the robot must be planar). A matrix, number or expression alone (a
+    claimed J or det(J Jᵀ), e.g. sp.eye(3) or 1) is refused: it belongs to no robot. Proofs by
     :func:`kinlib.singularities.singular_configurations` on J: no condition and complete ⇔ never singular.
 
     >>> rpp = ["matrix", 6, 3, *[["int", str(x)] for x in (0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0)]]
@@ -193,20 +176,19 @@ def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
     syms: dict = {}
     tree = stu.get("tree")
     tag = stu.get("tag")
-    what = f"{name}: det(J Jᵀ)"
     if not isinstance(tree, list) or tree[:1] != ["matrix"]:
         return False, _NOT_A_ROBOT.format(name=name)
     M = _matrix(tree, syms, [20_000], name)
     if isinstance(M, str):
         return False, M
-    if tag == "robot":
-        if M.rows != 6:
-            return False, f"{name}: a robot's screw axes are 6-vectors, got {M.rows} rows"
-        J = _robot_task_jacobian(M, name)
-        if isinstance(J, str):
-            return False, J
-        return _judge_task_jacobian(J, syms, name, f"{name}: det(J Jᵀ) of your robot")
-    return _judge_task_jacobian(M, syms, name, what)
+    if tag != "robot":  # a bare matrix (sp.eye(3): any constant invertible matrix) is no robot
+        return False, _A_MATRIX.format(name=name)
+    if M.rows != 6:
+        return False, f"{name}: a robot's screw axes are 6-vectors, got {M.rows} rows"
+    J = _robot_task_jacobian(M, name)
+    if isinstance(J, str):
+        return False, J
+    return _judge_task_jacobian(J, syms, name, f"{name}: det(J Jᵀ) of your robot")
 
 
 PROPERTIES = {"nonsingular": nonsingular}
@@ -339,15 +321,17 @@ def describe_property(value, points, seed=0):
 def compare_property(stu: dict, ref: dict, name: str, prop: str = "nonsingular") -> tuple[bool, str]:
     """An open-ended answer graded by the property asked, never by one design's value (the reference is not
     used): :func:`kinlib.course.answers.properties.judge`. ``prop``: "nonsingular": the answer is the student's own
-    redesigned robot (or its task Jacobian J), whose det(J Jᵀ) must be nonzero for every joint value, proved
+    redesigned robot, whose det(J Jᵀ) must be nonzero for every joint value, proved
     exactly (kinlib.singularities); a bare value of det(J Jᵀ) belongs to no robot and fails.
 
     >>> compare_property({"tag": "scalar", "tree": ["int", "1"]}, {}, "d")[0]
     False
     >>> col = lambda *xs: [["int", str(x)] for x in xs]
     >>> three_r = col(0, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, -1, -2, 0, 0, 0)   # joints at x = 0, 1, 2
-    >>> compare_property({"tag": "robot", "tree": ["matrix", 6, 3, *three_r]}, {}, "d")[1]
-    'd: det(J Jᵀ) of your robot = 0 where theta2 = 0, pi (+ 2πk): your design still has singular configurations'
+    >>> compare_property({"tag": "robot", "tree": ["matrix", 6, 3, *three_r]}, {}, "d")[1][:58]
+    'd: det(J Jᵀ) of your robot is 0 at some joint values: your'
+    >>> compare_property({"tag": "matrix", "tree": ["matrix", 1, 1, ["int", "1"]]}, {}, "d")[1][:42]
+    'd is a matrix: the answer is your redesign'
     """
     na = not_answered(stu)
     if na:

@@ -25,6 +25,7 @@ import numpy as np
 import sympy as sp
 
 from .base import as_sympy, is_bool, not_answered, subs_for, to_complex, type_name
+from .mistakes import SET_VARIABLE
 
 __all__ = [
     "to_set",
@@ -443,7 +444,7 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
     (True, '')
     >>> bare = {"conditions": [[[{"var": None, "points": [-1.5707963267948966, 1.5707963267948966]}]]]}
     >>> compare_set({"tag": "set", "conditions": [[[{"var": None, "points": [90.0, 270.0]}]]]}, bare, "v")[1]
-    'v: these look like degrees (90, 270): angles are radians (90° = sp.pi/2)'
+    'v: these look like degrees (90, 270): angles are radians (multiply degrees by sp.pi/180)'
     """
     na = not_answered(stu)
     if na:
@@ -467,6 +468,8 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
         if len(rc) == 1 and len(sc) == 1:
             r, s = rc[0], sc[0]
             if set(s) != set(r):
+                if len(s) == len(r) == 1 and _cond_match({next(iter(r)): next(iter(s.values()))}, r, periodic)[0]:
+                    return False, f"{name} {SET_VARIABLE.says}"  # the right set on the wrong variable
                 mine = ", ".join(sorted(map(str, (v for v in s if v is not None)))) or "one unnamed variable"
                 return False, (
                     f"{name} constrains {mine}: not the right joint variables (which joints does the "
@@ -507,7 +510,7 @@ def _looks_like_degrees(pts) -> list:
 def _degrees_msg(pts) -> str:
     degs = _looks_like_degrees(pts)
     shown = ", ".join(str(d) for d in degs[:4]) + (" …" if len(degs) > 4 else "")
-    return f"these look like degrees ({shown}): angles are radians (90° = sp.pi/2)"
+    return f"these look like degrees ({shown}): angles are radians (multiply degrees by sp.pi/180)"
 
 
 def _compare_component(s, r, periodic):

@@ -2,9 +2,13 @@
 
 At build time (``kinlib handouts``) each reference answer is turned into a *fingerprint*:
 the answer evaluated at fixed sample values of its symbols (the same values for a symbol of the same
-name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA-256). The workbook
-holds only the fingerprint; the student's answer is fingerprinted the same way when the self-check
-cell runs, so a right answer in any equivalent form (simplified or not, floats or exact) passes::
+name, whatever its assumptions), rounded to 8 significant digits and hashed (SHA-256). The sample values
+cover the domains the grader's secret points are drawn from (:func:`kinlib.course.answers.kinds.draw_points`:
+joint angles over a whole turn, one sample in each fifth, lengths in (0.5, 2), the reference's signed symbols
+across 0), so the two judges agree: |det J| for det J, a signed manipulability, fail at home as in the grade
+(tests/answer_table.py is the table both must agree on). The workbook holds only the fingerprint; the student's
+answer is fingerprinted the same way when the self-check cell runs, so a right answer in any equivalent form
+(simplified or not, exact, or decimals within the grader's tolerance: with a note) passes::
 
     from kinlib.course.workbook.selfcheck import check
     check("2.2", Js="matrix|6x3|3f0c1b9e5a7d2c44")
@@ -32,7 +36,9 @@ filled in, and if it fails while their self-check has not passed, says "fix the 
 
 from __future__ import annotations
 
+import contextvars
 import hashlib
+import itertools
 import json
 import math
 import sys
@@ -41,11 +47,12 @@ import numpy as np
 import sympy as sp
 
 from ..answers import mistakes
-from ..answers.base import is_bool, is_unanswered
+from ..answers.base import is_bool, is_unanswered, symbol_notes
 from ..answers.choice import choice_key, choice_value
 from ..answers.expr import to_sympy
+from ..answers.kinds import FORMS, is_angle_name, symbol_domain
 from ..answers.properties import property_spec, property_verdict
-from ..answers.sets import set_conditions, to_set
+from ..answers.sets import _var_name, set_conditions, to_set
 from ..schema import KINDS
 from .needs import answer_status, last_results, needs
 
@@ -66,7 +73,7 @@ __all__ = [
 ]
 
 FINGERPRINT_MARK = "KINLIB-SELFCHECK "  # starts the line emit_fingerprints prints (read by the handouts)
-SAMPLE_POINTS = 3  # configurations at which an answer's symbols are sampled
+SAMPLE_POINTS = 5  # configurations at which an answer's symbols are sampled (one per fifth of each domain)
 _DIGITS = 8  # significant digits kept of every sampled value
 _ZERO = 1e-10  # |x| below this counts as 0
 _PROJ_DECIMALS = 6  # decimals kept of a subspace's projector
@@ -112,29 +119,44 @@ class WrongForm(Exception):
         ...
     kinlib.course.workbook.selfcheck.WrongForm: it should be a SymPy Matrix, expression or number, yours is a list of ...
     >>> check("1.1", _namespace={"J": sp.eye(3)}, J=fingerprint(sp.eye(2), salt="1.1:J"))
-    part 1.1 · J: ✗ wrong form: it should be a 2×2 matrix, yours is a 3×3 matrix
+    part 1.1 · J: ✗ wrong form: it should be a 2×2 matrix, yours is a 3×3 matrix (J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?)
     """
 
 
 # ---------------------------------------------------------------------------------------------------
-# Sample values: a fixed exact rational in [0.2, 1.3] per (symbol name, sample index).
+# Sample values: fixed exact rationals per (symbol name, sample index), over the domains the grader's secret
+# points are drawn from (kinlib.course.answers.kinds.symbol_domain): joint angles over a whole turn, one sample
+# in each fifth of (-π, π) (so |sin θ| and sin θ, a signed manipulability, differ at some sample), lengths in
+# (0.5, 2), the reference's other signed symbols (forces, velocities; named in the spec) across 0.
+
+_SIGNED: contextvars.ContextVar = contextvars.ContextVar("kinlib_selfcheck_signed", default=frozenset())
 
 
-def sample_value(name: str, k: int) -> sp.Rational:
-    """The value given to every symbol called ``name`` at sample configuration ``k``.
+def sample_value(name: str, k: int, signed: bool = False) -> sp.Rational:
+    """The value given to every symbol called ``name`` at sample configuration ``k`` (of :data:`SAMPLE_POINTS`):
+    in the grader's domain for that symbol (:func:`kinlib.course.answers.kinds.symbol_domain`), one sample in each
+    fifth of it (the fifths in an order fixed per name).
 
-    >>> v = sample_value("theta1", 0)
-    >>> v == sample_value("theta1", 0) and sp.Rational(1, 5) <= v <= sp.Rational(13, 10)
-    True
+    >>> v = [sample_value("theta1", k) for k in range(SAMPLE_POINTS)]
+    >>> v[0] == sample_value("theta1", 0), all(-sp.pi < x < sp.pi for x in v), sorted(int((x + sp.pi) // (2 * sp.pi / 5)) for x in v)
+    (True, True, [0, 1, 2, 3, 4])
+    >>> all(sp.Rational(1, 2) < sample_value("L", k) < 2 for k in range(5)), min(sample_value("F_x", k, True) for k in range(5)) < 0
+    (True, True)
     """
-    h = hashlib.sha256(f"kinlib-selfcheck:{name}:{k}".encode()).digest()
-    u = int.from_bytes(h[:4], "big") % 1_100_000
-    return sp.Rational(200_000 + u, 1_000_000)
+    h = hashlib.sha256(f"kinlib-selfcheck-v2:{name}:{k}".encode()).digest()
+    u = 0.1 + 0.8 * (int.from_bytes(h[:4], "big") / 2**32)  # where in its fifth: away from the fifth's ends
+    order = sorted(
+        range(SAMPLE_POINTS), key=lambda j: hashlib.sha256(f"kinlib-selfcheck-bin:{name}:{j}".encode()).digest()
+    )
+    _, (lo, hi) = symbol_domain(name, positive=not signed and not is_angle_name(name))
+    x = lo + (order[k % SAMPLE_POINTS] + u) * (hi - lo) / SAMPLE_POINTS
+    return sp.Rational(round(x * 1_000_000), 1_000_000)
 
 
 def _point(expr, k: int) -> dict:
     syms = getattr(expr, "free_symbols", set())
-    return {s: sample_value(s.name, k) for s in syms if isinstance(s, sp.Symbol)}
+    signed = _SIGNED.get()
+    return {s: sample_value(s.name, k, s.name in signed) for s in syms if isinstance(s, sp.Symbol)}
 
 
 def _fmt(z) -> str:
@@ -237,8 +259,26 @@ def _default_value(value, shape: str | None = None):
     return v
 
 
+_SAMPLED: dict = {}  # (value, signed symbols) -> its samples: a self-check cell run again, the mistakes tried
+_SAMPLED_MAX = 64
+
+
 def _sampled(v):
-    """``v`` (Matrix or expression) at the sample points: an object array (points, rows, columns)."""
+    """``v`` (Matrix or expression) at the sample points: an object array (points, rows, columns); remembered for
+    the last :data:`_SAMPLED_MAX` values (each is evaluated once however many candidates and checks use it)."""
+    try:
+        key = (sp.ImmutableMatrix(v) if isinstance(v, sp.MatrixBase) else v, _SIGNED.get())
+        hash(key)
+    except Exception:  # noqa: BLE001  (an object SymPy cannot hash: not remembered)
+        return _sampled_now(v)
+    if key not in _SAMPLED:
+        if len(_SAMPLED) >= _SAMPLED_MAX:
+            _SAMPLED.pop(next(iter(_SAMPLED)))
+        _SAMPLED[key] = _sampled_now(v)
+    return _SAMPLED[key].copy()
+
+
+def _sampled_now(v):
     if isinstance(v, sp.MatrixBase):
         return np.array([_evaluate(v, k).tolist() for k in range(SAMPLE_POINTS)], dtype=object).reshape(
             SAMPLE_POINTS, *v.shape
@@ -319,25 +359,40 @@ def _canon_one_set(s, k, fmap=None):
     return sorted(out)
 
 
-def _canon_condition(cond: list, fmap=None) -> list:
+def _canon_condition(cond: list, fmap=None, keys: dict | None = None) -> list:
+    """A condition {variable: Set} canonical per sample point; keys by their untypeset name (θ_2 is theta2, as
+    the grader reads them, :func:`kinlib.course.answers.sets._var_name`), ``keys`` renaming some."""
+    keys = keys or {}
     return [
-        [str(key)] + [_canon_one_set(s, k, fmap) for k in range(SAMPLE_POINTS)]
-        for key, s in sorted(cond, key=lambda kv: str(kv[0]))
+        [keys.get(_var_name(key), _var_name(key))] + [_canon_one_set(s, k, fmap) for k in range(SAMPLE_POINTS)]
+        for key, s in sorted(cond, key=lambda kv: keys.get(_var_name(kv[0]), _var_name(kv[0])))
     ]
 
 
-def _canon_set(value, fmap=None):
-    """A dict {symbol: Set} is shape "dict", a list of several such dicts (a union) "union", the rest ""."""
+_EMPTY = [[] for _ in range(SAMPLE_POINTS)]
+
+
+def _canon_set(value, fmap=None, keys=None):
+    """A dict {symbol: Set} is shape "dict", a list of several such dicts (a union) "union", the rest ""; a set
+    with no member (an empty Set, ``[]``, a condition that no value meets) is the empty bare set, whatever its
+    form: an empty answer is judged by being empty, never told "it should be a dict"."""
     conds = set_conditions(value)
     if conds is None:
         raise WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
     if len(conds) == 1 and conds[0] and conds[0][0][0] is None:
         return "set", "", [_canon_one_set(conds[0][0][1], k, fmap) for k in range(SAMPLE_POINTS)]
-    if not conds:
-        return "set", "", [_canon_one_set(sp.S.EmptySet, k) for k in range(SAMPLE_POINTS)]
+    canon = [_canon_condition(c, fmap, keys) for c in conds]
+    live = [c for c in canon if not any(all(not pts for pts in entry[1:]) for entry in c)]
+    if not live:
+        return "set", "", _EMPTY
     if len(conds) == 1:
-        return "set", "dict", _canon_condition(conds[0], fmap)
-    return "set", "union", sorted((_canon_condition(c, fmap) for c in conds), key=json.dumps)
+        return "set", "dict", canon[0]
+    return "set", "union", sorted(canon, key=json.dumps)
+
+
+# the joint variables a one-variable condition may be re-keyed to (a bare set for a dict, the right set on the
+# wrong variable): the names the course uses
+_JOINT_NAMES = [f"{p}{i}" for p in ("theta", "q") for i in range(1, 8)]
 
 
 def _subspace_value(value, shape=None):
@@ -404,20 +459,46 @@ def _shape_words(shape: str) -> str:
 
 def _hash(kind, canon, salt: str = "") -> str:
     text = json.dumps([kind, canon], separators=(",", ":"))
-    return hashlib.sha256(f"kinlib-selfcheck-v1:{salt}:{text}".encode()).hexdigest()[:16]
+    return hashlib.sha256(f"kinlib-selfcheck-v2:{salt}:{text}".encode()).hexdigest()[:16]
+
+
+def _symbols_of(value) -> set:
+    """The SymPy symbols in an answer (SymPy objects, and dicts, lists, tuples, sets and arrays of them)."""
+    out, stack = set(), [value]
+    while stack:
+        o = stack.pop()
+        if isinstance(o, dict):
+            stack += list(o.keys()) + list(o.values())
+        elif isinstance(o, (list, tuple, set, frozenset)):
+            stack += list(o)
+        elif isinstance(o, np.ndarray) and o.dtype == object:
+            stack += o.ravel().tolist()
+        elif isinstance(o, (sp.Basic, sp.MatrixBase)):
+            out |= {x for x in o.free_symbols if isinstance(x, sp.Symbol)}
+    return out
+
+
+def _sym_hash(names, salt: str) -> str:
+    return _hash("symbols", sorted(set(names)), salt)[:8]
 
 
 def fingerprint(value, kind: str = "default", salt: str = "") -> str:
-    """The spec string of ``value``: ``"<form>|<shape>|<hash>"`` (no information about the value itself).
+    """The spec string of ``value``: ``"<form>|<shape>|<hash>"``, and for an answer with symbols
+    ``"|<symbols' hash>|<signed symbols>"`` (no information about the value itself).
 
     ``form`` is matrix/scalar/bool/choice/set/subspace; ``shape`` is ``"6x3"`` for a matrix, the ambient
     dimension for a subspace, ``"dict"`` for a dict of sets (``"union"`` for a list of them). ``salt``
-    (the workbooks use ``"part:name"``) makes equal answers to different questions hash differently.
+    (the workbooks use ``"part:name"``) makes equal answers to different questions hash differently. The
+    symbols' hash lets the self-check say, as the grader does, that an answer misses a variable ("did you
+    substitute L = 1?") or is a constant; the signed symbols (not lengths, not joint angles: forces, velocities)
+    are sampled on both sides of 0, as the grader's points are (:func:`sample_value`).
 
     >>> fingerprint(sp.Matrix([[1, 2, 3]]), salt="1.1:v")[:11]
     'matrix|1x3|'
     >>> fingerprint((2, 1), "choice") == fingerprint([1, 2, 2], "choice")
     True
+    >>> fingerprint(sp.Symbol("F_x", real=True) * sp.Symbol("L", positive=True), salt="7.4:tau").split("|")[4]
+    'F_x'
     """
     if is_unanswered(value):
         raise Unanswered("the value is missing or ...")
@@ -425,8 +506,17 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
         return property_spec(value, kind.partition(":")[2])
     if kind not in _CANON:
         raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
-    form, shape, canon = _CANON[kind](value)
-    return f"{form}|{shape}|{_hash(form, canon, salt)}"
+    syms = _symbols_of(value) if kind in ("default", "expr", "subspace") else set()
+    signed = sorted(x.name for x in syms if not x.is_positive and not is_angle_name(x.name))
+    token = _SIGNED.set(frozenset(signed))
+    try:
+        form, shape, canon = _CANON[kind](value)
+    finally:
+        _SIGNED.reset(token)
+    spec = f"{form}|{shape}|{_hash(form, canon, salt)}"
+    if syms:
+        spec += f"|{_sym_hash([x.name for x in syms], salt)}|{','.join(signed)}"
+    return spec
 
 
 def describe_answer(value, kind: str = "default") -> str:
@@ -438,7 +528,7 @@ def describe_answer(value, kind: str = "default") -> str:
     ('True or False', 'a list of dicts {symbol: SymPy Set}, one per condition ([] for none)')
     """
     if str(kind).startswith("property:"):
-        return "your robot (a kinlib SerialChain) or its task Jacobian J (a Matrix)"
+        return "your robot itself (a kinlib SerialChain: its screw axes and M)"
     if is_bool(value):  # before "choice": a True/False answer is no joint number
         return "True or False"
     if kind == "choice":
@@ -470,14 +560,18 @@ def describe_answer(value, kind: str = "default") -> str:
 
 
 def _parse_spec(spec: str):
-    try:
-        form, shape, digest = spec.split("|")
-    except ValueError:
-        raise ValueError(f"a self-check spec looks like 'matrix|6x3|<16 hex digits>', got {spec!r}") from None
-    return form, shape, digest
+    """(form, shape, digest, symbols' hash or None, signed symbols) of a spec (3 fields: an answer without
+    symbols, or a spec made before the symbols were recorded)."""
+    fields = spec.split("|") if isinstance(spec, str) else []
+    if len(fields) == 3:
+        return (*fields, None, frozenset())
+    if len(fields) == 5:
+        form, shape, digest, symhash, signed = fields
+        return form, shape, digest, symhash, frozenset(x for x in signed.split(",") if x)
+    raise ValueError(f"a self-check spec looks like 'matrix|6x3|<16 hex digits>', got {spec!r}")
 
 
-_FORM_KIND = dict.fromkeys(("matrix", "scalar", "bool"), "default") | {f: f for f in ("choice", "set", "subspace")}
+_FORM_KIND = {form: ("default" if k == "expr" else k) for form, k in FORMS.items()}
 
 
 def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
@@ -487,12 +581,14 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     instructor checker's): the message names the mistake, never the answer.
 
     >>> spec = fingerprint(sp.Rational(1, 2), salt="1.1:x")
-    >>> verdict(0.5, spec, salt="1.1:x"), verdict(..., spec, salt="1.1:x")[0]
+    >>> verdict(sp.Rational(1, 2), spec, salt="1.1:x"), verdict(..., spec, salt="1.1:x")[0]
     (('correct', 'correct'), 'unanswered')
-    >>> verdict(-0.5, spec, salt="1.1:x")
+    >>> verdict(-sp.Rational(1, 2), spec, salt="1.1:x")
     ('incorrect', 'not right yet: it has the wrong sign')
+    >>> verdict(0.5, spec, salt="1.1:x")[1]
+    'correct; note: it contains decimals (floats): exact values (sp.Rational, sp.sqrt, sp.pi) are safer'
     """
-    form, shape, digest = _parse_spec(spec)
+    form, shape, digest, symhash, signed = _parse_spec(spec)
     if is_unanswered(value):
         return "unanswered", "not answered yet"
     if form == "none":
@@ -502,14 +598,17 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     kind = _FORM_KIND.get(form)
     if kind is None:
         raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
+    token = _SIGNED.set(signed)
     try:
-        return _verdict(kind, value, form, shape, digest, salt)
+        return _verdict(kind, value, form, shape, digest, salt, symhash)
     except WrongForm as e:
         return "incorrect", f"wrong form: {e}"
     except CannotCheck as e:
         return "error", f"cannot check it automatically: {e}"
     except Exception as e:  # anything the student's object throws while being evaluated
         return "error", f"could not evaluate your answer ({type(e).__name__}: {e})"
+    finally:
+        _SIGNED.reset(token)
 
 
 _HOW = {
@@ -520,7 +619,7 @@ _HOW = {
 }
 
 
-def _verdict(kind, value, form, shape, digest, salt):
+def _verdict(kind, value, form, shape, digest, salt, symhash=None):
     def right(canon, mine_form=form):
         return _hash(mine_form, canon, salt) == digest
 
@@ -528,23 +627,7 @@ def _verdict(kind, value, form, shape, digest, salt):
         return "incorrect", f"not right yet: it {says}"
 
     if kind == "default":
-        try:
-            v = _default_value(value, shape)
-        except WrongForm:
-            found = _default_mistake(value, form, shape, right)
-            if found is None:
-                raise
-            yours = _shape_words(_shape_of(_as_sympy_value(value)))
-            return "incorrect", f"wrong form: it {found}: yours is {yours}, it should be {_shape_words(shape)}"
-        if isinstance(v, tuple):  # yes/no, dict
-            mine_form, _, canon = v
-            return ("correct", "correct") if right(canon, mine_form) else ("incorrect", f"not right yet: {_HOW[kind]}")
-        arr = _sampled(v)
-        mine_form, _, canon = _canon_sampled(arr, not isinstance(v, sp.MatrixBase))
-        if right(canon, mine_form):
-            return "correct", "correct"
-        found = _default_mistake(v, form, shape, right, arr)
-        return named(found) if found else ("incorrect", f"not right yet: {_HOW[kind]}")
+        return _verdict_expr(value, form, shape, right, salt, symhash)
     if kind == "subspace":
         try:
             v = _subspace_value(value, shape)
@@ -560,29 +643,123 @@ def _verdict(kind, value, form, shape, digest, salt):
         found = _subspace_mistake(arr, shape, right)
         return named(found) if found else ("incorrect", f"not right yet: {_HOW[kind]}")
     if kind == "set":
-        _, mine_shape, canon = _canon_set(value)
-        if mine_shape != shape:
-            want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(shape, "a single Set")
-            raise WrongForm(f"it should be {want}")
-        if right(canon):
-            return "correct", "correct"
-        for m in mistakes.SET_MISTAKES:
-            try:
-                if right(_canon_set(value, lambda s, m=m: next(m.candidates(s))[1])[2]):
-                    return named(m.message())
-            except Exception:  # noqa: BLE001  SymPy may not map this set: not that mistake
-                continue
-        return "incorrect", f"not right yet: {_HOW[kind]}"
+        return _verdict_set(value, shape, right, named)
     _, _, canon = _canon_choice(value)
     if right(canon):
         return "correct", "correct"
+    cv = choice_value(value)
+    if isinstance(cv, int) and not isinstance(cv, bool) and cv in (0, 1) and right(_choice_canon(bool(cv))):
+        return "correct", "correct"  # 0 / 1 for a yes/no answer: False / True (as the grader reads it)
     for m in mistakes.CHOICE_MISTAKES:
         try:
-            if right(_choice_canon(next(m.candidates(choice_value(value)))[1])):
+            if right(_choice_canon(next(m.candidates(cv))[1])):
                 return "incorrect", f"not right yet: that {m.message()}"
         except WrongForm:
             continue
     return "incorrect", f"not right yet: {_HOW[kind]}"
+
+
+def _verdict_set(value, shape, right, named):
+    _, mine_shape, canon = _canon_set(value)
+    if right(canon):
+        return "correct", "correct"
+    conds = set_conditions(value)
+    one_var = conds is not None and len(conds) == 1 and len(conds[0]) == 1
+    if mine_shape == "dict" and shape == "" and one_var:  # {θ2: S} for a bare S: the grader reads it as S
+        if right([_canon_one_set(conds[0][0][1], k) for k in range(SAMPLE_POINTS)]):
+            return "correct", "correct"
+    if mine_shape == "" and shape == "dict" and canon is not _EMPTY:  # a bare S for {θk: S}: the grader too
+        bare = [[(sp.Symbol(v), conds[0][0][1])] for v in _JOINT_NAMES]
+        if any(right(_canon_condition(c)) for c in bare):
+            return "correct", "correct"
+    if mine_shape == "dict" and one_var:  # the right set on the wrong variable (mistakes.SET_VARIABLE)
+        mine = _var_name(conds[0][0][0])
+        for v in _JOINT_NAMES:
+            if v != mine and right(_canon_condition(conds[0], keys={mine: v})):
+                return named(mistakes.SET_VARIABLE.says)
+    if canon is not _EMPTY and mine_shape != shape and (mine_shape, shape) not in (("dict", ""), ("", "dict")):
+        want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(shape, "a single Set")
+        raise WrongForm(f"it should be {want}")
+    for m in mistakes.SET_MISTAKES:
+        try:
+            if right(_canon_set(value, lambda s, m=m: next(m.candidates(s))[1])[2]):
+                return named(m.message())
+        except Exception:  # noqa: BLE001  SymPy may not map this set: not that mistake
+            continue
+    return "incorrect", f"not right yet: {_HOW['set']}"
+
+
+def _floats(v) -> list:
+    return sorted(v.atoms(sp.Float), key=float) if isinstance(v, (sp.Basic, sp.MatrixBase)) else []
+
+
+_DECIMALS_NOTE = "it contains decimals (floats): exact values (sp.Rational, sp.sqrt, sp.pi) are safer"
+
+
+def _verdict_expr(value, form, shape, right, salt, symhash):
+    def named(says):
+        return "incorrect", f"not right yet: it {says}"
+
+    try:
+        v = _default_value(value, shape)
+    except WrongForm as e:
+        found = _default_mistake(value, form, shape, right)
+        if found is None:
+            mine = _shape_of(_as_sympy_value(value)) if not isinstance(value, dict) and not is_bool(value) else ""
+            if "x" in mine and "x" in shape and len(set(mine.split("x"))) == 1 == len(set(shape.split("x"))):
+                raise WrongForm(f"{e} ({mistakes.PRODUCT_ORDER})") from None  # n×n for m×m: JᵀJ for JJᵀ?
+            raise
+        yours = _shape_words(_shape_of(_as_sympy_value(value)))
+        return "incorrect", f"wrong form: it {found}: yours is {yours}, it should be {_shape_words(shape)}"
+    if isinstance(v, tuple):  # yes/no, dict
+        mine_form, _, canon = v
+        return ("correct", "correct") if right(canon, mine_form) else ("incorrect", f"not right yet: {_HOW['default']}")
+    arr = _sampled(v)
+    mine_form, _, canon = _canon_sampled(arr, not isinstance(v, sp.MatrixBase))
+    floats = _floats(v)
+    if right(canon, mine_form):
+        return ("correct", f"correct; note: {_DECIMALS_NOTE}") if floats else ("correct", "correct")
+    if floats:  # rounded decimals: right once made exact? (the grader passes them within 1e-6, so do we)
+        exact, err = mistakes.exact_values(v)
+        if exact is not None and right(_canon_sampled(_sampled(exact), not isinstance(v, sp.MatrixBase))[2]):
+            if err <= mistakes.FLOAT_RTOL:
+                return "correct", f"correct; note: {_DECIMALS_NOTE}"
+            return named(mistakes.ROUNDED.says)
+    notes = _symbol_notes(v, salt, symhash)
+    found = _default_mistake(v, form, shape, right, arr)
+    if found is None:
+        found = mistakes.concept_says(
+            salt.rpartition(":")[2], constant=not _symbols_of(v), ref_constant=symhash is None
+        )
+    said = "; ".join(notes + ([found] if found else []))
+    if floats:
+        said = "; ".join(x for x in (said, mistakes.DECIMALS.says) if x)
+    return named(said) if said else ("incorrect", f"not right yet: {_HOW['default']}")
+
+
+# names the course's answers are written in: what a missing or extra variable is searched among
+_COURSE_SYMBOLS = ("L", "L1", "L2", "L3", "H", "a", "b", "c", "x", "F_x", "F_y") + tuple(
+    f"{p}{i}" for p in ("theta", "thetadot") for i in range(1, 7)
+)
+
+
+def _symbol_notes(v, salt, symhash) -> list:
+    """The grader's words (:func:`kinlib.course.answers.base.symbol_notes`) on a missing or extra variable,
+    found by the symbols' hash in the spec: the reference's symbols among the student's and the course's."""
+    mine = sorted({x.name for x in _symbols_of(v)})
+    want = symhash if symhash is not None else _sym_hash([], salt)
+    if _sym_hash(mine, salt) == want:
+        return []
+    pool = sorted(set(_COURSE_SYMBOLS) - set(mine))
+    for drop in itertools.chain([()], itertools.combinations(mine, 1), itertools.combinations(mine, 2)):
+        kept = [m for m in mine if m not in drop]
+        for k in range(0, 4):
+            for add in itertools.combinations(pool, k):
+                if _sym_hash(kept + list(add), salt) == want:
+                    return symbol_notes({"symbols": mine}, {"symbols": kept + list(add)})
+    if not mine:
+        return ["is a constant, but the answer depends on the problem's variables"]
+    return []
 
 
 def _default_mistake(v, form, shape, right, arr=None):
@@ -600,11 +777,14 @@ def _default_mistake(v, form, shape, right, arr=None):
 
     arr = _sampled(v) if arr is None else arr
     found = mistakes.search(arr, matches)
+    if found is None:
+        found = mistakes.search(arr, matches, mistakes.CONCEPT_MISTAKES, pairs=False)
     if found is not None:
         return found.says
-    fixed = mistakes.trig_degrees(v)
-    if fixed is not None and matches(_sampled(fixed)):
-        return "uses degrees inside sin/cos (e.g. sin(θ + 45)): angles are radians, write sp.pi/4"
+    for m in mistakes.SYMBOLIC_MISTAKES:
+        fixed = m.undo(v)
+        if fixed is not None and matches(_sampled(fixed)):
+            return m.says
     return None
 
 
@@ -624,7 +804,7 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
     ``specs`` maps variable names to fingerprints made at build time; the variables are looked up
     in the caller's globals (the notebook), so a missing variable reads as "not answered yet".
 
-    >>> check("1.1", _namespace={"x": 0.5}, x=fingerprint(sp.Rational(1, 2), salt="1.1:x"))
+    >>> check("1.1", _namespace={"x": sp.Rational(1, 2)}, x=fingerprint(sp.Rational(1, 2), salt="1.1:x"))
     part 1.1 · x: ✓ correct
     """
     ns = _namespace if _namespace is not None else sys._getframe(1).f_globals
@@ -635,11 +815,11 @@ def check(part: str, /, _namespace: dict | None = None, **specs: str) -> None:
         results[name] = status
         mark = {"correct": "✓", "incorrect": "✗", "unanswered": "…", "error": "?"}[status]
         if status == "unanswered":
-            form, shape, _ = _parse_spec(spec)
+            form, shape = _parse_spec(spec)[:2]
             what = (
                 _shape_words(shape)
                 if form in ("matrix", "scalar")
-                else "your robot, a SerialChain, or its task Jacobian J"
+                else "your robot itself, a kinlib SerialChain"
                 if form == "property"
                 else ("see the question" if form == "none" else "True or False" if form == "bool" else f"a {form}")
             )
