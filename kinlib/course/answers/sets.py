@@ -34,6 +34,7 @@ __all__ = [
     "describe_set",
     "compare_set",
     "reference_set",
+    "var_name",
     "MAX_SET_MEMBERS",
 ]
 
@@ -348,10 +349,10 @@ def _free(c):
 _GREEK = {"θ": "theta", "φ": "phi", "ψ": "psi", "α": "alpha", "β": "beta", "γ": "gamma"}
 
 
-def _var_name(v):
+def var_name(v):
     """A joint variable's name without typesetting: θ_2, theta_{2}, \\theta_2 and theta2 are one variable.
 
-    >>> [_var_name(v) for v in ("θ_2", "theta_{2}", r"\\theta_2", "theta2", None)]
+    >>> [var_name(v) for v in ("θ_2", "theta_{2}", r"\\theta_2", "theta2", None)]
     ['theta2', 'theta2', 'theta2', 'theta2', None]
     """
     if v is None:
@@ -372,7 +373,7 @@ def _conds(desc_point, ref_vars):
         dead = False
         live = [c for c in cond if not _free(c)]
         for c in cond:
-            v = _var_name(c.get("var"))
+            v = var_name(c.get("var"))
             if v is None and len(ref_vars) == 1:
                 v = next(iter(ref_vars))
             elif not ref_vars and len(live) == 1:
@@ -456,7 +457,7 @@ def compare_set(stu: dict, ref: dict, name: str, periodic: bool = True) -> tuple
     if len(stu.get("conditions", [])) != len(ref.get("conditions", [])):
         return False, f"{name} could not be compared (malformed values)"
     for sp_, rp in zip(stu["conditions"], ref["conditions"]):
-        ref_vars = {_var_name(c.get("var")) for cond in rp for c in cond if c.get("var") is not None}
+        ref_vars = {var_name(c.get("var")) for cond in rp for c in cond if c.get("var") is not None}
         rc, sc = _conds(rp, ref_vars), _conds(sp_, ref_vars)
         errs = [f"{v or 'your set'}: {c['error']}" for d in sc for v, c in d.items() if c.get("error")]
         if errs:

@@ -52,7 +52,7 @@ from ..answers.choice import choice_key, choice_value
 from ..answers.expr import to_sympy
 from ..answers.kinds import FORMS, is_angle_name, symbol_domain
 from ..answers.properties import property_spec, property_verdict
-from ..answers.sets import _var_name, set_conditions, to_set
+from ..answers.sets import var_name, set_conditions, to_set
 from ..schema import KINDS
 from .needs import answer_status, last_results, needs
 
@@ -361,11 +361,11 @@ def _canon_one_set(s, k, fmap=None):
 
 def _canon_condition(cond: list, fmap=None, keys: dict | None = None) -> list:
     """A condition {variable: Set} canonical per sample point; keys by their untypeset name (θ_2 is theta2, as
-    the grader reads them, :func:`kinlib.course.answers.sets._var_name`), ``keys`` renaming some."""
+    the grader reads them, :func:`kinlib.course.answers.sets.var_name`), ``keys`` renaming some."""
     keys = keys or {}
     return [
-        [keys.get(_var_name(key), _var_name(key))] + [_canon_one_set(s, k, fmap) for k in range(SAMPLE_POINTS)]
-        for key, s in sorted(cond, key=lambda kv: keys.get(_var_name(kv[0]), _var_name(kv[0])))
+        [keys.get(var_name(key), var_name(key))] + [_canon_one_set(s, k, fmap) for k in range(SAMPLE_POINTS)]
+        for key, s in sorted(cond, key=lambda kv: keys.get(var_name(kv[0]), var_name(kv[0])))
     ]
 
 
@@ -673,7 +673,7 @@ def _verdict_set(value, shape, right, named):
         if any(right(_canon_condition(c)) for c in bare):
             return "correct", "correct"
     if mine_shape == "dict" and one_var:  # the right set on the wrong variable (mistakes.SET_VARIABLE)
-        mine = _var_name(conds[0][0][0])
+        mine = var_name(conds[0][0][0])
         for v in _JOINT_NAMES:
             if v != mine and right(_canon_condition(conds[0], keys={mine: v})):
                 return named(mistakes.SET_VARIABLE.says)
