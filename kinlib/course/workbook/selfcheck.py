@@ -52,7 +52,7 @@ from ..answers.choice import choice_key, choice_value
 from ..answers.expr import to_sympy
 from ..answers.kinds import FORMS, is_angle_name, symbol_domain
 from ..answers.properties import property_spec, property_verdict
-from ..answers.sets import var_name, set_conditions, to_set
+from ..answers.sets import set_conditions, to_set, var_name
 from ..schema import KINDS
 from .needs import answer_status, last_results, needs
 
