@@ -163,10 +163,16 @@ class RankAnalysis:
         self.A = A
         self._fld = None
         self.certified = False
+        self.pose = None
         got = _certified_pivots(A)
         if got is not None:
             self.pivots, self.rows = got
             self.rank, self.R, self.certified = len(self.pivots), None, True
+            return
+        got = _singular_pose(A)
+        if got is not None:
+            self.pose, (self.pivots, self.rows) = got
+            self.rank, self.R = len(self.pivots), None
             return
         fld = self.fld
         size = max((abs(n) for n, _ in fld.multiples.values()), default=0) * min(A.shape)
@@ -182,10 +188,16 @@ class RankAnalysis:
         if self.rows is None:  # the pivot columns of Aᵀ, exactly
             self.rows = _rref(dA.transpose(), fld)[1]
 
-    def is_zero(self, e: sp.Expr) -> bool:
+    def is_zero(self, e: sp.Expr, minor: tuple | None = None) -> bool:
         """Whether e (a number or expression in the parameters, built from A's sines and cosines) is 0, proved:
-        nonzero when its value (parameters at :data:`SPECIAL_VALUES`) is above 10⁻³⁰ at 100 digits, else exactly."""
+        nonzero when its value (parameters at :data:`SPECIAL_VALUES`) is above 10⁻³⁰ at 100 digits, else exactly.
+        ``minor``: (rows, columns) when e is that minor of A (decided as at a singular pose, when A is one)."""
         import mpmath
+
+        if self.pose is not None and minor is not None:
+            z = self.pose.minor_zero(*minor)
+            if z is not None:
+                return z
 
         try:
             with mpmath.workdps(FALLBACK_DIGITS + 40):
@@ -201,10 +213,15 @@ class RankAnalysis:
             self._fld = ExactField(list(self.A))
         return self._fld
 
-    def entry_is_zero(self, k: int, j: int, expr) -> bool:
-        """Whether rref(A)[k, j] is 0; ``expr()`` gives its numerator (a minor) when it must be computed."""
+    def entry_is_zero(self, k: int, j: int, expr, minor: tuple | None = None) -> bool:
+        """Whether rref(A)[k, j] is 0; ``expr()`` gives its numerator (a minor) when it must be computed;
+        ``minor``: its (rows, columns) in A."""
         if self.R is not None:
             return not self.R[k][j]
+        if self.pose is not None and minor is not None:
+            z = self.pose.minor_zero(*minor)
+            if z is not None:
+                return z
         return decide_zero(expr())
 
 
@@ -235,7 +252,7 @@ def canonical_rows(A: sp.Matrix, an: RankAnalysis) -> sp.Matrix:
                 minor["d"] = ring_det(Bk)
                 return minor["d"]
 
-            if an.entry_is_zero(k, j, numerator):
+            if an.entry_is_zero(k, j, numerator, (I, P[:k] + [j] + P[k + 1 :])):
                 continue
             out[k, j] = readable_ratio(minor["d"] if "d" in minor else ring_det(Bk), D)
     return out
@@ -319,7 +336,7 @@ def rank_conditions(A: sp.Matrix, an: RankAnalysis) -> tuple:
     common, pivot_factors = None, None
     for I, P in itertools.islice(itertools.chain([first], (c for c in others if c != first)), MAX_MINORS):
         D = ring_det(A.extract(list(I), list(P)))  # in the sines and cosines of A (the field's atoms)
-        if D == 0 or ((I, P) != first or not an.certified) and an.is_zero(D):
+        if D == 0 or ((I, P) != first or not an.certified) and an.is_zero(D, (list(I), list(P))):
             continue
         facs = _vanishing_factors(D, an)
         if not facs:
@@ -328,3 +345,316 @@ def rank_conditions(A: sp.Matrix, an: RankAnalysis) -> tuple:
             pivot_factors = facs
         common = facs if common is None else [f for f in common if f in facs]
     return tuple(readable_fold(f) for f in (common or pivot_factors or ()))
+
+
+# ----------------------------------------------------------------------------------------------
+# singular poses: zero tests through independent angles (no number field)
+# ----------------------------------------------------------------------------------------------
+#: the nice parts ν of an angle Σ n_i φ_i + ν: multiples of π/12 (sin ν, cos ν in Q(√2, √3))
+_NICE = 12
+#: at most this many independent angles φ_i (3^k sign patterns are tried for each new angle)
+MAX_LIFT_ANGLES = 9
+#: the precisions (digits) at which a minor that is not 0 for all φ is looked at again: nonzero when above
+#: 10^(70 − digits) times Hadamard's bound (the margin of :func:`_numeric_pivots`, 70 digits)
+_ESCALATE = (100, 300, 1000)
+#: the factor step is skipped for minors with more terms than this (SymPy's multivariate factoring)
+_MAX_FACTOR_TERMS = 3000
+
+
+class PointLift:
+    """Zero tests at a configuration through angles taken as independent: what a singular pose needs.
+
+    At a singular pose a minor vanishes because of the arm's structure (sin θ3 = 0 at θ3 = π, whatever the
+    other joints are), not because of a coincidence between 2π/7 and 3π/11. Each sine or cosine in the matrix
+    is sin/cos of an angle a = r + qπ (r, q rational); the angles are written as a = Σ n_i φ_i + ν with
+    n_i ∈ {−1, 0, 1}, ν a multiple of π/12 and φ_i the matrix's own angles (smallest first: the joint values
+    before their sums), checked exactly (r and q compared as rationals). ``lifted(e)`` replaces every sine and
+    cosine by the polynomial in sin φ_i, cos φ_i (and sin ν, cos ν) it equals at the configuration. A
+    polynomial that is 0 for *every* φ (its normal form modulo sin² + cos² − 1 is 0,
+    :class:`kinlib.trigpoly.TrigRing`) is 0 at the configuration: a proof of "zero" that needs no number field
+    (Q(cos 2π/7, cos 3π/11, …) has degree in the hundreds). It proves nothing about "nonzero" (certified
+    numerics do that), and a zero by coincidence is left to the other exact routes.
+
+    >>> import sympy as sp
+    >>> a, b = 2 * sp.pi / 7, 3 * sp.pi / 11
+    >>> lift = PointLift([sp.sin(a), sp.sin(a + b), sp.cos(b)])
+    >>> len(lift.angles)   # 2π/7 and 3π/11; 43π/77 is their sum
+    2
+    >>> lift.is_zero(sp.sin(a + b) - sp.sin(a) * sp.cos(b) - sp.cos(a) * sp.sin(b))
+    True
+    """
+
+    def __init__(self, exprs: list):
+        from fractions import Fraction
+
+        from .exactfield import _angle_parts
+
+        atoms: set = set()
+        for e in exprs:
+            atoms |= e.atoms(sp.sin, sp.cos)
+        if any(e.has(sp.tan, sp.cot, sp.sec, sp.csc) for e in exprs):
+            raise NotExact("tan/cot/sec/csc: not lifted")
+        parts = {}
+        for f in atoms:
+            r, q = _angle_parts(f.args[0])  # NotExact for √2, or an angle with parameters
+            parts[f] = (Fraction(int(r.p), int(r.q)), Fraction(int(q.p), int(q.q)))
+        order = sorted(set(parts.values()), key=lambda a: (max(abs(a[0].numerator), a[0].denominator)
+                                                           * max(abs(a[1].numerator), a[1].denominator), a))
+        basis: list = []
+        combo: dict = {}  # angle -> (coefficients, nu)
+        for a in order:
+            found = self._express(a, basis)
+            if found is None:
+                if len(basis) >= MAX_LIFT_ANGLES:
+                    raise NotExact(f"more than {MAX_LIFT_ANGLES} independent angles")
+                basis.append(a)
+                found = (tuple([0] * (len(basis) - 1) + [1]), Fraction(0))
+            combo[a] = found
+        self.values = [sp.Rational(r.numerator, r.denominator) + sp.Rational(q.numerator, q.denominator) * sp.pi
+                       for r, q in basis]
+        self.angles = [sp.Dummy(f"phi{i}", real=True) for i in range(len(basis))]
+        self.table = {}
+        for f, a in parts.items():
+            coeffs, nu = combo[a]
+            arg = sum((n * p for n, p in zip(coeffs, self.angles) if n), sp.S.Zero)
+            arg += sp.Rational(nu.numerator, nu.denominator) * sp.pi
+            self.table[f] = sp.expand_trig(type(f)(arg))
+        self._back = {}
+        for p, v in zip(self.angles, self.values):
+            self._back[sp.sin(p)], self._back[sp.cos(p)] = sp.sin(v), sp.cos(v)
+
+    @staticmethod
+    def _express(a, basis):
+        """(coefficients in {−1, 0, 1}, ν) with a = Σ n_i b_i + νπ, ν a multiple of 1/12, or None."""
+        import itertools as it
+
+        r, q = a
+        k = len(basis)
+        for size in range(1, k + 1):
+            for support in it.combinations(range(k), size):
+                for signs in it.product((1, -1), repeat=size):
+                    rr, qq = r, q
+                    for i, s in zip(support, signs):
+                        rr -= s * basis[i][0]
+                        qq -= s * basis[i][1]
+                    if rr == 0 and (qq * _NICE).denominator == 1:
+                        coeffs = [0] * k
+                        for i, s in zip(support, signs):
+                            coeffs[i] = s
+                        return tuple(coeffs), qq
+        return None
+
+    def lifted(self, e: sp.Expr) -> sp.Expr:
+        """e with every sine and cosine written in the independent angles (equal at the configuration)."""
+        return e.xreplace(self.table)
+
+    def ring(self, exprs: list) -> TrigRing:
+        """The exact :class:`TrigRing` of lifted expressions (the angles φ_i; parameters as variables)."""
+        ring = TrigRing(exprs, self.angles)
+        if ring.domain.is_EX:
+            raise NotExact("constants outside SymPy's exact domains")
+        return ring
+
+    def is_zero(self, e: sp.Expr) -> bool:
+        """True when e is 0 for every value of the independent angles (so 0 here); False: not shown."""
+        try:
+            x = self.lifted(e)
+            return not self.ring([x]).normal_form(x)
+        except (NotTrigPolynomial, NotExact):
+            return False
+
+    def at_point(self, e: sp.Expr) -> sp.Expr:
+        """A lifted expression (in sin φ_i, cos φ_i) at the configuration again."""
+        return e.xreplace(self._back)
+
+
+def _has_division(e: sp.Expr) -> bool:
+    return any(p.exp.is_negative for p in e.atoms(sp.Pow))
+
+
+def _hadamard_small(d, X, rows, cols, digits: int) -> bool:
+    """Whether |d| (a minor X[rows, cols] computed at ``digits`` digits) is below the certification line
+    10^(70 − digits) · Π ‖column‖ (Hadamard's bound on the minor): "not certified nonzero"."""
+    import mpmath
+
+    h = mpmath.mpf(1)
+    for j in cols:
+        h *= mpmath.sqrt(mpmath.fsum(abs(X[i, j]) ** 2 for i in rows))
+    return not abs(d) > h * mpmath.mpf(10) ** (70 - digits)
+
+
+class _SingularPose:
+    """The rank, pivots and independent rows of an evaluated matrix A decided minor by minor: each minor
+    nonzero by certified numerics (escalated to 300 and 1000 digits), zero by :class:`PointLift` (0 for every
+    value of the independent angles), or, for a minor that is neither, by its factors one by one (nonzero
+    numerically, or decided exactly by :func:`~kinlib.exactfield.decide_zero` on that factor alone). A
+    minor none of these decides makes the whole analysis give way (None) to elimination in K(t)."""
+
+    def __init__(self, A: sp.Matrix):
+        self.A = A
+        self.lift = PointLift(list(A))
+        self.special = _special(A.free_symbols)
+        self._X: dict = {}
+        self._rows = None
+        self._ring = None
+        self._memo: dict = {}
+
+    def X(self, digits: int):
+        import mpmath
+
+        if digits not in self._X:
+            B = self.A.xreplace(self.special) if self.special else self.A
+            memo: dict = {}
+            with mpmath.workdps(digits):
+                self._X[digits] = mpmath.matrix([[mp_value(B[i, j], memo) for j in range(B.cols)]
+                                                 for i in range(B.rows)])
+        return self._X[digits]
+
+    def _lifted_rows(self):
+        """Each row of A lifted and multiplied by the product of its entries' denominators (nonzero at the
+        configuration: they are the entries' own denominators there), as ring elements."""
+        if self._rows is None:
+            fr = [[sp.fraction(sp.together(e)) if _has_division(e) else (e, sp.S.One) for e in row]
+                  for row in self.A.tolist()]
+            exprs = [self.lift.lifted(x) for row in fr for pair in row for x in pair]
+            ring = self.lift.ring(exprs)
+            it = iter(exprs)
+            rows = []
+            for row in fr:
+                nums, dens = [], []
+                for _ in row:
+                    nums.append(ring.normal_form(next(it)))
+                    dens.append(ring.normal_form(next(it)))
+                distinct = []
+                for d in dens:
+                    if d != ring.ring.one and d not in distinct:
+                        distinct.append(d)
+                out = []
+                for n, d in zip(nums, dens):
+                    x = n
+                    for o in distinct:
+                        if o != d:
+                            x = x * o
+                    out.append(x)
+                rows.append(out)
+            self._rows, self._ring = rows, ring
+        return self._rows
+
+    def _numeric(self, rows, cols, digits: int):
+        """The minor at ``digits`` digits: (nonzero certified?, value)."""
+        import mpmath
+
+        X = self.X(digits)
+        with mpmath.workdps(digits):
+            d = mpmath.det(mpmath.matrix([[X[i, j] for j in cols] for i in rows]))
+            return not _hadamard_small(d, X, rows, cols, digits), d
+
+    def minor_zero(self, rows, cols) -> bool | None:
+        """Whether det A[rows, cols] = 0 (True / False, proved), None when undecided."""
+        key = (tuple(sorted(rows)), tuple(sorted(cols)))
+        if key in self._memo:
+            return self._memo[key]
+        self._memo[key] = out = self._decide(list(rows), list(cols))
+        return out
+
+    def _decide(self, rows, cols):
+        if self._numeric(rows, cols, _ESCALATE[0])[0]:
+            return False
+        try:
+            L = self._lifted_rows()
+        except (NotTrigPolynomial, NotExact):
+            return None
+        ring = self._ring
+        D = DomainMatrix([[L[i][j] for j in cols] for i in rows], (len(rows), len(cols)), ring.ring.to_domain())
+        p = ring.reduce(D.det())
+        if not p:
+            return True
+        for digits in _ESCALATE[1:]:
+            if self._numeric(rows, cols, digits)[0]:
+                return False
+        return self._by_factors(ring, p)
+
+    def _by_factors(self, ring, p):
+        """p ≠ 0 as a polynomial, numerically 0 here: zero exactly when one of its factors is."""
+        if len(p.terms()) > _MAX_FACTOR_TERMS:
+            return None
+        try:
+            _c, factors = p.factor_list()
+        except Exception:  # an algebraic domain SymPy does not factor over: one factor, p itself
+            factors = [(p, 1)]
+        env = {a: v for a, v in zip(self.lift.angles, self.lift.values)}
+        for f, _m in factors:
+            e = ring.to_expr(f).xreplace(env)
+            try:
+                if decide_zero(e, "a factor of a minor"):
+                    return True
+            except ValueError:
+                return None
+        return False
+
+    def greedy(self, m: int, n: int, zero):
+        """(pivot columns, their rows) of an m×n matrix whose minors' zero tests are ``zero(rows, cols)``:
+        column j joins when some bordered minor [I + i, P + j] is nonzero (then A[I, P] stays nonsingular;
+        otherwise every bordered minor is 0 and column j lies in the span of the pivots)."""
+        P: list = []
+        I: list = []
+        for j in range(n):
+            if len(P) == m:
+                break
+            free = [i for i in range(m) if i not in I]
+            pick = None
+            for i in free:  # numerics first: any certified nonzero bordered minor will do
+                if zero(I + [i], P + [j], numeric=True) is False:
+                    pick = i
+                    break
+            if pick is None:
+                for i in free:
+                    z = zero(I + [i], P + [j])
+                    if z is None:
+                        return None
+                    if z is False:
+                        pick = i
+                        break
+            if pick is not None:
+                P.append(j)
+                I.append(pick)
+        return P, I
+
+    def analyse(self):
+        """(pivots, rows) of A as :class:`RankAnalysis` has them (rows: the first independent rows of
+        A[:, pivots]), or None when a minor is undecided."""
+        A = self.A
+
+        def zero(rows, cols, numeric=False):
+            if numeric:
+                return False if self._numeric(rows, cols, _ESCALATE[0])[0] else None
+            return self.minor_zero(rows, cols)
+
+        got = self.greedy(A.rows, A.cols, zero)
+        if got is None:
+            return None
+        P, _ = got
+        rows = _independent_rows(A, P)
+        if rows is None:  # the first independent rows of A[:, P], decided the same way (transposed)
+
+            def zero_t(rows_t, cols_t, numeric=False):
+                return zero(cols_t, [P[k] for k in rows_t], numeric)
+
+            got_t = self.greedy(len(P), A.rows, zero_t)
+            if got_t is None:
+                return None
+            rows = got_t[0]
+        return P, rows
+
+
+def _singular_pose(A: sp.Matrix):
+    """(the :class:`_SingularPose` analysis, (pivots, rows)) of A, or None when it does not apply (no sines and
+    cosines; an angle outside r + qπ; a minor it cannot decide): then elimination in K(t) decides."""
+    if not A.has(sp.sin, sp.cos):
+        return None
+    try:
+        pose = _SingularPose(A)
+        got = pose.analyse()
+    except (NotExact, NotTrigPolynomial):
+        return None
+    return None if got is None else (pose, got)
