@@ -362,6 +362,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None,
     except OutOfTime:
         why = _late(seconds)
     r, _ = fallback_rank(_numbers_only(M, "rank_at", why, seconds))
+    fallback_warning("rank_at", why)
     return Rank(r, exact=False, note=f"{FALLBACK_DIGITS}-digit SVD ({why})")
 
 

@@ -377,10 +377,11 @@ class PointLift:
 
     >>> import sympy as sp
     >>> a, b = 2 * sp.pi / 7, 3 * sp.pi / 11
-    >>> lift = PointLift([sp.sin(a), sp.sin(a + b), sp.cos(b)])
-    >>> len(lift.angles)   # 2π/7 and 3π/11; 43π/77 is their sum
-    2
-    >>> lift.is_zero(sp.sin(a + b) - sp.sin(a) * sp.cos(b) - sp.cos(a) * sp.sin(b))
+    >>> e = sp.sin(a + b) - sp.sin(a) * sp.cos(b) - sp.cos(a) * sp.sin(b)   # 0: sin(a + b) is sin(34π/77)
+    >>> lift = PointLift([e])
+    >>> lift.values   # 34π/77 = π − 2π/7 − 3π/11
+    [2*pi/7, 3*pi/11]
+    >>> lift.is_zero(e)
     True
     """
 
@@ -398,8 +399,10 @@ class PointLift:
         for f in atoms:
             r, q = _angle_parts(f.args[0])  # NotExact for √2, or an angle with parameters
             parts[f] = (Fraction(int(r.p), int(r.q)), Fraction(int(q.p), int(q.q)))
-        order = sorted(set(parts.values()), key=lambda a: (max(abs(a[0].numerator), a[0].denominator)
-                                                           * max(abs(a[1].numerator), a[1].denominator), a))
+        order = sorted(
+            set(parts.values()),
+            key=lambda a: (max(abs(a[0].numerator), a[0].denominator) * max(abs(a[1].numerator), a[1].denominator), a),
+        )
         basis: list = []
         combo: dict = {}  # angle -> (coefficients, nu)
         for a in order:
@@ -410,8 +413,9 @@ class PointLift:
                 basis.append(a)
                 found = (tuple([0] * (len(basis) - 1) + [1]), Fraction(0))
             combo[a] = found
-        self.values = [sp.Rational(r.numerator, r.denominator) + sp.Rational(q.numerator, q.denominator) * sp.pi
-                       for r, q in basis]
+        self.values = [
+            sp.Rational(r.numerator, r.denominator) + sp.Rational(q.numerator, q.denominator) * sp.pi for r, q in basis
+        ]
         self.angles = [sp.Dummy(f"phi{i}", real=True) for i in range(len(basis))]
         self.table = {}
         for f, a in parts.items():
@@ -468,6 +472,26 @@ class PointLift:
         return e.xreplace(self._back)
 
 
+def _mp_det(rows: list):
+    """det of a small square mpmath matrix (lists) by elimination with partial pivoting (call inside workdps);
+    mpmath.det fails on an exactly singular one."""
+    A = [list(r) for r in rows]
+    n, d = len(A), 1
+    for j in range(n):
+        k = max(range(j, n), key=lambda i: abs(A[i][j]))
+        if not A[k][j]:
+            return 0 * d
+        if k != j:
+            A[j], A[k] = A[k], A[j]
+            d = -d
+        d *= A[j][j]
+        for i in range(j + 1, n):
+            f = A[i][j] / A[j][j]
+            if f:
+                A[i] = [a - f * b for a, b in zip(A[i], A[j])]
+    return d
+
+
 def _has_division(e: sp.Expr) -> bool:
     return any(p.exp.is_negative for p in e.atoms(sp.Pow))
 
@@ -506,16 +530,19 @@ class _SingularPose:
             B = self.A.xreplace(self.special) if self.special else self.A
             memo: dict = {}
             with mpmath.workdps(digits):
-                self._X[digits] = mpmath.matrix([[mp_value(B[i, j], memo) for j in range(B.cols)]
-                                                 for i in range(B.rows)])
+                self._X[digits] = mpmath.matrix(
+                    [[mp_value(B[i, j], memo) for j in range(B.cols)] for i in range(B.rows)]
+                )
         return self._X[digits]
 
     def _lifted_rows(self):
         """Each row of A lifted and multiplied by the product of its entries' denominators (nonzero at the
         configuration: they are the entries' own denominators there), as ring elements."""
         if self._rows is None:
-            fr = [[sp.fraction(sp.together(e)) if _has_division(e) else (e, sp.S.One) for e in row]
-                  for row in self.A.tolist()]
+            fr = [
+                [sp.fraction(sp.together(e)) if _has_division(e) else (e, sp.S.One) for e in row]
+                for row in self.A.tolist()
+            ]
             exprs = [self.lift.lifted(x) for row in fr for pair in row for x in pair]
             ring = self.lift.ring(exprs)
             it = iter(exprs)
@@ -546,7 +573,7 @@ class _SingularPose:
 
         X = self.X(digits)
         with mpmath.workdps(digits):
-            d = mpmath.det(mpmath.matrix([[X[i, j] for j in cols] for i in rows]))
+            d = _mp_det([[X[i, j] for j in cols] for i in rows])
             return not _hadamard_small(d, X, rows, cols, digits), d
 
     def minor_zero(self, rows, cols) -> bool | None:
@@ -582,7 +609,7 @@ class _SingularPose:
             _c, factors = p.factor_list()
         except Exception:  # an algebraic domain SymPy does not factor over: one factor, p itself
             factors = [(p, 1)]
-        env = {a: v for a, v in zip(self.lift.angles, self.lift.values)}
+        env = dict(zip(self.lift.angles, self.lift.values))
         for f, _m in factors:
             e = ring.to_expr(f).xreplace(env)
             try:
