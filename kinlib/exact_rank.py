@@ -19,7 +19,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from .display import readable_fold, readable_ratio
-from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, decide_zero, mp_matrix, mp_value
+from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, PointLift, decide_zero, mp_matrix, mp_value
 from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = ["EXACT_BUDGET", "MAX_MINORS", "RankAnalysis", "ring_det", "canonical_rows", "rank_conditions"]
@@ -350,126 +350,11 @@ def rank_conditions(A: sp.Matrix, an: RankAnalysis) -> tuple:
 # ----------------------------------------------------------------------------------------------
 # singular poses: zero tests through independent angles (no number field)
 # ----------------------------------------------------------------------------------------------
-#: the nice parts ν of an angle Σ n_i φ_i + ν: multiples of π/12 (sin ν, cos ν in Q(√2, √3))
-_NICE = 12
-#: at most this many independent angles φ_i (3^k sign patterns are tried for each new angle)
-MAX_LIFT_ANGLES = 9
 #: the precisions (digits) at which a minor that is not 0 for all φ is looked at again: nonzero when above
 #: 10^(70 − digits) times Hadamard's bound (the margin of :func:`_numeric_pivots`, 70 digits)
 _ESCALATE = (100, 300, 1000)
 #: the factor step is skipped for minors with more terms than this (SymPy's multivariate factoring)
 _MAX_FACTOR_TERMS = 3000
-
-
-class PointLift:
-    """Zero tests at a configuration through angles taken as independent: what a singular pose needs.
-
-    At a singular pose a minor vanishes because of the arm's structure (sin θ3 = 0 at θ3 = π, whatever the
-    other joints are), not because of a coincidence between 2π/7 and 3π/11. Each sine or cosine in the matrix
-    is sin/cos of an angle a = r + qπ (r, q rational); the angles are written as a = Σ n_i φ_i + ν with
-    n_i ∈ {−1, 0, 1}, ν a multiple of π/12 and φ_i the matrix's own angles (smallest first: the joint values
-    before their sums), checked exactly (r and q compared as rationals). ``lifted(e)`` replaces every sine and
-    cosine by the polynomial in sin φ_i, cos φ_i (and sin ν, cos ν) it equals at the configuration. A
-    polynomial that is 0 for *every* φ (its normal form modulo sin² + cos² − 1 is 0,
-    :class:`kinlib.trigpoly.TrigRing`) is 0 at the configuration: a proof of "zero" that needs no number field
-    (Q(cos 2π/7, cos 3π/11, …) has degree in the hundreds). It proves nothing about "nonzero" (certified
-    numerics do that), and a zero by coincidence is left to the other exact routes.
-
-    >>> import sympy as sp
-    >>> a, b = 2 * sp.pi / 7, 3 * sp.pi / 11
-    >>> e = sp.sin(a + b) - sp.sin(a) * sp.cos(b) - sp.cos(a) * sp.sin(b)   # 0: sin(a + b) is sin(34π/77)
-    >>> lift = PointLift([e])
-    >>> lift.values   # 34π/77 = π − 2π/7 − 3π/11
-    [2*pi/7, 3*pi/11]
-    >>> lift.is_zero(e)
-    True
-    """
-
-    def __init__(self, exprs: list):
-        from fractions import Fraction
-
-        from .exactfield import _angle_parts
-
-        atoms: set = set()
-        for e in exprs:
-            atoms |= e.atoms(sp.sin, sp.cos)
-        if any(e.has(sp.tan, sp.cot, sp.sec, sp.csc) for e in exprs):
-            raise NotExact("tan/cot/sec/csc: not lifted")
-        parts = {}
-        for f in atoms:
-            r, q = _angle_parts(f.args[0])  # NotExact for √2, or an angle with parameters
-            parts[f] = (Fraction(int(r.p), int(r.q)), Fraction(int(q.p), int(q.q)))
-        order = sorted(
-            set(parts.values()),
-            key=lambda a: (max(abs(a[0].numerator), a[0].denominator) * max(abs(a[1].numerator), a[1].denominator), a),
-        )
-        basis: list = []
-        combo: dict = {}  # angle -> (coefficients, nu)
-        for a in order:
-            found = self._express(a, basis)
-            if found is None:
-                if len(basis) >= MAX_LIFT_ANGLES:
-                    raise NotExact(f"more than {MAX_LIFT_ANGLES} independent angles")
-                basis.append(a)
-                found = (tuple([0] * (len(basis) - 1) + [1]), Fraction(0))
-            combo[a] = found
-        self.values = [
-            sp.Rational(r.numerator, r.denominator) + sp.Rational(q.numerator, q.denominator) * sp.pi for r, q in basis
-        ]
-        self.angles = [sp.Dummy(f"phi{i}", real=True) for i in range(len(basis))]
-        self.table = {}
-        for f, a in parts.items():
-            coeffs, nu = combo[a]
-            arg = sum((n * p for n, p in zip(coeffs, self.angles) if n), sp.S.Zero)
-            arg += sp.Rational(nu.numerator, nu.denominator) * sp.pi
-            self.table[f] = sp.expand_trig(type(f)(arg))
-        self._back = {}
-        for p, v in zip(self.angles, self.values):
-            self._back[sp.sin(p)], self._back[sp.cos(p)] = sp.sin(v), sp.cos(v)
-
-    @staticmethod
-    def _express(a, basis):
-        """(coefficients in {−1, 0, 1}, ν) with a = Σ n_i b_i + νπ, ν a multiple of 1/12, or None."""
-        import itertools as it
-
-        r, q = a
-        k = len(basis)
-        for size in range(1, k + 1):
-            for support in it.combinations(range(k), size):
-                for signs in it.product((1, -1), repeat=size):
-                    rr, qq = r, q
-                    for i, s in zip(support, signs):
-                        rr -= s * basis[i][0]
-                        qq -= s * basis[i][1]
-                    if rr == 0 and (qq * _NICE).denominator == 1:
-                        coeffs = [0] * k
-                        for i, s in zip(support, signs):
-                            coeffs[i] = s
-                        return tuple(coeffs), qq
-        return None
-
-    def lifted(self, e: sp.Expr) -> sp.Expr:
-        """e with every sine and cosine written in the independent angles (equal at the configuration)."""
-        return e.xreplace(self.table)
-
-    def ring(self, exprs: list) -> TrigRing:
-        """The exact :class:`TrigRing` of lifted expressions (the angles φ_i; parameters as variables)."""
-        ring = TrigRing(exprs, self.angles)
-        if ring.domain.is_EX:
-            raise NotExact("constants outside SymPy's exact domains")
-        return ring
-
-    def is_zero(self, e: sp.Expr) -> bool:
-        """True when e is 0 for every value of the independent angles (so 0 here); False: not shown."""
-        try:
-            x = self.lifted(e)
-            return not self.ring([x]).normal_form(x)
-        except (NotTrigPolynomial, NotExact):
-            return False
-
-    def at_point(self, e: sp.Expr) -> sp.Expr:
-        """A lifted expression (in sin φ_i, cos φ_i) at the configuration again."""
-        return e.xreplace(self._back)
 
 
 def _mp_det(rows: list):
