@@ -490,9 +490,12 @@ class PointLift:
         return ring
 
     def is_zero(self, e: sp.Expr) -> bool:
-        """True when e is 0 for every value of the independent angles (so 0 here); False: not shown."""
+        """True when e is 0 for every value of the independent angles (so 0 here); False: not shown. A quotient
+        is 0 where its numerator is (its denominator is the lift of e's own denominators, nonzero here)."""
         try:
             x = self.lifted(e)
+            if any(p.exp.is_negative for p in x.atoms(sp.Pow)):
+                x = sp.fraction(sp.together(x))[0]
             return not self.ring([x]).normal_form(x)
         except (NotTrigPolynomial, NotExact):
             return False
