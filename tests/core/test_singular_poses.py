@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import exact_oracle as O
-from kinlib import robots
+from kinlib import SerialChain, robots
 from kinlib.exact import NumericFallbackWarning, Rank, column_space, exact_is_zero, left_null_space, rank_at
 from kinlib.exactfield import decide_zero
 from kinlib.singularities import K, singular_configurations
@@ -50,8 +50,24 @@ def mixed_pose(draw):
 multiple_of_pi = st.integers(-2, 2).map(lambda k: k * pi)
 
 
+def _stanford():
+    """The Stanford arm RRPRRR (the screws of tests/core/test_exact_rank.py's STANFORD; tool at (0, 1/2, 1))."""
+    S = [
+        [0, 0, 1, 0, 0, 0],
+        [1, 0, 0, 0, 1, 0],
+        [0, 0, 0, 0, 1, 0],
+        [0, 1, 0, -1, 0, 0],
+        [1, 0, 0, 0, 1, 0],
+        [0, 1, 0, -1, 0, 0],
+    ]
+    M = sp.eye(4)
+    M[:3, 3] = sp.Matrix([0, R(1, 2), 1])
+    return SerialChain(M, sp.Matrix(S).T, name="stanford")
+
+
 def _arms():
     return {
+        "stanford": _stanford(),
         "ur5": robots.ur5(),
         "puma560": robots.puma560(),
         "puma_no_offsets": robots.puma560(R(2, 5), 0, 0, R(2, 5)),
@@ -77,6 +93,10 @@ def _in_family(value, family) -> bool:
     """value ∈ {b + p k : k ∈ ℤ} (or a union of such), decided exactly."""
     parts = family.args if isinstance(family, sp.Union) else (family,)
     for s in parts:
+        if isinstance(s, sp.FiniteSet):  # a prismatic joint's values
+            if any((value - x).is_zero for x in s):
+                return True
+            continue
         expr = s.lamda.expr
         p, b = expr.coeff(K), expr.subs(K, 0)
         if sp.simplify((value - b) / p).is_Integer:
@@ -156,6 +176,15 @@ def test_puma_without_offsets_on_elbow_wrist_and_shoulder(data):
     else:
         q[2] = pi / 2 - 2 * q[1]
     _check_exact_and_right(ARMS["puma_no_offsets"], q, True, SETS, "puma_no_offsets")
+
+
+@settings(max_examples=3, **SETTINGS)
+@given(st.data())
+def test_stanford_on_its_wrist_family(data):
+    q = data.draw(mixed_pose())
+    q[2] = data.draw(rational_angle)  # the prismatic joint: a slide
+    q[4] = data.draw(multiple_of_pi)
+    _check_exact_and_right(ARMS["stanford"], q, True, SETS, "stanford")
 
 
 def test_the_same_angles_off_the_singular_set_are_full_rank():
