@@ -236,3 +236,19 @@ def test_rank_at_fallback_warns():
     with pytest.warns(NumericFallbackWarning, match="rank_at"):
         r = rank_at(J, [sp.sqrt(2), 0], arm.thetas)
     assert r == 1 and not r.exact
+
+
+def test_puma_with_a_symbolic_length_at_elbow_and_shoulder():
+    """puma560(L, 0, 0, L) at θ3 = π/2 (elbow and shoulder at once) with mixed angles: rank 4 for every L > 0,
+    exact; the oracle agrees at L = 2/5."""
+    L = sp.Symbol("L", positive=True)
+    arm = robots.puma560(L, 0, 0, L)
+    q = [3 * pi / 11, 2 * pi / 7, pi / 2, 5 * pi / 13, 3 * pi / 11, R(1, 3)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", NumericFallbackWarning)
+        r = rank_at(arm.jacobian_space(), q, arm.thetas)
+        N = left_null_space(arm.jacobian_space(), q, arm.thetas)
+    assert r == 4 and r.exact and not r.unless and N.shape == (6, 2)
+    assert O.rank(O.space_jacobian(ARMS["puma_no_offsets"].screws, q)) == 4
+    Jq = arm.jacobian_space().xreplace(dict(zip(arm.thetas, q)))
+    assert all(decide_zero(e) for e in (N.T * Jq))  # yᵀ J = 0 exactly, for all L
