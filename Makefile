@@ -16,7 +16,7 @@ TEST_JOBS ?= 2
 TESTS ?= tests
 XDIST := $(if $(filter-out 1,$(TEST_JOBS)),-n $(TEST_JOBS) --dist loadgroup)
 
-.PHONY: all setup lint format test test-fast lab notebooks handouts grade bench lock chromium webkit poppler bubblewrap compiler clean
+.PHONY: all setup lint format test test-fast lab lab-students notebooks handouts grade bench lock chromium webkit poppler bubblewrap compiler clean
 
 all: test
 
@@ -105,6 +105,22 @@ lab: $(STAMP)
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks --LabApp.app_settings_dir=$(CURDIR)/notebooks/.lab-settings \
 	    $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
 
+# Students start here: JupyterLab on the student workbooks (stubs and self-checks, no solution), never on the
+# solution notebooks. The workbooks are made by the students' handouts build (build/handouts-students/workbooks, made
+# first if missing: no site, no PDFs) and copied into WORKBOOKS_DIR, a folder of the student's own outside the
+# repository (default ~/kinlib-workbooks): a workbook already there is never overwritten (it holds the student's
+# work), so a later build or `make clean` loses nothing. Extra options as for lab: LAB_ARGS=--no-browser.
+WORKBOOKS_DIR ?= $(HOME)/kinlib-workbooks
+STUDENT_WORKBOOKS := build/handouts-students/workbooks
+lab-students: $(STAMP)
+	@ls $(STUDENT_WORKBOOKS)/[0-9][0-9]_*.ipynb >/dev/null 2>&1 || \
+	    $(VENV)/bin/kinlib handouts notebooks --out build/handouts-students --audience students --no-site --no-pdf
+	@mkdir -p "$(WORKBOOKS_DIR)" && for f in $(STUDENT_WORKBOOKS)/[0-9][0-9]_*.ipynb; do \
+	    test -e "$(WORKBOOKS_DIR)/$$(basename $$f)" || cp "$$f" "$(WORKBOOKS_DIR)/"; done
+	@echo "lab-students: your workbooks are in $(WORKBOOKS_DIR) (your edits are saved there)"
+	$(VENV)/bin/jupyter lab --notebook-dir="$(WORKBOOKS_DIR)" --LabApp.app_settings_dir=$(CURDIR)/notebooks/.lab-settings \
+	    $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
+
 # Execute notebooks in place (fresh kernel each, outputs + widget state, stable ids): after editing a
 # notebook, `make notebooks` (all) or `make notebooks NB=notebooks/05_singularities_planar.ipynb`.
 NB ?= $(NOTEBOOKS)
@@ -125,12 +141,13 @@ handouts: $(STAMP) chromium
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
 # http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.
-# To publish, copy build/handouts to any static web host: no server-side Python.
+# `make site AUDIENCE=students`: the students' site (build/handouts-students), as they will see it.
+# To publish, copy the folder to any static web host: no server-side Python.
 .PHONY: site
 PORT ?= 8000
 site: $(STAMP)
-	@test -f build/handouts/index.html -a -f build/handouts/lite/jupyter-lite.json || $(MAKE) handouts
-	$(VENV)/bin/python -c "from kinlib.course.publish.lite import serve; serve('build/handouts', $(PORT))"
+	@test -f $(HANDOUTS_OUT)/index.html -a -f $(HANDOUTS_OUT)/lite/jupyter-lite.json || $(MAKE) handouts AUDIENCE=$(AUDIENCE)
+	$(VENV)/bin/python -c "from kinlib.course.publish.lite import serve; serve('$(HANDOUTS_OUT)', $(PORT))"
 
 # Grade a class: make grade SUBMISSIONS=path/to/folder [JOBS=2] [OUT=build/grades]
 SUBMISSIONS ?= submissions

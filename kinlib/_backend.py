@@ -190,8 +190,32 @@ def _check_scalar(e: Any, name: str, symbolic: bool, real_symbols: bool = True):
     if isinstance(e, (numbers.Real, np.integer, np.floating)):
         if isinstance(e, (float, np.floating)) and not np.isfinite(e):
             raise ValueError(f"{name} must hold finite real numbers, got {e!r}")
+        if not isinstance(e, (float, np.floating, np.integer)):
+            within_float_range(e, name)
         return e
     raise TypeError(f"{name} must hold real numbers, got {describe(e)}")
+
+
+def within_float_range(e, name: str) -> float:
+    """``float(e)`` of a real number, or a ValueError naming ``name`` for one beyond the float range (a Python int
+    such as 10**400, a Fraction): numbers select the float backend, where it cannot be represented.
+
+    >>> within_float_range(10**400, "v")
+    Traceback (most recent call last):
+    ...
+    ValueError: v must hold numbers within the float range (|x| < 1.8e308), got an int of 401 digits; for exact work pass SymPy numbers (sp.Integer(...))
+    """
+    try:
+        v = float(e)  # an int raises OverflowError; a SymPy Integer gives inf
+        if math.isinf(v) and not isinstance(e, (float, np.floating, sp.Float)):
+            raise OverflowError
+        return v
+    except OverflowError:
+        what = f"an int of {len(str(abs(int(e))))} digits" if isinstance(e, (int, sp.Integer)) else describe(e)
+        raise ValueError(
+            f"{name} must hold numbers within the float range (|x| < 1.8e308), got {what}; "
+            "for exact work pass SymPy numbers (sp.Integer(...))"
+        ) from None
 
 
 def nested_shape(x: Any, name: str) -> tuple[int, ...]:
@@ -370,6 +394,7 @@ def real_array(x, name: str, want: str) -> np.ndarray:
                 or not isinstance(e, (numbers.Real, np.integer, np.floating))
             ):
                 raise TypeError(f"{name} must hold real numbers, got an entry {describe(e)}")
+            within_float_range(e, name)
         a = a.astype(float)
     a = a.astype(float, copy=False)
     if not np.all(np.isfinite(a)):
@@ -430,7 +455,7 @@ def as_scalar(x, name: str, symbolic: bool):
         if isinstance(x, (complex, np.complexfloating)):
             raise TypeError(f"{name} must be a real number, got the complex number {x!r}")
         raise TypeError(f"{name} must be a number or a SymPy expression, got {describe(x)}")
-    x = float(x)
+    x = within_float_range(x, name)
     if not math.isfinite(x):
         raise ValueError(f"{name} must be a finite real number, got {x!r}")
     return x

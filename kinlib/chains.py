@@ -6,6 +6,7 @@ Body form:   T(θ) = M e^{[B1]θ1} ⋯ e^{[Bn]θn},  with B_i = Ad_{M⁻¹} S_i.
 
 from __future__ import annotations
 
+import math
 import numbers
 from collections.abc import Mapping, Sequence
 
@@ -606,8 +607,23 @@ def _poe_rows(chain, what: str, num, joint):
 
 
 def _float_constant(x) -> float:
-    """An exact constant of the chain as the float the generated code uses (exact zeros stay 0.0)."""
-    return 0.0 if x == 0 else float(x)
+    """An exact constant of the chain as the float the generated code uses (exact zeros stay 0.0); a constant
+    beyond the float range (an M or a screw with 10**400 in it) is refused, never turned into inf or 0.
+
+    >>> _float_constant(sp.Integer(10) ** 400)
+    Traceback (most recent call last):
+    ...
+    ValueError: the chain's constant 1.0E+400 is beyond the float range (|x| < 1.8e308): its numeric code cannot represent it; pass SymPy joint values for an exact result
+    """
+    if x == 0:
+        return 0.0
+    v = float(x)
+    if not math.isfinite(v):
+        raise ValueError(
+            f"the chain's constant {sp.N(x, 2)} is beyond the float range (|x| < 1.8e308): its numeric code cannot "
+            "represent it; pass SymPy joint values for an exact result"
+        )
+    return v
 
 
 # --- URDF-style chains: constant placements and rotations about the joints' own axes (issue 25) -------------

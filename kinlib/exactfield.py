@@ -31,6 +31,7 @@ import sympy as sp
 from sympy.polys.constructor import construct_domain
 from sympy.polys.fields import field as _field
 from sympy.polys.matrices import DomainMatrix
+from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import ring as _ring
 
 from .trigpoly import NotTrigPolynomial, TrigRing, normal_form_zero
@@ -240,7 +241,10 @@ class ExactField:
     def _kconst(self, c):
         if c in self._known:
             return self.ring(self._known[c])
-        return self.ring(_field_constant(self.K, c))
+        try:
+            return self.ring(_field_constant(self.K, c))
+        except CoercionFailed as err:  # e.g. 1/(1 + π²): not algebraic, so not in any number field K
+            raise NotExact(f"{c} is not an algebraic number") from err
 
     def to_ratio(self, x) -> tuple[sp.Expr, sp.Expr]:
         """A field element back as SymPy (numerator, denominator), polynomials in sin g, cos g, the constants

@@ -162,6 +162,17 @@ def _kappa_parts(J: Any, what: str):
         if _exact_sign(top - bottom, "a difference of eigenvalues") == 0:
             return ("one",)
         return ("ratio", sp.radsimp(sp.sqrt(top)), sp.radsimp(sp.sqrt(bottom)))
+    if k > 2 and not M.free_symbols:
+        # a constant J with sines of numbers (sin 1, …): singular exactly when det G = 0 (decided exactly); else the
+        # eigenvalues are roots of a cubic or worse with transcendental coefficients: κ from a 60-digit SVD, flagged
+        from .fallback import fallback_rank, fallback_warning
+
+        Gc = M * M.T if M.rows <= M.cols else M.T * M
+        if decide_zero(exact_det(Gc)):
+            return ("singular",)
+        _, sv = fallback_rank(M)
+        fallback_warning(what, "the eigenvalues of a constant 3×3 (or larger) Gram matrix with sines of numbers")
+        return ("ratio", sp.Float(sv[0], FALLBACK_DIGITS), sp.Float(sv[k - 1], FALLBACK_DIGITS))
     if k > 2:
         raise ValueError(
             f"{what} of a symbolic J with k = min(m, n) = {k} ≥ 3 has no readable closed form (the Gram "

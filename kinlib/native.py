@@ -18,9 +18,17 @@ A module compiled before, by this or any other process, is loaded at once (≈ 1
 of :class:`~kinlib.codegen.CompiledMatrix` (e.g. ``chain.numeric_code("jg").compile_native()``) compiles
 now and waits. **Cache**: ``$KINLIB_CACHE/compiled`` (default ``~/.cache/kinlib/compiled``), one file per
 SHA-256 of the C source + the compiler's identity + the Python ABI; written under a temporary name and
-moved into place with ``os.replace``, so processes compiling the same key at once are safe; a file is
-loaded only if this user owns it and nobody else can write it. **No compiler, no Python headers,
-Pyodide, Windows, or** ``KINLIB_COMPILE=0``: the Python code, with the reason in ``native_status``.
+moved into place with ``os.replace``, so processes compiling the same key at once are safe.
+
+**The cache is untrusted input.** A module is written with the SHA-256 of its bytes beside it
+(``<module>.so.sha256``) and loaded only if the file's bytes have that hash: a truncated or altered file (a
+``.so`` cut short makes ``dlopen`` kill the process with SIGBUS) is removed and compiled again, never loaded.
+Both files must be regular files this user owns that nobody else can write, in a cache folder (and its parent)
+that this user owns and that is not group- or world-writable; otherwise nothing is compiled or loaded and
+``native_status`` says why. The compiler (and its ``--version`` probe) runs in a session of its own with a
+time limit (:data:`COMPILE_SECONDS`, :data:`PROBE_SECONDS`); past it the whole process group is killed.
+**No compiler, no Python headers, Pyodide, Windows, or** ``KINLIB_COMPILE=0``: the Python code, with the
+reason in ``native_status``.
 """
 
 from __future__ import annotations
@@ -39,10 +47,16 @@ import sympy as sp  # noqa: F401  (the examples use it)
 from sympy.printing.c import C99CodePrinter
 from sympy.printing.precedence import precedence
 
-__all__ = ["ArithmeticRules", "HOT_CALLS", "NativeSingle", "c_source", "toolchain"]
+__all__ = ["ArithmeticRules", "COMPILE_SECONDS", "HOT_CALLS", "NativeSingle", "PROBE_SECONDS", "c_source", "toolchain"]
 
 #: single calls of a matrix's Python code before its C is compiled in the background
 HOT_CALLS = 1000
+
+#: seconds one compile may take (a 7-joint arm: ≈ 0.5 s of CPU) before the compiler's process group is killed
+COMPILE_SECONDS = 60.0
+
+#: seconds the compiler's ``--version`` probe may take, likewise
+PROBE_SECONDS = 10.0
 
 #: changes whenever the generated C or the way it is compiled changes (part of the cache key)
 _GENERATOR = "kinlib-native-1"
@@ -257,7 +271,6 @@ def toolchain() -> tuple[list[str] | None, str]:
             return _toolchain_cache[env_cc]
     import shlex
     import shutil
-    import subprocess
     import sysconfig
 
     inc = sysconfig.get_paths().get("include", "")
@@ -268,16 +281,17 @@ def toolchain() -> tuple[list[str] | None, str]:
             argv = shlex.split(cand)
             if argv and shutil.which(argv[0]):
                 try:
-                    p = subprocess.run([*argv, "--version"], capture_output=True, text=True, timeout=30)
-                except (OSError, subprocess.SubprocessError):
+                    rc, version = _run([*argv, "--version"], PROBE_SECONDS)
+                except (OSError, TimeoutError) as e:
+                    result = (None, f"the C compiler {argv[0]} did not answer --version ({e})")
                     continue
-                if p.returncode == 0:
+                if rc == 0:
                     link = ["-bundle", "-undefined", "dynamic_lookup"] if sys.platform == "darwin" else ["-shared"]
                     flags = ["-O2", "-fPIC", "-ffp-contract=off", "-fno-fast-math", "-w", *link, "-I", inc]
                     about = "|".join(
                         [
                             shutil.which(argv[0]),
-                            p.stdout.strip(),
+                            version.strip(),
                             *flags,
                             sysconfig.get_config_var("EXT_SUFFIX") or "",
                             sys.version,
@@ -295,15 +309,107 @@ def _cache_dir() -> Path:
     return (Path(root) if root else Path.home() / ".cache" / "kinlib") / "compiled"
 
 
-def _safe(path: Path) -> bool:
-    """Loadable: a regular file this user owns that nobody else can write (a cache dir others can write to must not
-    let them run code in this process)."""
+def _run(argv: list[str], seconds: float) -> tuple[int, str]:
+    """Run ``argv`` in a session of its own (its own process group) with output to a file; (exit code, output).
+    Past ``seconds`` the whole process group is killed (the compiler's children too) and TimeoutError is raised.
+    Output goes to a file, not a pipe: a child that outlives the kill cannot keep this call waiting for EOF.
+
+    >>> _run([sys.executable, "-c", "print(6 * 7)"], 60)
+    (0, '42\\n')
+    """
+    import signal
+    import subprocess
+    import tempfile
+
+    with tempfile.TemporaryFile() as out:
+        p = subprocess.Popen(
+            argv, stdin=subprocess.DEVNULL, stdout=out, stderr=subprocess.STDOUT, start_new_session=True
+        )
+        try:
+            rc = p.wait(timeout=seconds)
+        except subprocess.TimeoutExpired:
+            with contextlib.suppress(OSError):
+                os.killpg(p.pid, signal.SIGKILL)
+            p.wait()
+            raise TimeoutError(
+                f"{Path(argv[0]).name} did not finish in {seconds:g} s; its processes were ended"
+            ) from None
+        finally:
+            with contextlib.suppress(OSError):  # whatever it left running in its group
+                os.killpg(p.pid, signal.SIGKILL)
+        out.seek(0)
+        return rc, out.read().decode("utf-8", "replace")
+
+
+def _private(path: Path) -> str | None:
+    """Why ``path`` (a cache folder) must not be used, or None: it must be a folder (not a link) this user owns
+    that neither the group nor others can write."""
     try:
-        st = path.stat()
+        st = path.lstat()
+    except OSError as e:
+        return f"the cache folder {path} cannot be read ({e.strerror})"
+    import stat
+
+    getuid = getattr(os, "getuid", None)
+    if not stat.S_ISDIR(st.st_mode):
+        return f"the cache folder {path} is not a folder"
+    if getuid is not None and st.st_uid != getuid():
+        return f"the cache folder {path} belongs to another user"
+    if st.st_mode & 0o022:
+        return (
+            f"the cache folder {path} can be written by others (mode {stat.S_IMODE(st.st_mode):o}): nothing is compiled"
+        )
+    return None
+
+
+def _ready_dir(folder: Path) -> None:
+    """Create the cache folder (mode 700) if needed; raise ValueError if it, or its parent, is not private."""
+    try:
+        folder.mkdir(parents=True, exist_ok=True, mode=0o700)
+    except OSError as e:
+        raise ValueError(f"the cache folder {folder} cannot be created ({e.strerror})") from None
+    for p in (folder, folder.parent):
+        why = _private(p)
+        if why:
+            raise ValueError(why)
+
+
+def _safe(path: Path) -> bool:
+    """Loadable: a regular file (not a link) this user owns that nobody else can write (a cache dir others can write to
+    must not let them run code in this process)."""
+    try:
+        st = path.lstat()
     except OSError:
         return False
+    import stat
+
     getuid = getattr(os, "getuid", None)
-    return path.is_file() and (getuid is None or st.st_uid == getuid()) and not st.st_mode & 0o022
+    return stat.S_ISREG(st.st_mode) and (getuid is None or st.st_uid == getuid()) and not st.st_mode & 0o022
+
+
+def _digest_path(path: Path) -> Path:
+    return path.with_name(path.name + ".sha256")
+
+
+def _verified(path: Path) -> bool:
+    """The module at ``path`` and its recorded SHA-256 are both safe files and agree (the whole file is read: a
+    truncated or altered module is never handed to ``dlopen``)."""
+    digest = _digest_path(path)
+    if not (_safe(path) and _safe(digest)):
+        return False
+    try:
+        want = digest.read_text(encoding="ascii").strip()
+        got = hashlib.sha256(path.read_bytes()).hexdigest()
+    except (OSError, UnicodeDecodeError):
+        return False
+    return len(want) == 64 and want == got
+
+
+def _discard(path: Path) -> None:
+    """Remove a damaged module and its digest (another process may be replacing them: errors are ignored)."""
+    for p in (path, _digest_path(path)):
+        with contextlib.suppress(OSError):
+            p.unlink()
 
 
 def _load(path: Path, module: str, shape) -> object:
@@ -320,12 +426,13 @@ def _load(path: Path, module: str, shape) -> object:
 
 def _compile(argv: list[str], source: str, path: Path) -> None:
     """Compile ``source`` to ``path``: in a temporary folder beside it, then ``os.replace`` (atomic: a process that
-    compiles the same key at once replaces the file with identical bytes; one that loaded it keeps its copy)."""
+    compiles the same key at once replaces the file with identical bytes; one that loaded it keeps its copy). The
+    module's SHA-256 goes beside it (``.sha256``, moved into place after the module): :func:`_verified` loads
+    nothing else. The compiler runs for at most :data:`COMPILE_SECONDS` (TimeoutError after that)."""
     import shutil
-    import subprocess
     import tempfile
 
-    path.parent.mkdir(parents=True, exist_ok=True, mode=0o700)
+    _ready_dir(path.parent)
     now = time.time()
     for old in path.parent.glob(".build-*"):  # left by a process that ended while compiling (a daemon thread)
         with contextlib.suppress(OSError):
@@ -334,13 +441,16 @@ def _compile(argv: list[str], source: str, path: Path) -> None:
     tmp = Path(tempfile.mkdtemp(prefix=".build-", dir=path.parent))
     try:
         (tmp / "m.c").write_text(source, encoding="utf-8")
-        p = subprocess.run(
-            [*argv, str(tmp / "m.c"), "-o", str(tmp / path.name), "-lm"], capture_output=True, text=True, timeout=300
-        )
-        if p.returncode != 0:
-            raise OSError(f"the C compiler failed: {(p.stderr or p.stdout).strip()[-300:]}")
-        os.chmod(tmp / path.name, 0o755)
-        os.replace(tmp / path.name, path)
+        rc, out = _run([*argv, str(tmp / "m.c"), "-o", str(tmp / path.name), "-lm"], COMPILE_SECONDS)
+        if rc != 0:
+            raise OSError(f"the C compiler failed: {out.strip()[-300:]}")
+        built = tmp / path.name
+        os.chmod(built, 0o755)
+        digest = tmp / (path.name + ".sha256")
+        digest.write_text(hashlib.sha256(built.read_bytes()).hexdigest() + "\n", encoding="ascii")
+        os.chmod(digest, 0o644)
+        os.replace(built, path)
+        os.replace(digest, _digest_path(path))
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
@@ -374,6 +484,7 @@ class NativeSingle:
         argv, about = toolchain()
         if argv is None:
             raise ValueError(about)
+        _ready_dir(_cache_dir())
         if self._module is None:
             text = self._key_text or c_source(*self._pieces)
             self._module = "_kinlib_" + hashlib.sha256("\0".join([_GENERATOR, text, about]).encode()).hexdigest()[:32]
@@ -394,14 +505,19 @@ class NativeSingle:
         except ValueError as e:
             self.status = f"Python: {e}"
             return False
+        rebuilt = ""
         with _lock:
             fn = _loaded.get(module)
-            if fn is None and _safe(path):
+            if fn is None and _verified(path):
                 try:
                     fn = _loaded[module] = _load(path, module, self.shape)
                     self.status = f"C (loaded from {path})"
                 except (ImportError, OSError) as e:
                     self.status = f"Python: {path} could not be loaded ({e})"
+            elif fn is None and (path.exists() or _digest_path(path).exists()):
+                rebuilt = "; the cached copy failed its check and was rebuilt"
+                if _safe(path) or not path.exists():  # ours but damaged: rebuild (another user's file: never touch)
+                    _discard(path)
         if fn is not None:
             return self._ready(fn, on_ready)
         if not wait:
@@ -415,7 +531,7 @@ class NativeSingle:
                     _compile(argv, self.source(), path)
                     with _lock:
                         fn = _loaded[module] = _load(path, module, self.shape)
-                    self.status = f"C (compiled into {path})"
+                    self.status = f"C (compiled into {path}{rebuilt})"
         except (OSError, ImportError, ValueError, TimeoutError) as e:
             self.status = f"Python: {e}"
             return False

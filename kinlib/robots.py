@@ -228,8 +228,9 @@ def puma560(a2=None, d3=None, a3=None, d4=None) -> SerialChain:
     long). At θ = 0 the upper arm lies along x_s, the forearm points up, the tool is at the wrist centre
     (a2 + a3, −d3, d4). The space screw axes come from the DH frames at θ = 0 (joint i turns about z_{i−1}).
     Shoulder singularity: a2 cos θ2 + a3 cos(θ2 + θ3) − d4 sin(θ2 + θ3) = 0 (the wrist centre over the line
-    of joint 1's axis in the arm's plane; on that axis when d3 = 0); elbow: a3 cos θ3 − d4 sin θ3 = 0; wrist:
-    sin θ5 = 0. Pass symbols (``puma560(L, 0, 0, L)``) for a symbolic arm.
+    of joint 1's axis in the arm's plane; on that axis when d3 = 0); elbow: a3 sin θ3 + d4 cos θ3 = 0 (the
+    wrist centre on the line of the upper arm: the arm stretched out or folded back); wrist: sin θ5 = 0 (the
+    factors of det J of the geometric Jacobian, :func:`~kinlib.singularities.singular_configurations`). Pass symbols (``puma560(L, 0, 0, L)``) for a symbolic arm.
 
     >>> import sympy as sp
     >>> r = puma560()

@@ -199,7 +199,9 @@ class SingularSet(list):
 
     It is a plain list otherwise: ``conds == []``, ``conds[0]``, ``len(conds)`` work as before, and it prints
     as a list (so SymPy's notebook printing typesets it); an incomplete answer is announced by an
-    :class:`IncompleteResultWarning` carrying the note when it is made.
+    :class:`IncompleteResultWarning` carrying the note when it is made. An incomplete answer equals no list
+    (``==`` is False even against the same conditions): "no singular configuration" can only be read off a
+    complete one, so a test or a caller that compares with ``[]`` cannot mistake giving up for an answer.
 
     >>> import sympy as sp
     >>> from kinlib.robots import planar_2r
@@ -209,12 +211,24 @@ class SingularSet(list):
     ([{theta2: ImageSet(Lambda(k, pi*k), Integers)}], True, 'from the factors of det J')
     >>> conds[0] == {r.thetas[1]: periodic_family([0, sp.pi])}   # a plain list otherwise
     True
+    >>> SingularSet([], complete=False) == [], SingularSet([], complete=False) != []
+    (False, True)
     """
+
+    __hash__ = None  # a list: unhashable
 
     def __init__(self, conditions=(), complete: bool = True, note: str = ""):
         super().__init__(conditions)
         self.complete = bool(complete)
         self.note = note
+
+    def __eq__(self, other):
+        if not self.complete or (isinstance(other, SingularSet) and not other.complete):
+            return False  # what was found is not the answer: it equals nothing, itself included
+        return list.__eq__(self, other)
+
+    def __ne__(self, other):
+        return not self == other
 
 
 class IncompleteResultWarning(UserWarning):

@@ -37,6 +37,7 @@ from ._backend import (
     is_symbolic,
     numeric_jacobian,
     numeric_vectors,
+    within_float_range,
 )
 from .budget import ExactTimeoutError, OutOfTime, budget_seconds, within
 from .display import readable, readable_ratio
@@ -409,7 +410,7 @@ def damped_least_squares(J: Any, V: Any, damping: Any, *, time_budget=TIME_BUDGE
                 seconds,
                 "the closed form in the joint symbols grows fast: give J at a configuration (exact values) or floats",
             ) from None
-    lam = float(_damping(damping))
+    lam = within_float_range(_damping(damping), "damping")
     A = numeric_jacobian(J)
     v = numeric_vectors(V, "V", A.shape[-2], "a twist (the rows of J)")
     if lam == 0:

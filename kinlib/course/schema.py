@@ -53,6 +53,8 @@ __all__ = [
     "cell_meta",
     "cell_part",
     "cell_answers",
+    "cell_reveals",
+    "students_markdown",
     "answer_kind",
     "grading_kind",
     "PROPERTIES",
@@ -158,6 +160,38 @@ def cell_part(meta: dict, default: str = "") -> str:
     """
     part = meta.get("part")
     return str(part) if part is not None and str(part) else default
+
+
+def cell_reveals(cell) -> list[str]:
+    """The graded parts a cell states the answer of (``"kinlib": {"reveals": ["5.1", ...]}``), as strings; [] when
+    it states none. Every students' file leaves such a cell out, shows its ``students`` markdown instead, or (a
+    picture) shows it without what answers those parts: :mod:`kinlib.course.publish.handouts`, ``notebooks/README.md``.
+
+    >>> cell_reveals({"metadata": {"kinlib": {"reveals": ["5.1", 6.1]}}}), cell_reveals({"metadata": {}})
+    (['5.1', '6.1'], [])
+    >>> cell_reveals({"metadata": {"kinlib": {"reveals": "5.1"}}})
+    ['5.1']
+    """
+    got = cell_meta(cell).get("reveals")
+    if got is None or got == "":
+        return []
+    items = [got] if isinstance(got, (str, int, float)) else got if isinstance(got, (list, tuple)) else []
+    return [str(x) for x in items if str(x)]
+
+
+def students_markdown(cell) -> str | None:
+    """The students' version of a markdown cell that ``reveals`` a graded answer (its ``kinlib.students`` text),
+    or None (then the students' files leave the cell out).
+
+    >>> students_markdown({"metadata": {"kinlib": {"reveals": ["1.3"], "students": "Which $n$? See 1.3."}}})
+    'Which $n$? See 1.3.'
+    >>> students_markdown({"metadata": {"kinlib": {"reveals": ["1.3"]}}}) is None
+    True
+    """
+    text = cell_meta(cell).get("students")
+    if isinstance(text, list):
+        text = "".join(str(x) for x in text)
+    return text if isinstance(text, str) and text.strip() else None
 
 
 def cell_answers(meta: dict) -> list[str]:

@@ -8,11 +8,13 @@ JupyterLite, the static pages and the PDF: :mod:`kinlib.widgets.explorer`):
   σ_min/σ_max and the singular set on the sliders;
 * :func:`animate_singularity` — the arm along a path through a singular configuration (problem 5.2), played
   and scrubbed step by step, beside the manipulability along the path;
-* :func:`config_picker` — named configurations (problem 4.1) and each joint's contribution to a row of J.
+* :func:`config_picker` — named configurations (problem 4.1) and each joint's contribution to a row of J;
+* :func:`without_answers` — the students' version of any of them: nothing that answers a graded part (the
+  singular set on the sliders, the state, det J, the manipulability and its maximum) is shown or sent.
 """
 
 from .animation import SingularityAnimation, animate_singularity
-from .explorer import FRONT_END, Explorer, classify_families, explorer
+from .explorer import FRONT_END, Explorer, classify_families, explorer, without_answers
 from .picker import ConfigPicker, config_picker
 
 __all__ = [
@@ -23,5 +25,6 @@ __all__ = [
     "config_picker",
     "ConfigPicker",
     "classify_families",
+    "without_answers",
     "FRONT_END",
 ]

@@ -11,6 +11,12 @@
   function readout(X, k, st) {
     var S = X.S, sing = st.state === "singular", L = [];
     L.push("step <span class='kinlib-step-no'>" + (k + 1) + "</span> of " + X.N + ": θ = " + thetas(st.q));
+    if (S.answers === false) { // the students' version: the arm and its ellipse, no state or manipulability
+      L.push("velocity ellipse semi-axes: <span class='kinlib-held'>" + lengths((st.held || st.free).s) + "</span>");
+      X.readout.innerHTML = L.join("<br>");
+      F.banner(X.status, S, st);
+      return;
+    }
     L.push(S.wLabel + " = <span class='kinlib-w'>" + (sing ? "0" : st.w.toFixed(4)) + "</span> (" + (sing ? "0" : (100 * st.w / S.wMax).toFixed(1)) +
       "% of its largest value " + S.wMax.toFixed(4) + "; near below " + (100 * S.near.ratio) + "%)");
     if (st.det !== null) L.push("det J = <span class='kinlib-det'>" + (sing ? "0" : (st.det >= 0 ? "+" : "") + fmt(st.det, 4)) + "</span>");
@@ -58,7 +64,7 @@
     F.picture(X, root, "drawing of " + S.title);
     var side = el("div", {class: "kinlib-side", style: "width:214px"}, root);
     F.armLegend(S, el("ul", {class: "kinlib-legend", "aria-label": "legend"}, side));
-    chart(X, side);
+    if (S.answers !== false) chart(X, side); else X.place = function () {};
     F.orbit(X, side, function () { F.draw(X, X.st); });
     // controls: play/pause, a step back/forward, the step slider
     var ctl = el("div", {class: "kinlib-controls"}, root);
@@ -100,18 +106,24 @@
     };
     X.pause = function () {
       if (X.timer === null) return;
-      clearInterval(X.timer); X.timer = null;
+      clearTimeout(X.timer); X.timer = null;
       play.textContent = "▶ play"; play.setAttribute("aria-label", "play"); play.setAttribute("aria-pressed", "false");
       say(X.k, X.st);
     };
+    // playing: S.interval ms per step, S.dwell ms on a singular step (time to look at it), and it stops at the last
+    // step unless S.loop (a student's pace; no endless motion by default)
     X.play = function () {
       if (X.timer !== null) return;
       play.textContent = "❚❚ pause"; play.setAttribute("aria-label", "pause"); play.setAttribute("aria-pressed", "true");
       if (X.k === X.N - 1) X.go(0, true);
-      X.timer = setInterval(function () {
+      function wait() { return X.st && X.st.state === "singular" ? Math.max(S.dwell || 0, S.interval) : S.interval; }
+      function tick() {
         if (!root.isConnected) { X.pause(); return; } // the output was cleared
+        if (X.k === X.N - 1 && !S.loop) { X.pause(); return; }
         X.go(X.k + 1, true);
-      }, S.interval);
+        X.timer = setTimeout(tick, wait());
+      }
+      X.timer = setTimeout(tick, wait());
     };
     play.addEventListener("click", function () { if (X.timer === null) X.play(); else X.pause(); });
     prev.addEventListener("click", function () { X.pause(); X.go(X.k - 1); });

@@ -39,7 +39,8 @@ class SingularityAnimation(Explorer):
     """The animation made by :func:`animate_singularity` (an :class:`~kinlib.widgets.Explorer` without
     sliders, driven along ``path``): ``path`` (N×n), ``values`` (the manipulability √det(J Jᵀ) of the task
     ``rows`` at each step), ``states`` (each step's 'singular', 'near' or 'regular', by the explorer's rules,
-    which the browser applies too), ``interval`` (ms per step while playing), ``spec``/``javascript`` (what the
+    which the browser applies too), ``interval`` (ms per step while playing; ``dwell`` ms on a singular step; it stops
+    at the last step unless ``loop``), ``spec``/``javascript`` (what the
     browser gets).
 
     >>> from kinlib.robots import planar_2r
@@ -51,8 +52,8 @@ class SingularityAnimation(Explorer):
     entry = "animation"
 
     # fmt: off
-    def __init__(self, chain, path, *, rows=None, ellipse_rows=None, params=None, interval=100, velocity_scale=0.5,
-                 title=None, size=420, singular_budget=None, figsize=None, dpi=None):
+    def __init__(self, chain, path, *, rows=None, ellipse_rows=None, params=None, interval=700, dwell=2500, loop=False,
+                 velocity_scale=0.5, title=None, size=420, singular_budget=None, figsize=None, dpi=None):
         # fmt: on
         del figsize, dpi  # the matplotlib animation's keywords: accepted, no meaning here
         chain = checked_numeric(chain, params)
@@ -64,6 +65,10 @@ class SingularityAnimation(Explorer):
             )
         if not isinstance(interval, (int, float)) or isinstance(interval, bool) or not 10 <= interval <= 10000:
             raise ValueError(f"interval must be a number of milliseconds in [10, 10000], got {describe(interval)}")
+        if not isinstance(dwell, (int, float)) or isinstance(dwell, bool) or not 0 <= dwell <= 60000:
+            raise ValueError(f"dwell must be a number of milliseconds in [0, 60000], got {describe(dwell)}")
+        if not isinstance(loop, bool):
+            raise TypeError(f"loop must be True or False, got {describe(loop)}")
         self.path = P
         super().__init__(
             chain, q=P[0], rows=rows, ellipse_rows=ellipse_rows, velocity_scale=velocity_scale, size=size,
@@ -78,7 +83,7 @@ class SingularityAnimation(Explorer):
         self.states = [self.update(q).state for q in P]
         self.update(P[0])
         self.spec.update(
-            path=P.tolist(), interval=self.interval, wLabel=measure_label("yoshikawa", len(self.rows), chain.n),
+            path=P.tolist(), interval=self.interval, dwell=float(dwell), loop=loop, wLabel=measure_label("yoshikawa", len(self.rows), chain.n),
             rowsLabel=rows_label(self.rows),
         )  # fmt: skip
 
@@ -94,14 +99,19 @@ class SingularityAnimation(Explorer):
 
         from ..plotting import draw_chain, draw_velocity_ellipses
 
-        fig = Figure(figsize=(8, 3.6), dpi=60)
+        fig = Figure(figsize=(8, 3.6) if self.answers else (4.4, 3.6), dpi=60)
         FigureCanvasAgg(fig)
-        ax = fig.add_subplot(1, 2, 1, projection=None if self.planar else "3d")
+        ax = fig.add_subplot(1, 2 if self.answers else 1, 1, projection=None if self.planar else "3d")
         lo, hi = self.path.min(axis=0), self.path.max(axis=0)
         draw_chain(self.chain, self.path[0], ax, ranges=[(a - 1e-6, b + 1e-6) for a, b in zip(lo, hi)],
                    labels=True, title=self.spec["title"])  # fmt: skip
         draw_velocity_ellipses(ax, self.chain, self.path[0], task=self.rows, rows=self.ellipse_rows,
                                scale=self.spec["velScale"])  # fmt: skip
+        if not self.answers:  # the students' version: no manipulability along the path (it shows the singular step)
+            fig.tight_layout()
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png")
+            return buf.getvalue()
         ax2 = fig.add_subplot(1, 2, 2)
         ax2.plot(np.arange(len(self.values)), self.values, lw=2)
         ax2.plot([0], [self.values[0]], "o", color="tab:red", ms=8)
@@ -115,9 +125,10 @@ class SingularityAnimation(Explorer):
         return buf.getvalue()
 
     def _repr_mimebundle_(self, **kwargs):
+        counts = f"{self.states.count('singular')} singular, {self.states.count('near')} near; " if self.answers else ""
         text = (
             f"animation of {self.chain.name} along a path of {len(self.path)} configurations "
-            f"({self.states.count('singular')} singular, {self.states.count('near')} near; run the cell to play it)"
+            f"({counts}run the cell to play it)"
         )
         return {
             "application/javascript": self.javascript,
@@ -138,7 +149,9 @@ def animate_singularity(chain, path, **kwargs) -> SingularityAnimation:
     """A :class:`SingularityAnimation` of ``chain`` following ``path`` (N×n configurations, e.g. from
     :func:`kinlib.plotting.sweep`); display it as the last expression of a cell. Keywords: ``rows`` (task rows of
     the manipulability and the state; default the chain's task space), ``ellipse_rows``, ``velocity_scale`` (display
-    factor of the ellipses, 0.5), ``interval`` (ms per step when playing, 100), ``title``, ``size`` (the drawing
+    factor of the ellipses, 0.5), ``interval`` (ms per step when playing, 700: a pace a student can follow),
+    ``dwell`` (ms the player stays on a singular step, 2500), ``loop`` (False: playing stops at the last step),
+    ``title``, ``size`` (the drawing
     in pixels), ``params``, ``singular_budget``; ``figsize`` and ``dpi`` are accepted and ignored.
 
     >>> from kinlib.robots import planar_2r

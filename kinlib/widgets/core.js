@@ -113,6 +113,7 @@
     var cond = exactSingular(S, q);
     var rankLost = !S.complete && sLast <= S.near.rtol * smax;
     var state = cond >= 0 || rankLost ? "singular" : (wRatio < S.near.ratio ? "near" : "regular");
+    if (S.answers === false) state = "unmarked"; // the students' version: no state is told (kinlib.widgets.without_answers)
     // ellipses: ṗ (the drawn rows) with the task's orientation rows held, and with every joint free
     var Jp = rowsOf(J, n, S.ellRows), d = S.ellRows.length;
     function ellipse(A) {
@@ -131,7 +132,7 @@
     }
     var main = held || free, smin = main.s[d - 1], smx = main.s[0];
     var mratio = smx > 0 ? smin / smx : 0;
-    var block = (state !== "regular" && mratio < 0.35) ? main.U[d - 1] : null;
+    var block = (state !== "regular" && state !== "unmarked" && mratio < 0.35) ? main.U[d - 1] : null;
     var v = Jp.map(function (r) { var s = 0; for (var k = 0; k < n; k++) s += r[k] * qd[k]; return s; });
     var axes = []; // each joint's axis in space: ω_i (revolute) or the direction of ṗ_i (prismatic)
     for (i = 0; i < n; i++) {
@@ -283,6 +284,10 @@
 
   function words(S, st) {
     var parts = [];
+    if (st.state === "unmarked") { // the students' version: what the drawing shows, no state
+      var e = st.held || st.free;
+      return "Velocity ellipse semi-axes " + lengths(e.s) + ".";
+    }
     if (st.state === "singular") parts.push("Singular configuration: J loses rank (rank " + st.rank + " of " + st.full + ").");
     else if (st.state === "near") parts.push("Near a singular configuration: the manipulability is " + fmt(st.wRatio, 3) + " of its largest value, below " + S.near.ratio + ".");
     else parts.push("Regular configuration: full rank " + st.full + ".");
@@ -314,7 +319,12 @@
     ".kinlib-ui .kinlib-player{margin:6px 0}.kinlib-ui .kinlib-player input[type=range]{width:300px}" +
     ".kinlib-ui .kinlib-chart{display:block;margin-top:8px}.kinlib-ui table{border-collapse:collapse;margin-top:6px}" +
     ".kinlib-ui td,.kinlib-ui th{padding:0 8px;text-align:right;font-family:monospace}" +
-    "@media print{.kinlib-ui .kinlib-track,.kinlib-ui .kinlib-orbit,.kinlib-ui .kinlib-sr,.kinlib-ui .kinlib-player{display:none}}";
+    // narrow screens (a phone): the drawing scales to its container and comes first, the sliders just under it
+    ".kinlib-ui .kinlib-controls,.kinlib-ui .kinlib-side{max-width:100%}.kinlib-ui .kinlib-track{max-width:100%}.kinlib-ui input[type=range]{max-width:100%}" +
+    ".kinlib-ui figure.kinlib-figure{margin:0;min-width:0;max-width:100%}.kinlib-ui svg.kinlib-picture{width:100%;height:auto}" +
+    "@media (max-width:760px){.kinlib-ui figure.kinlib-figure{order:-1}}" +
+    // printed: no slider, so no slider legend either
+    "@media print{.kinlib-ui .kinlib-track,.kinlib-ui .kinlib-orbit,.kinlib-ui .kinlib-sr,.kinlib-ui .kinlib-player,.kinlib-ui .kinlib-mark-legend{display:none}}";
 
   function legendItem(ul, text, attrs, fill) {
     var li = el("li", {}, ul), s = svg("svg", {width: 30, height: 12, "aria-hidden": "true"}, li);
@@ -337,7 +347,7 @@
   }
   // the picture: an SVG of S.size px, its grid (2-D: ticks in world units) and the scene group that is redrawn
   function picture(X, parent, label) {
-    var S = X.S, fig = el("figure", {style: "margin:0"}, parent);
+    var S = X.S, fig = el("figure", {class: "kinlib-figure", style: "flex:0 1 " + S.size + "px"}, parent);
     var sv = svg("svg", {width: S.size, height: S.size, viewBox: "0 0 " + S.size + " " + S.size, role: "img",
       "aria-label": label + (S.planar ? "" : " (drag, or focus and use the arrow keys, to turn the view)"),
       class: "kinlib-picture", style: "background:#fff;outline:1px solid #ddd;touch-action:none;display:block", tabindex: S.planar ? null : 0}, fig);
@@ -395,11 +405,12 @@
         legendItem(ul, "ṗ with " + S.hold.map(function (r) { return ROWNAMES[r]; }).join(", ") + " held (×" + S.velScale + ")", {stroke: C.held}, C.heldFill);
         legendItem(ul, "ṗ, all joints free (×" + S.velScale + ")", {stroke: C.free, "stroke-width": 1.3, "stroke-dasharray": "5 3"});
       } else legendItem(ul, "velocity ellipse (×" + S.velScale + ")", {stroke: C.held}, C.heldFill);
-      legendItem(ul, "direction the tool cannot move", {stroke: C.block, "stroke-width": 2.5, "stroke-dasharray": "9 4 2 4"});
+      if (S.answers !== false) legendItem(ul, "direction the tool cannot move", {stroke: C.block, "stroke-width": 2.5, "stroke-dasharray": "9 4 2 4"}); // (never drawn in the students' version)
     }
   }
   // the banner: the state (data-state) in words
   function banner(status, S, st) {
+    if (st.state === "unmarked") { status.setAttribute("data-state", "unmarked"); status.textContent = ""; return; }
     var msg = st.state === "singular"
       ? "SINGULAR configuration: J loses rank (rank " + st.rank + " of " + st.full + ")" + (st.block ? "; the tool cannot move along the red dash-dot line" : "")
       : st.state === "near" ? "near a singular configuration: some directions need large joint rates"

@@ -9,6 +9,15 @@
   function readout(X, st) {
     var S = X.S, sing = st.state === "singular", L = [];
     L.push("task rows of J: (" + S.rows.map(function (r) { return ROWNAMES[r]; }).join(", ") + ")");
+    if (S.answers === false) { // the students' version: no det J, manipulability, σ or rank (kinlib.widgets.without_answers)
+      if (st.held) L.push("ṗ ellipse, " + S.hold.map(function (r) { return ROWNAMES[r]; }).join(", ") + " held: semi-axes <span class='kinlib-held'>" + lengths(st.held.s) + "</span>");
+      else L.push("velocity ellipse semi-axes: <span class='kinlib-held'>" + lengths(st.free.s) + "</span>");
+      if (S.showVelocity) L.push("ṗ = (" + st.v.map(function (x) { return (x >= 0 ? "+" : "") + x.toFixed(3); }).join(", ") + ")");
+      X.readout.innerHTML = L.join("<br>");
+      F.banner(X.status, S, st);
+      X.live.textContent = words(S, st);
+      return;
+    }
     if (st.det !== null) L.push("det J = <span class='kinlib-det'>" + (sing ? "0" : (st.det >= 0 ? "+" : "") + fmt(st.det, 4)) + "</span>");
     L.push("manipulability " + (S.n < S.rows.length ? "√det(JᵀJ)" : "√det(JJᵀ)") + " = <span class='kinlib-w'>" + (sing ? "0" : st.w.toFixed(4)) + "</span>" +
       (S.showMaximum ? " (" + (sing ? "0" : (100 * st.w / S.wMax).toFixed(1)) + "% of its maximum " + S.wMax.toFixed(4) + ")" : ""));
@@ -96,7 +105,7 @@
     var side = el("div", {class: "kinlib-side", style: "width:210px"}, root);
     var ul = el("ul", {class: "kinlib-legend", "aria-label": "legend"}, side);
     F.armLegend(S, ul);
-    el("li", {}, ul).innerHTML = "<span style='color:" + C.mark + "'>▲</span> on a slider: singular there";
+    if (S.answers !== false) el("li", {class: "kinlib-mark-legend"}, ul).innerHTML = "<span style='color:" + C.mark + "'>▲</span> on a slider: singular there";
     F.orbit(X, side, function () { draw(X, X.st); });
     update(X);
     root.kinlib = X; // for tests and scripts: the state, and set(q) to move the arm

@@ -49,6 +49,7 @@ colours that differ in lightness and line style. HTML hooks for tests: ``.kinlib
 from __future__ import annotations
 
 import base64
+import copy
 import io
 import math
 from pathlib import Path
@@ -64,7 +65,7 @@ from ..singularities import singular_configurations
 from ..taskspace import default_task_rows, is_planar, task_row_indices, task_rows
 from .frontend import script, square_view
 
-__all__ = ["explorer", "Explorer", "classify_families", "FRONT_END"]
+__all__ = ["explorer", "Explorer", "classify_families", "without_answers", "FRONT_END"]
 
 #: the explorer's part of the front end (beside it: core.js, the part every picture shares)
 FRONT_END = Path(__file__).with_name("explorer.js")
@@ -244,6 +245,35 @@ class Explorer:
 
     #: the picture's part of the front end (:data:`kinlib.widgets.frontend.ENTRIES`)
     entry = "explorer"
+    #: False in the students' version (:meth:`without_answers`): nothing that answers a graded part is shown or sent
+    answers = True
+
+    def without_answers(self):
+        """The students' version of this picture (a new object; this one is unchanged): the same arm, sliders,
+        velocity ellipses and ṗ arrow, and nothing that answers a graded part, neither shown nor in the data sent
+        to the browser (a student can read the script): no singular marks on the tracks and no closed-form
+        singular set (its families and generated conditions), no status banner or live sentence of "singular"
+        or "near", no det J, manipulability, σ or rank readout, no largest manipulability (w_max), no direction
+        the tool cannot move. ``kinlib handouts`` shows it on the problem pages and in the workbooks for a cell
+        whose metadata says ``"kinlib": {"reveals": [...]}`` (``notebooks/README.md``).
+
+        >>> from kinlib.robots import planar_2r
+        >>> ex = explorer(planar_2r(1, 1), q=[0.3, 0.0]).without_answers()
+        >>> ex.spec["conditions"], ex.spec["wMax"], ex.spec["answers"], "singular" in ex._repr_mimebundle_()["text/plain"]
+        ([], 0.0, False, False)
+        """
+        other = copy.copy(self)
+        other.answers = False
+        other.spec = self._students_spec()
+        other._funcs = list(self._funcs[:2])  # skel and jg: no generated singular condition
+        other._exprs = []
+        other.conditions, other.complete = [], False
+        return other
+
+    def _students_spec(self) -> dict:
+        spec = dict(self.spec)
+        spec.update(answers=False, conditions=[], complete=False, showMaximum=False, wMax=0.0)
+        return spec
 
     @property
     def javascript(self) -> str:
@@ -310,7 +340,8 @@ class Explorer:
 
     def _repr_mimebundle_(self, **kwargs):
         q = ", ".join(f"{x:.3f}" for x in self.q)
-        text = f"explorer of {self.chain.name} at θ = ({q}): {self.state} configuration (run the cell for sliders)"
+        state = f": {self.state} configuration" if self.answers else ""
+        text = f"explorer of {self.chain.name} at θ = ({q}){state} (run the cell for sliders)"
         return {
             "application/javascript": self.javascript,
             "image/png": base64.b64encode(self._static_png()).decode("ascii"),
@@ -339,6 +370,26 @@ def explorer(chain, **kwargs) -> Explorer:
     ((3, 4), 'singular', 1)
     """
     return Explorer(chain, **kwargs)
+
+
+def without_answers(picture):
+    """The students' version of an explorer, animation or configuration picker (``picture.without_answers()``):
+    the same picture without whatever answers a graded part (see :meth:`Explorer.without_answers`). Display it
+    as the last expression of a cell; ``kinlib handouts`` uses it for the cells whose metadata says
+    ``"kinlib": {"reveals": [...]}``. Anything else is refused:
+
+    >>> without_answers(42)
+    Traceback (most recent call last):
+        ...
+    TypeError: without_answers() takes an explorer, an animation or a configuration picker (kinlib.widgets), got int 42
+    """
+    method = getattr(type(picture), "without_answers", None)
+    if method is None or not callable(method):
+        raise TypeError(
+            "without_answers() takes an explorer, an animation or a configuration picker (kinlib.widgets), "
+            f"got {describe(picture)}"
+        )
+    return picture.without_answers()
 
 
 def _without_exact_rank_test(state: str, complete: bool) -> str:

@@ -81,7 +81,7 @@
     });
     F.picture(X, root, "drawing of " + S.title + " with each joint's velocity arrow at the tool");
     var side = el("div", {class: "kinlib-side", style: "width:300px"}, root);
-    X.chart = svg("svg", {width: 300, height: 220, class: "kinlib-chart", role: "img", "aria-label": "each joint's contribution to the chosen row"}, side);
+    X.chart = S.answers === false ? null : svg("svg", {width: 300, height: 220, class: "kinlib-chart", role: "img", "aria-label": "each joint's contribution to the chosen row"}, side);
     X.table = el("div", {class: "kinlib-readout"}, side);
     var ul = el("ul", {class: "kinlib-legend", "aria-label": "legend"}, side);
     F.legendItem(ul, "arm (joints: ○ revolute, □ prismatic)", {stroke: C.arm, "stroke-width": 4});
@@ -102,6 +102,13 @@
       var best = strongest(c), lab = S.rowNames[cf.row];
       X.contributions = c; X.best = best;
       redraw();
+      if (S.answers === false) { // the students' version: the arrows only, no bars, table or "largest" (problem 4.1)
+        X.buttons.forEach(function (b, j) { b.setAttribute("aria-pressed", String(j === k)); b.classList.toggle("mod-active", j === k); });
+        X.table.innerHTML = "<div>θ = (" + cf.q.map(function (x) { return x.toFixed(4); }).join(", ") + ")</div>";
+        X.live.textContent = "Configuration " + cf.name + ".";
+        root.setAttribute("data-config", cf.name);
+        return X;
+      }
       bars(X, c, cf.row, cf.name);
       X.buttons.forEach(function (b, j) { b.setAttribute("aria-pressed", String(j === k)); b.classList.toggle("mod-active", j === k); });
       var who = best.length === 1 ? "joint " + best[0] : "a tie between joints " + best.join(" and ");

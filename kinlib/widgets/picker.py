@@ -54,6 +54,25 @@ class ConfigPicker:
     """
 
     entry = "picker"
+    #: False in the students' version (:meth:`without_answers`)
+    answers = True
+
+    def without_answers(self):
+        """The students' version (a new object): the buttons, the arm and each joint's velocity arrow, without the
+        bar chart, the table of contributions and the sentence naming the largest (what problem 4.1 asks); see
+        :meth:`kinlib.widgets.Explorer.without_answers`.
+
+        >>> from kinlib.robots import planar_3r
+        >>> cp = config_picker(planar_3r(1, 1, 1), {"a": [0.1, 0.2, 0.3]}).without_answers()
+        >>> cp.spec["answers"], "largest" in cp._repr_mimebundle_()["text/plain"]
+        (False, False)
+        """
+        import copy
+
+        other = copy.copy(self)
+        other.answers = False
+        other.spec = {**self.spec, "answers": False}
+        return other
 
     def __init__(self, chain, configs: Mapping, *, rows="vx", params=None, scale=1.0, title=None, size=420, **legacy):
         unknown = set(legacy) - {"figsize", "dpi"}  # the matplotlib picker's keywords: accepted, no meaning here
@@ -146,12 +165,17 @@ class ConfigPicker:
         from ..plotting import draw_chain, draw_joint_velocities
 
         q, row, v = self.configs[self.name], self.rows[self.name], self.spec["view"]
-        fig = Figure(figsize=(9.5, 4.3), dpi=60)
+        fig = Figure(figsize=(9.5, 4.3) if self.answers else (4.8, 4.3), dpi=60)
         FigureCanvasAgg(fig)
-        ax = fig.add_subplot(1, 2, 1, projection=None if self.planar else "3d")
+        ax = fig.add_subplot(1, 2 if self.answers else 1, 1, projection=None if self.planar else "3d")
         lim = [[v["x0"], v["x1"]], [v["y0"], v["y1"]]] if self.planar else [[c - v["r"], c + v["r"]] for c in v["c"]]
         draw_chain(self.chain, q, ax, limits=np.array(lim), title=self.spec["title"])
         draw_joint_velocities(ax, self.chain, q, scale=self.scale)
+        if not self.answers:  # the students' version: no bar chart of the contributions
+            fig.tight_layout()
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png")
+            return buf.getvalue()
         bar = fig.add_subplot(1, 2, 2)
         n, c = self.chain.n, self.contributions
         bar.bar(np.arange(1, n + 1), c, color=self.spec["colors"])

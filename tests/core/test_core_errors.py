@@ -451,3 +451,31 @@ def test_every_message_has_a_got():
             call()
         msg = str(info.value)
         assert "got" in msg or "give them numbers" in msg or "no parameter" in msg, f"{label}: {msg}"
+
+
+def test_exact_unit_axes_with_pi_and_constant_condition_numbers():
+    """issue 32: an exact unit axis with π in it (1/(1 + π²) is not algebraic) is checked, not a SymPy-internal
+    CoercionFailed; a constant exact 3×3 J with sines of numbers gets κ (60-digit, flagged) or ∞ exactly, never the
+    advice to give what it already is."""
+    import warnings
+
+    from kinlib import condition_number, exp3, screw_revolute
+    from kinlib.fallback import NumericFallbackWarning
+
+    n = sp.sqrt(sp.pi**2 + 1)
+    axis = [sp.pi / n, 1 / n, 0]
+    R = exp3(axis, sp.Rational(1, 2))
+    assert sp.simplify(R.T * R - sp.eye(3)) == sp.zeros(3) and sp.simplify(R.det()) == 1
+    assert screw_revolute(axis, [1, sp.pi, 0])[:3, 0] == sp.Matrix(axis)
+    with pytest.raises(ValueError, match="unit vector"):
+        exp3([sp.pi / n, 2 / n, 0], 1)
+    r = robots.planar_3r(1, 1, 1)
+    q = [sp.Integer(1), sp.Integer(2), sp.Rational(1, 3)]
+    J = r.jacobian_geometric(q)[[3, 4, 2], :]  # ṗx, ṗy, ωz: square
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        k = condition_number(J)
+    assert any(w.category is NumericFallbackWarning for w in caught)
+    assert abs(float(k) - np.linalg.cond(np.array(J.evalf(30), dtype=float))) < 1e-9
+    stretched = r.jacobian_geometric([sp.Integer(1), sp.Integer(0), sp.Integer(0)])[[3, 4, 2], :]
+    assert condition_number(stretched) == sp.oo  # decided exactly: det(J Jᵀ) = 0

@@ -578,6 +578,58 @@ def test_non_real_symbols_zero_d_arrays_and_ragged_lists_are_refused(case):
                 _refused_naming(case, values, k, f"{a.name} = {bad!r}")
 
 
+def _exact_anywhere(v) -> bool:
+    if isinstance(v, (sp.Basic, sp.MatrixBase)):
+        return True
+    if isinstance(v, (list, tuple)):
+        return any(_exact_anywhere(e) for e in v)
+    if isinstance(v, np.ndarray) and v.dtype == object:
+        return any(_exact_anywhere(e) for e in v.reshape(-1))
+    return isinstance(v, kinlib.SerialChain)
+
+
+@pytest.mark.parametrize("case", PARAMS)
+def test_integers_beyond_float_range_are_refused_by_the_float_backend(case):
+    """issue 32: an int such as 10**400 in any numeric argument slot (each entry in turn) raises a ValueError or
+    TypeError naming the argument, never a bare OverflowError. Only calls whose arguments are all numbers (the
+    float backend): with SymPy arguments an int of any size is an exact number."""
+    if any(_exact_anywhere(a.value) for a in case.args):
+        pytest.skip("an exact call: 10**400 is a valid exact number there")
+    for k, a in enumerate(case.args):
+        if not a.entries or isinstance(a.value, (str, dict)) or a.value is None:
+            continue
+        for path in _leaves(a.value):
+            if not isinstance(_get(a.value, path), (int, float, np.integer, np.floating)) or isinstance(
+                _get(a.value, path), bool
+            ):
+                continue
+            values = [copy.copy(x.value) for x in case.args]
+            values[k] = _set(a.value, path, 10**400)
+            name = a.msg or a.name
+            try:
+                out = _call(case, values)
+            except (ValueError, TypeError) as err:
+                assert _named(str(err), name), f"{case.label}: the message does not name {name!r}: {err}"
+                continue
+            # a chain is built from exact numbers, an exact value (subs of a configuration, a length) is exact:
+            # 10**400 is fine there; a float answer must refuse
+            assert isinstance(out, (kinlib.SerialChain, sp.Basic, sp.MatrixBase)), (
+                f"{case.label} with {a.name}{list(path)} = 10**400: {out}"
+            )
+            if (
+                isinstance(out, kinlib.SerialChain) and out.n and not out.params
+            ):  # and its float code then refuses what it cannot represent
+                with pytest.raises((ValueError, TypeError, OverflowError)) as caught:
+                    out.jacobian_geometric(np.zeros(out.n))
+                assert caught.type is not OverflowError, caught.value
+
+
+def _get(v, path):
+    for head in path:
+        v = v[head]
+    return v
+
+
 # ==========================================================================================================
 # Item 3: numbers typed by the student become exact when the chain is built
 # ==========================================================================================================

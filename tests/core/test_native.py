@@ -246,3 +246,124 @@ def test_the_joint_tables_are_the_urdf_files():
             if xml is None:
                 pytest.skip("example-robot-data is not installed (the bench extra)")
             assert urdf_arms.urdf_joints(xml, tip)[0] == tables[name]
+
+
+# --- the cache is untrusted input; the compiler cannot block (issue 32) ----------------------------------------
+_BUILD = r"""
+import sympy as sp
+from kinlib import native
+x0, q0 = sp.symbols("_x0 _q0")
+ns = native.NativeSingle([(x0, sp.cos(q0))], [x0, 2 * x0 - 1], 1, (1, 2), "truncation test")
+assert ns.build(), ns.status
+assert ns.fn([0.5]).tolist() == [[float(sp.cos(0.5)), 2 * float(sp.cos(0.5)) - 1]]
+print(ns._prepare()[2])
+print(ns.status)
+"""
+
+
+def test_a_damaged_cached_module_is_rebuilt_and_the_process_lives(tmp_path):
+    """A .so cut to 10-75 % of its size (dlopen of it kills the process with SIGBUS), one byte altered, its digest
+    missing or damaged: each is rebuilt by the next process, never loaded. Every process is a child: one that
+    loaded a damaged file would die (returncode -7) and fail the test, not kill this test process."""
+    import subprocess
+
+    env = {**os.environ, "KINLIB_CACHE": str(tmp_path / "cache")}
+
+    def next_process() -> tuple[Path, str]:
+        p = subprocess.run([sys.executable, "-c", _BUILD], capture_output=True, text=True, env=env, timeout=600)
+        assert p.returncode == 0, (p.returncode, p.stdout, p.stderr[-2000:])
+        path, status = p.stdout.strip().splitlines()[-2:]
+        return Path(path), status
+
+    path, status = next_process()
+    assert status.startswith("C (compiled into"), status
+    assert next_process()[1].startswith("C (loaded from"), "a sound module is loaded, not compiled again"
+    good = path.read_bytes()
+    digest = native._digest_path(path)
+    damages = [("cut to 10 %", lambda: path.write_bytes(good[: len(good) // 10]))]
+    damages += [("cut to 50 %", lambda: path.write_bytes(good[: len(good) // 2]))]
+    damages += [("cut to 75 %", lambda: path.write_bytes(good[: 3 * len(good) // 4]))]
+    damages += [("one byte altered", lambda: path.write_bytes(good[:999] + bytes([good[999] ^ 0xFF]) + good[1000:]))]
+    damages += [("its digest missing", digest.unlink), ("its digest cut", lambda: digest.write_text("ab12"))]
+    for what, damage in damages:
+        damage()
+        _, status = next_process()
+        assert status.startswith("C (compiled into") and "failed its check and was rebuilt" in status, (what, status)
+        assert native._verified(path), what
+
+
+def test_a_cache_folder_others_can_write_is_not_used(tmp_path, monkeypatch):
+    root = tmp_path / "shared-cache"
+    (root / "compiled").mkdir(parents=True)
+    os.chmod(root / "compiled", 0o777)
+    monkeypatch.setenv("KINLIB_CACHE", str(root))
+    x = sp.Symbol("x", real=True)
+    c = CompiledMatrix(sp.Matrix([[sp.sin(x)]]), [x])
+    assert c.compile_native() is False
+    assert "can be written by others" in c.native_status and "compiled" in c.native_status
+    assert float(c([0.5])[0, 0]) == float(np.sin(0.5))  # the Python code answers
+    assert list((root / "compiled").iterdir()) == []  # nothing written there
+    os.chmod(root / "compiled", 0o700)
+    os.chmod(root, 0o775)  # the parent group-writable: refused too (the group could swap the folder)
+    c = CompiledMatrix(sp.Matrix([[sp.sin(x)]]), [x])
+    assert c.compile_native() is False and "can be written by others" in c.native_status
+
+
+def _fake_compiler(tmp_path, body: str) -> Path:
+    cc = tmp_path / "slowcc"
+    cc.write_text("#!/bin/sh\n" + body)
+    cc.chmod(0o755)
+    return cc
+
+
+def _ended(pid: int) -> bool:
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            return f.read().split(") ")[1].startswith("Z")  # a zombie waiting for init to reap it: ended
+    except FileNotFoundError:
+        return True
+
+
+def _wait_ended(pidfile: Path) -> None:
+    """Every pid written to ``pidfile`` has ended (polled for up to 30 s: the kill is immediate, reaping by init is not)."""
+    pids = [int(p) for p in pidfile.read_text().split()]
+    assert pids
+    for _ in range(300):
+        if all(_ended(p) for p in pids):
+            return
+        threading.Event().wait(0.1)
+    raise AssertionError(f"still running: {[p for p in pids if not _ended(p)]}")
+
+
+def test_a_compiler_that_hangs_is_ended_with_its_children(tmp_path, monkeypatch):
+    """A compiler that never finishes (and started a child that would outlive it) is killed with its whole process
+    group after COMPILE_SECONDS; compile_native() returns False with the reason, and the Python code answers. The
+    limit is set to 1 s here; nothing asserts how long anything took."""
+    pids = tmp_path / "pids"
+    cc = _fake_compiler(
+        tmp_path,
+        f'if [ "$1" = --version ]; then echo fake-cc 1.0; exit 0; fi\nsleep 600 &\necho $! >> {pids}\necho $$ >> {pids}\nwait\n',
+    )
+    monkeypatch.setenv("CC", str(cc))
+    monkeypatch.setenv("KINLIB_CACHE", str(tmp_path / "cache"))
+    monkeypatch.setattr(native, "COMPILE_SECONDS", 1.0)
+    monkeypatch.setattr(native, "_toolchain_cache", {})
+    x = sp.Symbol("x", real=True)
+    c = CompiledMatrix(sp.Matrix([[sp.tan(x)]]), [x])
+    assert c.compile_native() is False
+    assert "did not finish in 1 s" in c.native_status, c.native_status
+    _wait_ended(pids)
+    assert float(c([0.5])[0, 0]) == float(np.tan(0.5))
+
+
+def test_a_compiler_whose_version_probe_hangs_is_not_used(tmp_path, monkeypatch):
+    pids = tmp_path / "pids"
+    cc = _fake_compiler(tmp_path, f"sleep 600 &\necho $! >> {pids}\nwait\n")
+    monkeypatch.setenv("CC", str(cc))
+    monkeypatch.setattr(native, "PROBE_SECONDS", 1.0)
+    monkeypatch.setattr(native, "_toolchain_cache", {})
+    monkeypatch.setattr("sysconfig.get_config_var", lambda name: None)  # no fallback to the real compiler
+    monkeypatch.setattr("shutil.which", lambda name: str(cc) if name == str(cc) else None)
+    argv, why = native.toolchain()
+    assert argv is None and "did not answer --version" in why and "did not finish in 1 s" in why, why
+    _wait_ended(pids)

@@ -22,6 +22,7 @@ from kinlib.singular_search import SingularPoints, find_singularities
 from kinlib.singularities import (
     IncompleteResultWarning,
     SingularSet,
+    periodic_family,
     representatives,
     singular_configurations,
     task_rows,
@@ -424,3 +425,37 @@ def test_seven_joint_arm_answers_and_covers_numeric_search():
                 assert sigma_k(mr.JacobianSpace(S, q)) > 1e-8
     else:
         assert "find_singularities" in conds.note
+
+
+def test_an_incomplete_singular_set_equals_no_list():
+    """issue 32: a SingularSet that gave up is not the empty answer (nor any other list), so `== []` in a test or a
+    caller cannot mistake giving up for "no singular configuration"; a complete one compares as a list."""
+    r = robots.planar_2r()
+    J = task_rows(r.jacobian_geometric(), ["vx", "vy"])
+    with pytest.warns(IncompleteResultWarning):
+        gave_up = singular_configurations(J, r.thetas, time_budget=0)
+    assert not gave_up.complete and list(gave_up) == []
+    assert gave_up != [] and not (gave_up == []) and gave_up != gave_up
+    assert SingularSet([], complete=True) == [] and SingularSet([1], complete=False) != [1]
+    done = singular_configurations(J, r.thetas)
+    assert done.complete and done == [{r.thetas[1]: periodic_family([0, sp.pi])}]
+
+
+def test_puma_elbow_factor_is_the_one_its_docstring_states():
+    """robots.puma560's docstring: elbow a3 sin θ3 + d4 cos θ3 = 0. Checked independently: at θ3 with
+    tan θ3 = −d4/a3 the upper arm and the line from the elbow to the wrist centre are parallel (their cross product
+    vanishes), and the 6×6 geometric J is singular there (60-digit determinant)."""
+    import mpmath
+
+    r = robots.puma560()
+    a3, d4 = sp.Rational("0.0203"), sp.Rational("0.4318")
+    th3 = sp.atan2(-d4, a3)  # a3 sin θ3 + d4 cos θ3 = 0
+    assert sp.simplify(a3 * sp.sin(th3) + d4 * sp.cos(th3)) == 0
+    q = [sp.Rational(1, 3), sp.Rational(-2, 7), th3, sp.Rational(1, 5), sp.Rational(3, 4), sp.Rational(1, 2)]
+    J = r.jacobian_geometric(q)
+    with mpmath.workdps(60):
+        d = mpmath.det(mpmath.matrix([[mpmath.mpf(sp.N(J[i, j], 70)) for j in range(6)] for i in range(6)]))
+    assert abs(d) < mpmath.mpf(10) ** -50
+    q[2] = th3 + sp.Rational(1, 10)  # off the factor: regular
+    J = r.jacobian_geometric(q)
+    assert abs(sp.N(J.det(), 30)) > 1e-6

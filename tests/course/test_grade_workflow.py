@@ -130,14 +130,15 @@ def test_the_notebooks_points_add_up(path):
     assert sum(p["points"] for p in parts.values()) == sum(q for q in questions if q)
 
 
-def test_section_5_totals_25_with_the_drawing_as_a_manual_row():
+def test_section_5_totals_30_with_the_drawing_as_a_manual_row():
+    # 5.1–5.5 (25 points) and 5.6, the unseen-robot exercise (5 points; issue 30)
     nb = json.loads((ROOT / "notebooks" / "05_singularities_planar.ipynb").read_text())
     parts = _parts(nb)
     assert parts["5.2"]["answers"] == [] and sum(parts["5.2"]["manual"].values()) == 5
     rows = [_row(p, "pass") for p in parts]
     res = credit.score_parts({"submission": "s", "notebook": "05", "rows": rows}, list(parts.values()))
     t = credit.result_totals(res["rows"])
-    assert t["max_points"] == 25 and any(x.startswith("5.2/") for x in t["pending"])
+    assert t["max_points"] == 30 and any(x.startswith("5.2/") for x in t["pending"])
 
 
 # ----------------------------------------------------------------------------------------- student ids

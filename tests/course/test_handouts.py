@@ -222,6 +222,46 @@ def test_problems_leak_no_solution(built):
     assert "(6, 3)" not in text and "\\left( 6, \\  3\\right)" not in text
 
 
+def test_cells_that_reveal_a_graded_answer_show_their_students_version(built):
+    """Issue 30, ``"kinlib": {"reveals": [...]}``: the solutions keep the cells as they are; the problems and the
+    workbook show a markdown cell's ``students`` text or leave it out, and an explorer's students' version (made in
+    the kernel: no closed-form singular set, no w_max, no state in its data or text; the workbook wraps the call
+    in ``without_answers``, and the workbook runs: test_workbook_runs_top_to_bottom_unanswered)."""
+    import json
+
+    out, entry, _ = built
+    solutions = (out / "solutions" / f"{STEM}.html").read_text()
+    problems = (out / "problems" / f"{STEM}.html").read_text()
+    workbook = (out / "workbooks" / f"{STEM}.ipynb").read_text()
+    assert "LEAK-REVEALS-MD" in solutions and "LEAK-REVEALS-DROPPED" in solutions
+    for text in (problems, workbook):
+        assert "LEAK-REVEALS" not in text and "Where does det J vanish? That is part 1.3" in text
+    assert "kinlib_students_outputs" not in solutions + problems + workbook  # build-internal
+
+    def explorer_output(nb):
+        (cell,) = [c for c in nb.cells if "widgets.explorer(r1" in c.source]
+        return cell, {k: v for o in cell.get("outputs", []) for k, v in o.get("data", {}).items()}
+
+    def spec(js):
+        return json.loads(re.search(r"\nvar S = (\{.*\});\nS\.skel", js).group(1))
+
+    _, full = explorer_output(entry["executed"])
+    s_full = spec(full["application/javascript"])
+    assert s_full["conditions"] and s_full["wMax"] > 0 and "function c0" not in full["application/javascript"]
+    _, shown = explorer_output(entry["problems"])
+    js = shown["application/javascript"]
+    s_students = spec(js)
+    assert s_students["answers"] is False and s_students["conditions"] == [] and s_students["wMax"] == 0
+    assert s_students["showMaximum"] is False and s_students["complete"] is False
+    assert '"period"' not in json.dumps(s_students) and repr(s_full["wMax"]) not in js
+    assert "configuration" not in shown["text/plain"] and shown["image/png"]
+    assert '"answers":false' in problems  # the page shows that output
+    wb = nbformat.read(out / "workbooks" / f"{STEM}.ipynb", as_version=4)
+    (cell,) = [c for c in wb.cells if "widgets.explorer(r1" in c.source]
+    assert "without_answers(widgets.explorer(r1, q=[0.3, 0.7, 0.2]))" in cell.source
+    assert cell.source.startswith("from kinlib.widgets import without_answers")
+
+
 def html_escape(s):
     import html
 

@@ -697,3 +697,44 @@ def test_no_developer_settings_in_the_site(built_site):
     assert all(u.startswith("./") for u in settings.get("pipliteUrls", []))
     text = "\n".join(p.read_text(errors="replace") for p in site.rglob("*.json") if p.stat().st_size < 2_000_000)
     assert str(ROOT) not in text and str(Path.home()) + "/" not in text, "a local path leaked into the site"
+
+
+_STDERR_OF_FIRST_PICTURE = """() => {
+  const cells = Array.from(document.querySelectorAll('.jp-Notebook .jp-CodeCell'));
+  const picture = c => Array.from(c.querySelectorAll('.jp-OutputArea-output img')).some(i => i.naturalWidth >= 100)
+                       || c.querySelector('.jp-OutputArea-output .kinlib-arm') !== null;
+  const stderr = c => Array.from(c.querySelectorAll('.jp-OutputArea-output[data-mime-type="application/vnd.jupyter.stderr"]'))
+                        .map(e => e.textContent);
+  const first = cells.find(picture);
+  return {index: first ? cells.indexOf(first) : -1, first: first ? stderr(first) : [],
+          all: cells.flatMap(stderr)};
+}"""
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+def test_workbook_05_first_picture_shows_no_stderr_in_a_new_browser(handouts_site, site_base, shared_browser):
+    """A new browser profile (a fresh context: nothing stored) opens workbook 05 in the site and runs it: its first
+    picture cell shows no stderr box, and no output says "Matplotlib is building the font cache": the site's
+    matplotlib wheel ships a font cache that matplotlib 3.8.4 accepts (lite.font_cache)."""
+    import labdriver
+
+    context, page, blocker, _ready = open_workbook(shared_browser, site_base)
+    try:
+        labdriver.run_all(page, timeout=400)
+        got = page.evaluate(_STDERR_OF_FIRST_PICTURE)
+        assert got["index"] >= 0, "workbook 05 showed no picture"
+        assert not got["first"], f"the first picture cell ({got['index']}) shows stderr: {got['first']}"
+        assert not any("font cache" in t for t in got["all"]), got["all"]
+        page.evaluate(  # that cell at the top of the window (the notebook draws only the cells in view)
+            """(i) => { const w = window.jupyterapp.shell.currentWidget.content;
+                        const c = Array.from(w.widgets).filter(c => c.model.type === 'code')[i];
+                        return w.scrollToItem(w.widgets.indexOf(c), 'start'); }""",
+            got["index"],
+        )
+        page.wait_for_timeout(500)
+        SCREENSHOTS.mkdir(parents=True, exist_ok=True)
+        page.screenshot(path=str(SCREENSHOTS / "lite-05-first-picture.png"))
+    finally:
+        context.close()
+    assert not blocker.blocked, blocker.blocked[:5]

@@ -187,3 +187,76 @@ def test_row_order_swap_elsewhere():
     assert np.allclose(P @ P, np.eye(6)) and np.allclose(P.T @ P, np.eye(6))
     assert np.allclose(np.linalg.svd(P @ J, compute_uv=False), np.linalg.svd(J, compute_uv=False))
     assert np.allclose((P @ J)[:3], J[3:])  # the linear rows first
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# issue 30: statements relative to the task (rows, Jacobian, units), each checked numerically
+
+
+def _planar(points):
+    return np.column_stack([kinlib.screw_revolute([0, 0, 1], [x, y, 0]) for x, y in points])
+
+
+def test_rows_without_omega_depend_on_the_jacobian():
+    _states(
+        r"rows of $J_s$ have $\det \equiv 0$ in every pose", r"$L_1 L_2\sin\theta_2$", "never the $v$ rows of $J_s$"
+    )
+    for _ in range(10):
+        l1, l2 = RNG.uniform(0.3, 2, 2)
+        S, M = _planar([(0, 0), (l1, 0)]), np.eye(4)
+        M[0, 3] = l1 + l2
+        q = RNG.uniform(-np.pi, np.pi, 2)
+        T = mr.FKinSpace(M, S, q)
+        Js = mr.JacobianSpace(S, q)
+        Jb = mr.Adjoint(mr.TransInv(T)) @ Js
+        Jg = np.vstack([Js[:3], Js[3:] + np.cross(Js[:3].T, T[:3, 3]).T])
+        assert abs(np.linalg.det(Js[[3, 4]])) < 1e-12
+        assert np.allclose([np.linalg.det(Jb[[3, 4]]), np.linalg.det(Jg[[3, 4]])], l1 * l2 * np.sin(q[1]))
+
+
+def test_planar_columns_of_js():
+    _states("$(1, y_i, -x_i)$", "$(0, u_x, u_y)$")
+    for _ in range(10):
+        x, y = RNG.normal(size=2)
+        u = RNG.normal(size=2)
+        u /= np.linalg.norm(u)
+        S = np.column_stack([kinlib.screw_revolute([0, 0, 1], [x, y, 0]), kinlib.screw_prismatic([u[0], u[1], 0])])
+        J = mr.JacobianSpace(S, [0.0, 0.0])  # joint 1 first: its point is where it was placed
+        assert np.allclose(J[[2, 3, 4], 0], [1, y, -x]) and np.allclose(J[[2, 3, 4], 1], [0, u[0], u[1]])
+
+
+def test_dls_rates_peak_where_sigma_min_is_lambda():
+    _states(r"its rates are largest where", r"$\sigma_{\min} \approx \lambda$")
+    lam = 0.05
+    U = np.linalg.qr(RNG.normal(size=(3, 3)))[0]
+    V = U[:, 2]  # along the direction being lost
+    sig = np.logspace(-3, 0, 601)
+    rates = [np.linalg.norm(damped_least_squares(U @ np.diag([2.0, 1.0, s]) @ U.T, V, lam)) for s in sig]
+    assert abs(sig[int(np.argmax(rates))] / lam - 1) < 0.03
+    assert max(rates) <= 1 / (2 * lam) + 1e-9
+
+
+def test_yoshikawa_is_for_m_le_n():
+    _states(r"for $m \le n$", r"With $m \gt n$ it is 0 everywhere")
+    M, S, q = _random_arm(4)
+    J = mr.JacobianSpace(S, q)
+    assert abs(np.linalg.det(J @ J.T)) < 1e-9 and np.linalg.det(J.T @ J) > 1e-6
+
+
+def test_near_rule_is_a_convention_unit_free_only_sometimes():
+    _states("is a convention, not a standard", "unit-free when $J$ is square")
+
+    def ratio(scale, gram):  # w(qa)/w(qb) of a 3-row, 2-joint arm: one revolute, one slide
+        S = np.column_stack([kinlib.screw_revolute([0, 0, 1], [0, 0, 0]), kinlib.screw_prismatic([1, 0, 0])])
+        M = np.eye(4)
+        M[0, 3] = scale
+        out = []
+        for slide in (0.5, 2.0):
+            T = mr.FKinSpace(M, S, [0.3, slide * scale])
+            Js = mr.JacobianSpace(S, [0.3, slide * scale])
+            Jg = np.vstack([Js[:3], Js[3:] + np.cross(Js[:3].T, T[:3, 3]).T])[[2, 3, 4]]
+            out.append(np.sqrt(np.linalg.det(Jg.T @ Jg)) if gram else abs(np.linalg.det(Jg[1:])))
+        return out[0] / out[1]
+
+    assert abs(ratio(1.0, True) - ratio(1000.0, True)) > 0.05  # m > n, mixed joint types: depends on the unit
+    assert np.isclose(ratio(1.0, False), ratio(1000.0, False))  # the square ṗ block: unit-free

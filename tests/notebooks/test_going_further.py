@@ -99,6 +99,11 @@ def _semi_axes(J, descending=True):
     return sp.Matrix([sp.sqrt(e) for e in ev])
 
 
+# 7.6, the P-R-R arm (issue 30): the columns from the rule, a slide (0, u_x, u_y), a revolute joint at its current
+# point (x, y): (1, y, −x); joint 2 at (θ1, 0), joint 3 at (θ1 + L c2, L s2)
+J_PRR = sp.Matrix([[0, 1, 1], [1, 0, L * sp.sin(t2)], [0, -t1, -t1 - L * sp.cos(t2)]])
+S_PRR = sp.Matrix([[0, 0, 0, 1, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0]]).T
+
 # name: (part, kind, right, [other valid forms], {wrong label: value})
 CASES = {
     "A_v": (
@@ -169,6 +174,37 @@ CASES = {
         [J_SCARA.applyfunc(sp.expand_trig)],
         {"[v; ω] order": J_SCARA[3:, :].col_join(J_SCARA[:3, :]), "slide up": J_SCARA.subs({J_SCARA[5, 2]: 1})},
     ),
+    "S_76": (
+        "7.6",
+        "expr",
+        S_PRR,
+        [sp.Matrix.hstack(S_PRR[:, 0], S_PRR[:, 1], S_PRR[:, 2])],
+        {
+            "v = +ω × q": S_PRR.subs(L, -L),
+            "the slide as a rotation": sp.Matrix([[0, 0, 1, 0, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, 1, 0, -L, 0]]).T,
+        },
+    ),
+    "detJ_76": (
+        "7.6",
+        "expr",
+        J_PRR.det(),
+        [L * sp.cos(t2), L * sp.sin(t2 + pi / 2)],
+        {
+            "columns (1, −y, x)": sp.Matrix([[0, 1, 1], [1, 0, -L * sp.sin(t2)], [0, t1, t1 + L * sp.cos(t2)]]).det(),
+            "sin": L * sp.sin(t2),
+        },
+    ),
+    "singular_76": (
+        "7.6",
+        "set",
+        {t2: family(pi / 2, period=pi)},
+        [{t2: family(pi / 2, -pi / 2)}, [{t2: family(-pi / 2, period=pi)}]],
+        {
+            "stretched (the collinear rule)": {t2: family(0, period=pi)},
+            "none": [],
+            "one member": {t2: sp.FiniteSet(pi / 2)},
+        },
+    ),
     "scara_singular": (
         "7.5",
         "set",
@@ -200,7 +236,7 @@ def _grader(kind, student, reference, name):
 def test_the_notebook_declares_these_answers():
     nb = json.loads(NB.read_text())
     assert schema.notebook_id(nb) == "07_going_further"
-    assert schema.notebook_sections(nb) == ["7.1", "7.2", "7.3", "7.4", "7.5"]
+    assert schema.notebook_sections(nb) == ["7.1", "7.2", "7.3", "7.4", "7.5", "7.6"]
     declared = {(p.part, n, p.kinds[n]) for p in schema.parse_parts(nb) for n in p.answers}
     assert declared == {(part, n, kind) for n, (part, kind, *_rest) in CASES.items()}
     groups = {(pid, n, kind) for g in schema.answer_groups(nb) for pid, n, kind, _ in g.answers}

@@ -35,9 +35,9 @@ from helpers import assert_sym_equal  # noqa: E402
 
 NB_DIR = pathlib.Path(__file__).resolve().parents[2] / "notebooks"
 NOTEBOOKS = {
-    "01_properties_of_jacobians": ["1.1", "1.2", "1.3"],
-    "02_planar_robot_jacobian": ["2.1", "2.2", "2.3", "2.4"],
-    "03_spatial_robot_jacobian": ["3.1", "3.2", "3.3", "3.4"],
+    "01_properties_of_jacobians": ["1.1", "1.2", "1.3", "1.4"],
+    "02_planar_robot_jacobian": ["2.1", "2.2", "2.3", "2.4", "2.5"],
+    "03_spatial_robot_jacobian": ["3.1", "3.2", "3.3", "3.4", "3.5"],
 }
 sin, cos, sqrt, pi = sp.sin, sp.cos, sp.sqrt, sp.pi
 

@@ -527,3 +527,80 @@ def test_animation_bad_input(r3):
         widgets.animate_singularity(r3, [[np.nan, 0, 0], [0, 0, 0]])
     with pytest.raises(ValueError, match="interval"):
         widgets.animate_singularity(r3, np.zeros((2, 3)), interval=0)
+
+
+# --- the students' version (issue 30: kinlib.widgets.without_answers) ---------------------------------------------
+def test_students_version_sends_nothing_that_answers_a_part(r3):
+    """The 05 explorer's students' version: its script holds no closed-form singular set (no family offsets, no
+    generated condition), no largest manipulability (5.4: √2 L² here), and its text no state; the original is
+    unchanged. The animation's and the picker's students' versions likewise; anything else is refused."""
+    ex = widgets.explorer(r3, q=[0.3, -math.pi / 4, 0.2])
+    st = widgets.without_answers(ex)
+    js, full = st.javascript, ex.javascript
+    assert ex.spec["conditions"] and '"offset":-0.785398' in full and "1.41421" in full  # what the solutions show
+    assert '"conditions":[]' in js and '"offset"' not in js and "1.41421" not in js and "function c0" not in js
+    assert '"answers":false' in js and "singular" not in st._repr_mimebundle_()["text/plain"]
+    assert ex.spec["conditions"] and ex.answers and "singular" in ex._repr_mimebundle_()["text/plain"]
+    anim = widgets.animate_singularity(r3, _path_05(r3))
+    sa = widgets.without_answers(anim)
+    assert "singular" not in sa._repr_mimebundle_()["text/plain"] and '"conditions":[]' in sa.javascript
+    assert "1.41421" not in sa.javascript and "1 singular" in anim._repr_mimebundle_()["text/plain"]
+    sp_ = widgets.without_answers(_picker_4_1())
+    assert '"answers":false' in sp_.javascript
+    with pytest.raises(TypeError, match="without_answers"):
+        widgets.without_answers(r3)
+
+
+_READ_STUDENTS = """() => {
+  const root = document.querySelector('.kinlib-explorer');
+  return {status: root.querySelector('.kinlib-status').textContent, state: root.getAttribute('data-state'),
+          marks: root.querySelectorAll('.kinlib-mark').length, det: root.querySelectorAll('.kinlib-det').length,
+          blocked: root.querySelectorAll('.kinlib-blocked').length, readout: root.querySelector('.kinlib-readout').textContent,
+          legend: root.querySelector('.kinlib-legend').textContent, live: root.querySelector('.kinlib-live').textContent,
+          held: root.querySelector('.kinlib-held').textContent,
+          desc: Array.from(root.querySelectorAll('.kinlib-sr')).map(e => e.textContent).join(' ')};
+}"""
+
+
+@pytest.mark.browser
+def test_students_explorer_marks_nothing_at_the_singular_configuration(chromium, r3, tmp_path):
+    """The students' version of the 05 explorer, moved with the keyboard onto θ2 = −π/4 (5.1's answer): the held
+    ellipse collapses as the arm does, but no mark on a track, no banner, no det J / w / σ / rank readout, no blocked
+    direction, no "singular" in the live sentence, the slider descriptions or the legend."""
+    ex = widgets.without_answers(widgets.explorer(r3, q=[math.pi / 6, math.pi / 6, -math.pi / 3], show_maximum=False))
+    page, errors = page_with(chromium, [ex], tmp_path)
+    try:
+        s = page.locator("input.kinlib-slider[data-joint='2']")
+        s.focus()
+        for _ in range(75):  # π/6 → −π/4
+            page.keyboard.press("ArrowLeft")
+        got = page.evaluate(_READ_STUDENTS)
+        held = [float(x) for x in got["held"].split(",")]
+        assert min(held) == 0 < max(held)  # the picture still shows what happens
+        assert got["marks"] == got["det"] == got["blocked"] == 0 and got["status"] == ""
+        assert got["state"] == "unmarked"
+        for key in ("readout", "legend", "live", "desc"):
+            low = got[key].lower()
+            assert "singular" not in low and "det" not in low and "rank" not in low and "σ" not in low, (key, got[key])
+        assert not errors, errors
+    finally:
+        page.close()
+
+
+@pytest.mark.browser
+def test_animation_plays_once_at_a_pace_and_stays_on_the_singular_step(chromium, r3, tmp_path):
+    """5.2's animation: by default it stops at the last step (no endless loop), spends `dwell` on the singular
+    step (longer than a step) and has a step of at least half a second. Asserted on the spec and on what the
+    player does (the step it stops on), never on how long the machine took."""
+    anim = widgets.animate_singularity(r3, _path_05(r3))
+    assert anim.spec["loop"] is False and anim.spec["interval"] >= 500 and anim.spec["dwell"] > anim.spec["interval"]
+    fast = widgets.animate_singularity(r3, _path_05(r3), interval=10, dwell=10)  # the behaviour, quickly
+    page, errors = page_with(chromium, [fast], tmp_path)
+    try:
+        page.locator("button.kinlib-play").click()
+        page.wait_for_function("() => document.querySelector('button.kinlib-play').getAttribute('aria-pressed') === 'false'",
+                               timeout=60000)  # fmt: skip
+        assert page.evaluate(_READ_STEP)["step"] == len(fast.path) - 1  # stopped at the end, not looping
+        assert not errors, errors
+    finally:
+        page.close()

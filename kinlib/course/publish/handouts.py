@@ -43,6 +43,7 @@ from __future__ import annotations
 import asyncio
 import copy
 import json
+import re
 import shutil
 import subprocess
 import time
@@ -62,13 +63,14 @@ from ..schema import (
     cell_answers,
     cell_meta,
     cell_part,
+    cell_reveals,
     cell_tags,
     notebook_sections,
     notebook_title,
     set_source_hidden,
 )
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
-from .aids import stub, student_reading_aid
+from .aids import STUDENTS_OUTPUTS, show_students_version, stub, student_reading_aid, students_cell
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
 from .execute import notebook_client
 from .incremental import Stamps, build_sections, build_site, code_key, key, print_changed_pdfs
@@ -123,6 +125,12 @@ def _capture_code(specs: dict) -> str:
     return f"__import__({module!r}, fromlist=[{function!r}]).{function}({specs!r}, globals())"
 
 
+def _students_code() -> str:
+    """Kernel code displaying the students' version of the picture the cell just run showed (:mod:`.aids`)."""
+    module, function = show_students_version.__module__, show_students_version.__name__
+    return f"__import__({module!r}, fromlist=[{function!r}]).{function}()"
+
+
 async def _execute(nb, path: Path, timeout: int, capture_after: dict) -> dict:
     from nbclient.exceptions import CellExecutionError, CellTimeoutError, DeadKernelError
 
@@ -147,6 +155,16 @@ async def _execute(nb, path: Path, timeout: int, capture_after: dict) -> dict:
                 await client.async_execute_cell(cell, i, execution_count=count)
             except (CellExecutionError, CellTimeoutError, DeadKernelError) as e:
                 raise NotebookFailed(path, i, cell, e) from None
+            if cell.cell_type == "code" and cell_reveals(cell):  # its picture for the students (make_problems)
+                probe = nbformat.v4.new_code_cell(_students_code())
+                try:
+                    await client.async_execute_cell(probe, i, store_history=False)
+                except CellExecutionError as e:
+                    raise NotebookFailed(path, i, cell, e) from None
+                finally:
+                    nb.cells[i] = cell
+                shown = [o for o in probe.outputs if o.get("output_type") in ("display_data", "execute_result")]
+                cell.metadata[STUDENTS_OUTPUTS] = shown or None
             if i in capture_after:
                 probe = nbformat.v4.new_code_cell(_capture_code(capture_after[i]))
                 try:
@@ -298,9 +316,18 @@ def prune_widget_state(nb) -> None:
 
 
 def _used_names(cells) -> set | None:
-    """Every name the code ``cells`` read (None when one of them does not parse: then trim nothing)."""
+    """Every name the code ``cells`` read (None when one of them does not parse: then trim nothing), and every
+    name the markdown ``cells`` show as code (`` `rank_at` ``, `` `task_rows(J, "planar")` ``): a function the
+    student's text names is imported in the student's set-up (issue 30).
+
+    >>> import nbformat
+    >>> sorted(_used_names([nbformat.v4.new_markdown_cell("take the rank (`rank_at`), or `task_rows(J, 2)`")]))
+    ['rank_at', 'task_rows']
+    """
     used: set = set()
     for c in cells:
+        if c.cell_type == "markdown":
+            used |= set(re.findall(r"`([A-Za-z_][A-Za-z0-9_]*)\b", c.source))
         if c.cell_type == "code":
             names = loaded_names(c.source)
             if names is None:
@@ -359,14 +386,25 @@ def make_problems(executed) -> tuple:
     def dropped_cell(i, c):
         return bool(ANSWER_TAGS & set(cell_tags(c))) or i in narrative or i in dependents or i in captions
 
+    students_outputs = {i: c.metadata.pop(STUDENTS_OUTPUTS, None) for i, c in enumerate(nb.cells)}
     used = _used_names([c for i, c in enumerate(nb.cells) if not dropped_cell(i, c)])
+    revealing = []
     for i, c in enumerate(nb.cells):
         if dropped_cell(i, c):
             continue  # answers, worked-solution steps, what is computed from answers and its caption
+        if cell_reveals(c):  # a cell that states a graded answer: its students' version, or nothing
+            revealing.append(i)
+            if c.cell_type == "code":
+                shown = students_outputs.get(i)
+                if not shown:
+                    continue
+                c.outputs = [nbformat.from_dict(o) for o in shown]
+            elif students_cell(c) is None:
+                continue
         student_reading_aid(c)
         if c.cell_type == "code":
             _student_setup(c, used)  # the student's setup: not the imports that give the method away
-            kept = [o for o in c.outputs if not _leaks(o, texts, images)]
+            kept = [o for o in c.outputs if i in revealing or not _leaks(o, texts, images)]
             if len(kept) != len(c.outputs):
                 notes.append(
                     f"problems: cell {i}: dropped {len(c.outputs) - len(kept)} output(s) that repeat an answer"
@@ -377,6 +415,11 @@ def make_problems(executed) -> tuple:
             c.outputs = kept
             c.execution_count = None
         cells.append(c)
+    if revealing:
+        notes.append(
+            f"problems and workbook: {len(revealing)} cell(s) that state a graded answer shown in their students' "
+            f"version or left out (cells {', '.join(map(str, revealing))})"
+        )
     nb.cells = cells
     prune_widget_state(nb)
     return nb, notes
@@ -398,8 +441,12 @@ def _selfcheck_source(answers: list, fps: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def make_workbook(source_nb, groups: list, fps: dict):
+def make_workbook(source_nb, groups: list, fps: dict, pictures: set | None = None):
     """The student workbook made from the (unexecuted) notebook, its groups and the fingerprints.
+
+    A cell with ``"reveals"`` becomes its students' version (:func:`kinlib.course.publish.aids.students_cell`); a
+    code one is kept as a picture when its index is in ``pictures`` (the cells whose students' version the kernel
+    made; None: every one that ends with an expression), else left out.
 
     The fingerprints are those :func:`execute_notebook` reads from the kernel; made by hand here:
 
@@ -453,11 +500,13 @@ def make_workbook(source_nb, groups: list, fps: dict):
                 cells.append(_selfcheck_cell(g, fps, cell))
         elif i in narrative:
             pass
+        elif cell_reveals(cell) and students_cell(cell, None if pictures is None else i in pictures) is None:
+            pass  # states a graded answer and has no students' version
         else:
             student_reading_aid(cell)
             if i in needs:
                 cell.source = f"%%needs {' '.join(needs[i])}\n" + cell.source
-            else:
+            elif not cell_reveals(cell):  # (a students' picture keeps its import of without_answers)
                 _student_setup(cell, used)  # imports only what the student starts with
             cells.append(cell)
         if i in after:
@@ -542,6 +591,10 @@ def build_one(
     executed, groups, fps = execute_notebook(path, timeout)
     t_exec = time.perf_counter() - t0
     title = notebook_title(executed, stem.replace("_", " "))
+    pictures = {i for i, c in enumerate(executed.cells) if c.metadata.get(STUDENTS_OUTPUTS)}
+    problems, notes = make_problems(executed)
+    for c in executed.cells:  # build-internal: not in the solutions page nor the kept execution
+        c.metadata.pop(STUDENTS_OUTPUTS, None)
     if audience == "all":
         export_html(
             executed,
@@ -551,11 +604,10 @@ def build_one(
             problems=False,
             links=links,
         )
-    problems, notes = make_problems(executed)
     export_html(
         problems, out / "problems" / f"{stem}.html", urls, title=f"{title} (problems)", problems=True, links=links
     )
-    wb = make_workbook(source, groups, fps)
+    wb = make_workbook(source, groups, fps, pictures)
     wpath = out / "workbooks" / f"{stem}.ipynb"
     wpath.parent.mkdir(parents=True, exist_ok=True)
     nbformat.write(wb, wpath)

@@ -538,6 +538,7 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
         sources = {pure[n].name: pure[n] for n in pure} | {kinlib_whl.name: kinlib_whl}
         copy_lock_files({k: lock["packages"][k] for k in extra}, sources, pyo)
         _with_bytecode(lock, pyo, pkg, cache, kinlib_whl.name, log)
+        _with_font_cache(lock, pyo, log)
         (pyo / "pyodide-lock.json").write_text(json.dumps(lock, indent=1))
         _favicons(site / "static" / "favicons")
 
@@ -571,6 +572,76 @@ def _with_bytecode(lock: dict, pyo: Path, pkg: Path, cache: Path, own: str, log=
             e["sha256"] = _sha256(src)
     if pyo / own in compiled:  # a new one each build: not kept
         shutil.rmtree(compiled[pyo / own].parent, ignore_errors=True)
+
+
+def font_cache(wheel: bytes) -> bytes | None:
+    r"""The font cache (``matplotlib/fontlist.json``) matplotlib's Pyodide wheel should ship, or None when the one it
+    ships is right. Pyodide 0.27.7's matplotlib 3.8.4 reads its cache beside ``font_manager.py`` and accepts it only
+    if its ``_version`` is ``FontManager.__version__`` (330); the wheel ships one made by a newer matplotlib (390),
+    so every new kernel builds the cache again and prints "Matplotlib is building the font cache; this may take a
+    moment." on stderr: an error box under the first picture of every notebook, in every new browser. The right
+    cache is the shipped one with the module's version and only the fonts the wheel holds (their paths are
+    relative to ``mpl-data``, as matplotlib writes them).
+
+    >>> import io, zipfile
+    >>> buf = io.BytesIO()
+    >>> with zipfile.ZipFile(buf, "w") as z:
+    ...     z.writestr("matplotlib/font_manager.py", "class FontManager:\n    __version__ = 330\n")
+    ...     z.writestr("matplotlib/mpl-data/fonts/ttf/DejaVuSans.ttf", b"")
+    ...     z.writestr("matplotlib/fontlist.json", json.dumps({"_version": 390, "ttflist": [
+    ...         {"fname": "fonts/ttf/DejaVuSans.ttf"}, {"fname": "/usr/share/fonts/x.ttf"}], "afmlist": []}))
+    >>> fixed = json.loads(font_cache(buf.getvalue()))
+    >>> fixed["_version"], [e["fname"] for e in fixed["ttflist"]]
+    (330, ['fonts/ttf/DejaVuSans.ttf'])
+    """
+    import io
+
+    with zipfile.ZipFile(io.BytesIO(wheel)) as z:
+        names = set(z.namelist())
+        if "matplotlib/fontlist.json" not in names or "matplotlib/font_manager.py" not in names:
+            return None
+        m = re.search(r"^\s+__version__ = (\d+)\s*$", z.read("matplotlib/font_manager.py").decode(), re.M)
+        data = json.loads(z.read("matplotlib/fontlist.json"))
+    if m is None:
+        return None
+    version = int(m.group(1))
+    keep = {
+        key: [e for e in data.get(key, []) if f"matplotlib/mpl-data/{e.get('fname', '')}" in names]
+        for key in ("ttflist", "afmlist")
+    }
+    if data.get("_version") == version and all(len(keep[k]) == len(data.get(k, [])) for k in keep):
+        return None
+    return json.dumps({**data, **keep, "_version": version}, indent=2).encode()
+
+
+def _with_font_cache(lock: dict, pyo: Path, log=print) -> None:
+    """matplotlib's wheel in the site (already verified, and compiled) with the font cache it should ship
+    (:func:`font_cache`); ``lock`` gets its new sha256."""
+    from .lite_bytecode import record_line
+
+    entry = lock["packages"].get("matplotlib")
+    if entry is None:
+        return
+    path = pyo / entry["file_name"]
+    fixed = font_cache(path.read_bytes())
+    if fixed is None:
+        return
+    part = path.with_name(path.name + ".part")
+    with zipfile.ZipFile(path) as z, zipfile.ZipFile(part, "w", zipfile.ZIP_DEFLATED) as out:
+        for info in z.infolist():
+            data = fixed if info.filename == "matplotlib/fontlist.json" else z.read(info)
+            if info.filename.endswith(".dist-info/RECORD"):
+                lines = [
+                    record_line("matplotlib/fontlist.json", fixed) if ln.startswith("matplotlib/fontlist.json,") else ln
+                    for ln in data.decode().split("\n")
+                ]
+                data = "\n".join(lines).encode()
+            out.writestr(info, data, compress_type=zipfile.ZIP_DEFLATED)
+    part.replace(path)
+    entry["sha256"] = _sha256(path)
+    log(
+        f"  lite: matplotlib's font cache fixed (version {json.loads(fixed)['_version']}): no font cache build in the browser"
+    )
 
 
 # ---------------------------------------------------------------------------------------------------

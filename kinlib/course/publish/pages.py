@@ -65,7 +65,8 @@ _MATHJAX_LOCAL_CONFIG = """\
                  styles: {"@font-face": {"font-family": "MathJax_Blank", src: none}}},
     NativeMML: {styles: mml},
     SVG: {font: "STIX-Web"},
-    MathMenu: {showLocale: false}
+    MathMenu: {showLocale: false},
+    menuSettings: {inTabOrder: false}  /* formulas are not Tab stops (their menu stays on the right click) */
   });
 })();
 MathJax.Ajax.loadComplete("[MathJax]/config/kinlib.js");
@@ -273,6 +274,61 @@ def _figure_alts(nb, section_default: str) -> dict:
     return alts
 
 
+_PICTURES = {
+    "window.kinlibExplorer(": "explorer",
+    "window.kinlibAnimation(": "animation",
+    "window.kinlibPicker(": "picker",
+}
+_PART = re.compile(r"^\s*(?:#+\s*)?\**\s*(\d+\.\d+)")
+_SKIP_CSS = (
+    "<style>/* kinlib: skip links, the first Tab stops of a page */\n"
+    ".kinlib-skip { font: 13px/1.6 system-ui, sans-serif; margin: 0 0 .3rem; }\n"
+    ".kinlib-skip a { color: #0b4fa8; margin-right: .9rem; } .kinlib-skip a:focus { outline: 2px solid #0b4fa8; }\n"
+    "@media print { .kinlib-skip { display: none; } }\n</style>\n"
+)
+
+
+def skip_links(nb) -> str:
+    """The page's first Tab stops (issue 30, keyboard): a link to each explorer, animation and picker, then to each
+    graded part's question, by the cells' ids (``#cell-id=…``, nbconvert's). Following one and pressing Tab lands
+    on that picture's first control. "" when the page has neither.
+
+    >>> import nbformat
+    >>> q = nbformat.v4.new_markdown_cell("**5.1 (5 points).** Where?", id="q51")
+    >>> q.metadata["tags"] = ["question"]
+    >>> ex = nbformat.v4.new_code_cell("ex", id="ex1", outputs=[nbformat.v4.new_output("display_data",
+    ...     {"application/javascript": "window.kinlibExplorer(host, S);", "text/plain": "explorer of planar_2r at θ = (0, 0)"})])
+    >>> print(skip_links(nbformat.v4.new_notebook(cells=[q, ex])))  # doctest: +NORMALIZE_WHITESPACE
+    <style>...
+    <nav class="kinlib-skip" aria-label="Skip to"><a href="#cell-id=ex1">Skip to the explorer (planar_2r)</a><a href="#cell-id=q51">Part 5.1</a></nav>
+    """
+    pictures, parts = [], []
+    for c in nb.cells:
+        cid = c.get("id")
+        if not cid:
+            continue
+        if c.get("cell_type") == "code":
+            for o in c.get("outputs", []):
+                js = o.get("data", {}).get("application/javascript", "")
+                js = "".join(js) if isinstance(js, list) else js
+                kind = next((k for marker, k in _PICTURES.items() if marker in js), None)
+                if kind:
+                    text = o.get("data", {}).get("text/plain", "")
+                    text = "".join(text) if isinstance(text, list) else text
+                    m = re.search(r"(?:of|for) (\S+)", text)
+                    pictures.append((cid, f"Skip to the {kind}" + (f" ({m.group(1)})" if m else "")))
+                    break
+        elif "question" in cell_tags(c):
+            src = c.get("source", "")
+            m = _PART.match("".join(src) if isinstance(src, list) else src)
+            if m:
+                parts.append((cid, f"Part {m.group(1)}"))
+    if not pictures and not parts:
+        return ""
+    links = "".join(f'<a href="#cell-id={html.escape(cid)}">{html.escape(t)}</a>' for cid, t in pictures + parts)
+    return _SKIP_CSS + f'<nav class="kinlib-skip" aria-label="Skip to">{links}</nav>\n'
+
+
 def _print_and_links(body: str, nb, dest: Path, *, title: str, problems: bool, links=LINKS) -> str:
     from .printing import HEADER_META, PRINT_HEAD
 
@@ -300,7 +356,8 @@ def _print_and_links(body: str, nb, dest: Path, *, title: str, problems: bool, l
     m = re.search(r"<main>", body)
     if m is None:
         raise RuntimeError(f"nbconvert's lab template changed: no <main> in {dest.name}")
-    body = body[: m.end()] + "\n" + bar + body[m.end() :]
+    body = body[: m.end()] + "\n" + skip_links(nb) + bar + body[m.end() :]
+    body = body.replace("<head>", '<head>\n<meta name="viewport" content="width=device-width, initial-scale=1">', 1)
     alts = _figure_alts(nb, html.unescape(header))
     pieces = re.split(r'(id="cell-id=[^"]*")', body)
     for i in range(1, len(pieces), 2):

@@ -432,15 +432,21 @@ def describe_answer(value, kind: str = "default") -> str:
 
     >>> describe_answer(sp.zeros(6, 3)), describe_answer(3, "choice"), describe_answer({sp.Symbol("t"): {0}}, "set")
     ('a 6×3 Matrix', 'a joint number or a tuple of joint numbers (1-based)', 'a dict {symbol: SymPy Set}')
+    >>> describe_answer(False, "choice"), describe_answer([{sp.Symbol("t"): {0}}], "set")
+    ('True or False', 'a list of dicts {symbol: SymPy Set}, one per condition ([] for none)')
     """
     if str(kind).startswith("property:"):
         return "your robot (a kinlib SerialChain) or its task Jacobian J (a Matrix)"
+    if is_bool(value):  # before "choice": a True/False answer is no joint number
+        return "True or False"
     if kind == "choice":
         return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"
     if kind == "set":
-        return "a dict {symbol: SymPy Set}" if isinstance(value, dict) else "a SymPy Set"
-    if is_bool(value):
-        return "True or False"
+        if isinstance(value, dict):
+            return "a dict {symbol: SymPy Set}"
+        if isinstance(value, (list, tuple)) and all(isinstance(v, dict) for v in value):
+            return "a list of dicts {symbol: SymPy Set}, one per condition ([] for none)"
+        return "a SymPy Set"
     if kind == "subspace":
         try:
             return f"a Matrix whose columns span the subspace ({_as_sympy_value(value, True).shape[0]}-vectors)"
