@@ -353,8 +353,9 @@ def rank_conditions(A: sp.Matrix, an: RankAnalysis) -> tuple:
 #: the precisions (digits) at which a minor that is not 0 for all φ is looked at again: nonzero when above
 #: 10^(70 − digits) times Hadamard's bound (the margin of :func:`_numeric_pivots`, 70 digits)
 _ESCALATE = (100, 300, 1000)
-#: the factor step is skipped for minors with more terms than this (SymPy's multivariate factoring)
-_MAX_FACTOR_TERMS = 3000
+#: minors are factored only over QQ and with at most this many terms (SymPy's multivariate factoring, slow over
+#: an algebraic extension: 25 s a minor); otherwise the minor's value is decided whole
+_MAX_FACTOR_TERMS = 400
 
 
 def _mp_det(rows: list):
@@ -488,12 +489,12 @@ class _SingularPose:
 
     def _by_factors(self, ring, p):
         """p ≠ 0 as a polynomial, numerically 0 here: zero exactly when one of its factors is."""
-        if len(p.terms()) > _MAX_FACTOR_TERMS:
-            return None
-        try:
-            _c, factors = p.factor_list()
-        except Exception:  # an algebraic domain SymPy does not factor over: one factor, p itself
-            factors = [(p, 1)]
+        factors = [(p, 1)]
+        if ring.domain.is_QQ and len(p.terms()) <= _MAX_FACTOR_TERMS:
+            try:
+                factors = p.factor_list()[1]
+            except Exception:  # pragma: no cover - then p is decided whole
+                pass
         env = dict(zip(self.lift.angles, self.lift.values))
         for f, _m in factors:
             e = ring.to_expr(f).xreplace(env)

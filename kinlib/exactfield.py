@@ -406,7 +406,7 @@ class PointLift:
     At a singular pose a minor vanishes because of the arm's structure (sin θ3 = 0 at θ3 = π, whatever the
     other joints are), not because of a coincidence between 2π/7 and 3π/11. Each sine or cosine in the matrix
     is sin/cos of an angle a = r + qπ (r, q rational); the angles are written as a = Σ n_i φ_i + ν with
-    n_i ∈ {−1, 0, 1}, ν a multiple of π/12 and φ_i the matrix's own angles (smallest first: the joint values
+    n_i ∈ {−1, 0, 1} (or ±2 on at most two φ_i), ν a multiple of π/12 and φ_i the matrix's own angles (smallest first: the joint values
     before their sums), checked exactly (r and q compared as rationals). ``lifted(e)`` replaces every sine and
     cosine by the polynomial in sin φ_i, cos φ_i (and sin ν, cos ν) it equals at the configuration. A
     polynomial that is 0 for *every* φ (its normal form modulo sin² + cos² − 1 is 0,
@@ -465,12 +465,16 @@ class PointLift:
 
     @staticmethod
     def _express(a, basis):
-        """(coefficients in {−1, 0, 1}, ν) with a = Σ n_i b_i + νπ, ν a multiple of 1/12, or None."""
+        """(coefficients, ν) with a = Σ n_i b_i + νπ, ν a multiple of 1/12: n_i ∈ {−1, 0, 1} (sums of joint
+        values), then n_i ∈ {±1, ±2} on at most two angles (θ3 = π/2 − 2θ2); None when neither fits."""
         r, q = a
         k = len(basis)
-        for size in range(1, k + 1):
+        tries = [(size, (1, -1)) for size in range(1, k + 1)] + [(size, (2, -2, 1, -1)) for size in (1, 2)]
+        for size, choices in tries:
             for support in itertools.combinations(range(k), size):
-                for signs in itertools.product((1, -1), repeat=size):
+                for signs in itertools.product(choices, repeat=size):
+                    if len(choices) == 4 and all(abs(s) == 1 for s in signs):
+                        continue  # tried already
                     rr, qq = r, q
                     for i, s in zip(support, signs):
                         rr -= s * basis[i][0]
