@@ -62,6 +62,7 @@ T_LITE_FIRST = 30.0  # JupyterLite: opening workbook 05 and running all → its 
 T_IMPORT = 0.6
 T_FIRST_CALL = 2.0  # first numeric call (code generation) of any chain of <= 7 joints
 T_EXACT_RANK = 30.0  # exact rank / column space / left null space at a configuration of a 6-joint arm
+T_SINGULAR_POSE = 5.0  # the same at a textbook singular pose with mixed rational·π angles, exact (issue 32)
 T_SINGULAR_7 = 60.0  # singular set of a 6×7 Jacobian: an answer or a clear "out of reach"
 T_COND_2R = 2.0  # symbolic condition number of a planar 2R
 
@@ -884,6 +885,59 @@ def exact_section(args, targets: Targets) -> list[str]:
     return lines + table(["what", "rank_at", "column_space", "left_null_space", "target", "status"], rows)
 
 
+def singular_poses_section(args, targets: Targets) -> list[str]:
+    """Exact rank and bases at the textbook's singular poses with mixed rational·π angles (issue 32, item 2):
+    each call's CPU seconds and whether the answer is exact (``Rank.exact``; the bases: no Floats, no warning)."""
+    import warnings
+
+    from kinlib.exact import NumericFallbackWarning, column_space, left_null_space, rank_at
+
+    R, pi = sp.Rational, sp.pi
+    h = [3 * pi / 11, 2 * pi / 7, 5 * pi / 13, 3 * pi / 11, 2 * pi / 7, R(1, 3)]
+    no_offsets = robots.puma560(R(2, 5), 0, 0, R(2, 5))
+    cases = [
+        ("UR5 elbow θ3 = π", robots.ur5(), [h[0], h[1], pi, h[2], h[3], h[4]]),
+        ("UR5 wrist θ5 = 0", robots.ur5(), [h[0], h[1], h[2], h[3], 0, h[4]]),
+        ("UR5 elbow and wrist", robots.ur5(), [h[0], h[1], 0, h[2], pi, h[5]]),
+        ("UR5 θ3 = π + 10⁻⁷⁰ (R07: full rank)", robots.ur5(), [R(1, 2), 2 * pi / 7, pi + R(1, 10**70), 3, h[3], 1]),
+        ("PUMA 560 wrist θ5 = π", robots.puma560(), [h[0], h[1], h[2], h[3], pi, h[5]]),
+        ("PUMA (no offsets) elbow θ3 = π/2", no_offsets, [h[0], h[1], pi / 2, h[2], h[3], h[4]]),
+        ("PUMA (no offsets) shoulder θ3 = π/2 − 2θ2", no_offsets, [h[0], h[1], pi / 2 - 2 * h[1], h[2], h[3], h[5]]),
+    ]
+    lines = [
+        "## Exact analysis at singular poses (issue 32)",
+        "",
+        "`rank_at`, `column_space`, `left_null_space` of the space Jacobian at elbow, wrist and shoulder "
+        "singularities with mixed rational·π angles (2π/7, 3π/11, 5π/13, 1/3: their number field has degree in the "
+        "hundreds). CPU seconds per call (`time.thread_time`, SymPy's cache cleared before each pose) and whether "
+        "the answer is exact. Before issue 32 each call spent its whole 60 s budget, then answered in 60-digit "
+        "numerics.",
+        "",
+    ]
+    rows = []
+    for label, chain, q in cases if not args.quick else cases[:2]:
+        J = chain.jacobian_space()
+        sp.core.cache.clear_cache()
+        cells, worst, exact = [], 0.0, True
+        for fn in (rank_at, column_space, left_null_space):
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
+                t0 = CLOCK()
+                out = fn(J, q, chain.thetas)
+                dt = CLOCK() - t0
+            if fn is rank_at:
+                ok, r = bool(out.exact), out
+            else:
+                ok = not any(e.has(sp.Float) for e in out)
+            ok = ok and not any(issubclass(w.category, NumericFallbackWarning) for w in caught)
+            exact &= ok
+            worst = max(worst, dt)
+            cells.append(f"{fmt_t(dt)} ({'exact' if ok else 'NOT exact'})")
+        status = targets.upper(f"singular pose, {label}", worst if exact else None, T_SINGULAR_POSE)
+        rows.append([f"{label}: rank {int(r)}", *cells, f"≤ {fmt_t(T_SINGULAR_POSE)} each, exact", status])
+    return lines + table(["pose", "rank_at", "column_space", "left_null_space", "target", "status"], rows)
+
+
 _SINGULAR7_SCRIPT = r"""
 import json, sys, time, warnings
 import numpy as np, sympy as sp
@@ -1391,7 +1445,7 @@ def main(argv=None) -> int:
         "--only",
         default="",
         help="comma-separated sections to run, e.g. --only urdf,numeric (names: numeric, urdf, first_call, symbolic, "
-        "exact, analysis, notebook, explorer, browser, static, lite, grader, import; default: all)",
+        "exact, singular-poses, analysis, notebook, explorer, browser, static, lite, grader, import; default: all)",
     )
     args = ap.parse_args(argv)
     if args.quick:
@@ -1411,6 +1465,7 @@ def main(argv=None) -> int:
         first_call_section,
         symbolic_section,
         exact_section,
+        singular_poses_section,
         analysis_section,
         notebook_section,
         explorer_section,
@@ -1420,7 +1475,7 @@ def main(argv=None) -> int:
         grader_section,
         import_section,
     ):
-        if args.only and fn.__name__.removesuffix("_section") not in args.only.split(","):
+        if args.only and fn.__name__.removesuffix("_section") not in args.only.replace("-", "_").split(","):
             continue
         t0 = time.perf_counter()
         sections.append(fn(args, targets))

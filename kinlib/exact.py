@@ -10,7 +10,12 @@ a proof). But first a 60-digit SVD (entries to 100 digits) decides every *nonzer
 10⁻²⁰·σ_max is certified nonzero (entries and SVD are accurate to ~10⁻⁵⁵·σ_max, and |σ_i(A) − σ_i(Ã)| ≤
 ‖A − Ã‖). With symbolic parameters this is done at fixed rational values of them: a minor nonzero there is a
 nonzero function of the parameters, so full rank there proves full rank. Only a decision "this is zero" (a rank
-drop, a skipped pivot column, a zero entry) is left to exact fraction-free elimination over K[t, L1, L2, …].
+drop, a skipped pivot column, a zero entry) is left to exact arithmetic: first minor by minor, by the arm's
+structure (:class:`kinlib.exactfield.PointLift`: the configuration's angles written as sums of independent angles,
+so that a minor that is 0 for *every* value of them, such as one with the factor sin θ3 at θ3 = π, is proved 0
+with no number field; a minor that is not is certified nonzero at 100, 300 or 1000 digits, or decided factor by
+factor), which answers the textbook's singular poses at angles such as 2π/7 next to 3π/11 in about a second;
+what that leaves undecided goes to fraction-free elimination over K[t, L1, L2, …].
 Parameters count as indeterminates: the rank found is the rank for all their positive values except where a
 stated expression vanishes (see :class:`Rank`).
 
@@ -399,6 +404,7 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None,
     except OutOfTime:
         why = _late(seconds)
     r, _ = fallback_rank(_numbers_only(M, "rank_at", why, seconds))
+    fallback_warning("rank_at", why)
     return Rank(r, exact=False, note=f"{FALLBACK_DIGITS}-digit SVD ({why})")
 
 

@@ -19,7 +19,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from .display import readable_fold, readable_ratio
-from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, decide_zero, mp_context, mp_matrix, mp_value
+from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, PointLift, decide_zero, mp_context, mp_matrix, mp_value
 from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = ["EXACT_BUDGET", "MAX_MINORS", "RankAnalysis", "ring_det", "canonical_rows", "rank_conditions"]
@@ -163,10 +163,16 @@ class RankAnalysis:
         self.A = A
         self._fld = None
         self.certified = False
+        self.pose = None
         got = _certified_pivots(A)
         if got is not None:
             self.pivots, self.rows = got
             self.rank, self.R, self.certified = len(self.pivots), None, True
+            return
+        got = _singular_pose(A)
+        if got is not None:
+            self.pose, (self.pivots, self.rows) = got
+            self.rank, self.R = len(self.pivots), None
             return
         fld = self.fld
         size = max((abs(n) for n, _ in fld.multiples.values()), default=0) * min(A.shape)
@@ -182,10 +188,16 @@ class RankAnalysis:
         if self.rows is None:  # the pivot columns of Aᵀ, exactly
             self.rows = _rref(dA.transpose(), fld)[1]
 
-    def is_zero(self, e: sp.Expr) -> bool:
+    def is_zero(self, e: sp.Expr, minor: tuple | None = None) -> bool:
         """Whether e (a number or expression in the parameters, built from A's sines and cosines) is 0, proved:
-        nonzero when its value (parameters at :data:`SPECIAL_VALUES`) is above 10⁻³⁰ at 100 digits, else exactly."""
+        nonzero when its value (parameters at :data:`SPECIAL_VALUES`) is above 10⁻³⁰ at 100 digits, else exactly.
+        ``minor``: (rows, columns) when e is that minor of A (decided as at a singular pose, when A is one)."""
         mpmath = mp_context()
+
+        if self.pose is not None and minor is not None:
+            z = self.pose.minor_zero(*minor)
+            if z is not None:
+                return z
 
         try:
             with mpmath.workdps(FALLBACK_DIGITS + 40):
@@ -201,10 +213,15 @@ class RankAnalysis:
             self._fld = ExactField(list(self.A))
         return self._fld
 
-    def entry_is_zero(self, k: int, j: int, expr) -> bool:
-        """Whether rref(A)[k, j] is 0; ``expr()`` gives its numerator (a minor) when it must be computed."""
+    def entry_is_zero(self, k: int, j: int, expr, minor: tuple | None = None) -> bool:
+        """Whether rref(A)[k, j] is 0; ``expr()`` gives its numerator (a minor) when it must be computed;
+        ``minor``: its (rows, columns) in A."""
         if self.R is not None:
             return not self.R[k][j]
+        if self.pose is not None and minor is not None:
+            z = self.pose.minor_zero(*minor)
+            if z is not None:
+                return z
         return decide_zero(expr())
 
 
@@ -235,7 +252,7 @@ def canonical_rows(A: sp.Matrix, an: RankAnalysis) -> sp.Matrix:
                 minor["d"] = ring_det(Bk)
                 return minor["d"]
 
-            if an.entry_is_zero(k, j, numerator):
+            if an.entry_is_zero(k, j, numerator, (I, P[:k] + [j] + P[k + 1 :])):
                 continue
             out[k, j] = readable_ratio(minor["d"] if "d" in minor else ring_det(Bk), D)
     return out
@@ -319,7 +336,7 @@ def rank_conditions(A: sp.Matrix, an: RankAnalysis) -> tuple:
     common, pivot_factors = None, None
     for I, P in itertools.islice(itertools.chain([first], (c for c in others if c != first)), MAX_MINORS):
         D = ring_det(A.extract(list(I), list(P)))  # in the sines and cosines of A (the field's atoms)
-        if D == 0 or ((I, P) != first or not an.certified) and an.is_zero(D):
+        if D == 0 or ((I, P) != first or not an.certified) and an.is_zero(D, (list(I), list(P))):
             continue
         facs = _vanishing_factors(D, an)
         if not facs:
@@ -328,3 +345,229 @@ def rank_conditions(A: sp.Matrix, an: RankAnalysis) -> tuple:
             pivot_factors = facs
         common = facs if common is None else [f for f in common if f in facs]
     return tuple(readable_fold(f) for f in (common or pivot_factors or ()))
+
+
+# ----------------------------------------------------------------------------------------------
+# singular poses: zero tests through independent angles (no number field)
+# ----------------------------------------------------------------------------------------------
+#: the precisions (digits) at which a minor that is not 0 for all φ is looked at again: nonzero when above
+#: 10^(70 − digits) times Hadamard's bound (the margin of :func:`_numeric_pivots`, 70 digits)
+_ESCALATE = (100, 300, 1000)
+#: minors are factored only over QQ and with at most this many terms (SymPy's multivariate factoring, slow over
+#: an algebraic extension: 25 s a minor); otherwise the minor's value is decided whole
+_MAX_FACTOR_TERMS = 400
+
+
+def _mp_det(rows: list):
+    """det of a small square mpmath matrix (lists) by elimination with partial pivoting (call inside workdps);
+    mpmath.det fails on an exactly singular one."""
+    A = [list(r) for r in rows]
+    n, d = len(A), 1
+    for j in range(n):
+        k = max(range(j, n), key=lambda i: abs(A[i][j]))
+        if not A[k][j]:
+            return 0 * d
+        if k != j:
+            A[j], A[k] = A[k], A[j]
+            d = -d
+        d *= A[j][j]
+        for i in range(j + 1, n):
+            f = A[i][j] / A[j][j]
+            if f:
+                A[i] = [a - f * b for a, b in zip(A[i], A[j])]
+    return d
+
+
+def _has_division(e: sp.Expr) -> bool:
+    return any(p.exp.is_negative for p in e.atoms(sp.Pow))
+
+
+def _hadamard_small(d, X, rows, cols, digits: int) -> bool:
+    """Whether |d| (a minor X[rows, cols] computed at ``digits`` digits) is below the certification line
+    10^(70 − digits) · Π ‖column‖ (Hadamard's bound on the minor): "not certified nonzero"."""
+    mpmath = mp_context()
+
+    h = mpmath.mpf(1)
+    for j in cols:
+        h *= mpmath.sqrt(mpmath.fsum(abs(X[i, j]) ** 2 for i in rows))
+    return not abs(d) > h * mpmath.mpf(10) ** (70 - digits)
+
+
+class _SingularPose:
+    """The rank, pivots and independent rows of an evaluated matrix A decided minor by minor: each minor
+    nonzero by certified numerics (escalated to 300 and 1000 digits), zero by :class:`PointLift` (0 for every
+    value of the independent angles), or, for a minor that is neither, by its factors one by one (nonzero
+    numerically, or decided exactly by :func:`~kinlib.exactfield.decide_zero` on that factor alone). A
+    minor none of these decides makes the whole analysis give way (None) to elimination in K(t)."""
+
+    def __init__(self, A: sp.Matrix):
+        self.A = A
+        self.lift = PointLift(list(A))
+        self.special = _special(A.free_symbols)
+        self._X: dict = {}
+        self._rows = None
+        self._ring = None
+        self._memo: dict = {}
+
+    def X(self, digits: int):
+        mpmath = mp_context()
+
+        if digits not in self._X:
+            B = self.A.xreplace(self.special) if self.special else self.A
+            memo: dict = {}
+            with mpmath.workdps(digits):
+                self._X[digits] = mpmath.matrix(
+                    [[mp_value(B[i, j], memo, mpmath) for j in range(B.cols)] for i in range(B.rows)]
+                )
+        return self._X[digits]
+
+    def _lifted_rows(self):
+        """Each row of A lifted and multiplied by the product of its entries' denominators (nonzero at the
+        configuration: they are the entries' own denominators there), as ring elements."""
+        if self._rows is None:
+            fr = [
+                [sp.fraction(sp.together(e)) if _has_division(e) else (e, sp.S.One) for e in row]
+                for row in self.A.tolist()
+            ]
+            exprs = [self.lift.lifted(x) for row in fr for pair in row for x in pair]
+            ring = self.lift.ring(exprs)
+            it = iter(exprs)
+            rows = []
+            for row in fr:
+                nums, dens = [], []
+                for _ in row:
+                    nums.append(ring.normal_form(next(it)))
+                    dens.append(ring.normal_form(next(it)))
+                distinct = []
+                for d in dens:
+                    if d != ring.ring.one and d not in distinct:
+                        distinct.append(d)
+                out = []
+                for n, d in zip(nums, dens):
+                    x = n
+                    for o in distinct:
+                        if o != d:
+                            x = x * o
+                    out.append(x)
+                rows.append(out)
+            self._rows, self._ring = rows, ring
+        return self._rows
+
+    def _numeric(self, rows, cols, digits: int):
+        """The minor at ``digits`` digits: (nonzero certified?, value)."""
+        mpmath = mp_context()
+
+        X = self.X(digits)
+        with mpmath.workdps(digits):
+            d = _mp_det([[X[i, j] for j in cols] for i in rows])
+            return not _hadamard_small(d, X, rows, cols, digits), d
+
+    def minor_zero(self, rows, cols) -> bool | None:
+        """Whether det A[rows, cols] = 0 (True / False, proved), None when undecided."""
+        key = (tuple(sorted(rows)), tuple(sorted(cols)))
+        if key in self._memo:
+            return self._memo[key]
+        self._memo[key] = out = self._decide(list(rows), list(cols))
+        return out
+
+    def _decide(self, rows, cols):
+        if self._numeric(rows, cols, _ESCALATE[0])[0]:
+            return False
+        try:
+            L = self._lifted_rows()
+        except (NotTrigPolynomial, NotExact):
+            return None
+        ring = self._ring
+        D = DomainMatrix([[L[i][j] for j in cols] for i in rows], (len(rows), len(cols)), ring.ring.to_domain())
+        p = ring.reduce(D.det())
+        if not p:
+            return True
+        for digits in _ESCALATE[1:]:
+            if self._numeric(rows, cols, digits)[0]:
+                return False
+        return self._by_factors(ring, p)
+
+    def _by_factors(self, ring, p):
+        """p ≠ 0 as a polynomial, numerically 0 here: zero exactly when one of its factors is."""
+        factors = [(p, 1)]
+        if ring.domain.is_QQ and len(p.terms()) <= _MAX_FACTOR_TERMS:
+            try:
+                factors = p.factor_list()[1]
+            except Exception:  # pragma: no cover - then p is decided whole
+                pass
+        env = dict(zip(self.lift.angles, self.lift.values))
+        for f, _m in factors:
+            e = ring.to_expr(f).xreplace(env)
+            try:
+                if decide_zero(e, "a factor of a minor"):
+                    return True
+            except ValueError:
+                return None
+        return False
+
+    def greedy(self, m: int, n: int, zero):
+        """(pivot columns, their rows) of an m×n matrix whose minors' zero tests are ``zero(rows, cols)``:
+        column j joins when some bordered minor [I + i, P + j] is nonzero (then A[I, P] stays nonsingular;
+        otherwise every bordered minor is 0 and column j lies in the span of the pivots)."""
+        P: list = []
+        I: list = []
+        for j in range(n):
+            if len(P) == m:
+                break
+            free = [i for i in range(m) if i not in I]
+            pick = None
+            for i in free:  # numerics first: any certified nonzero bordered minor will do
+                if zero(I + [i], P + [j], numeric=True) is False:
+                    pick = i
+                    break
+            if pick is None:
+                for i in free:
+                    z = zero(I + [i], P + [j])
+                    if z is None:
+                        return None
+                    if z is False:
+                        pick = i
+                        break
+            if pick is not None:
+                P.append(j)
+                I.append(pick)
+        return P, I
+
+    def analyse(self):
+        """(pivots, rows) of A as :class:`RankAnalysis` has them (rows: the first independent rows of
+        A[:, pivots]), or None when a minor is undecided."""
+        A = self.A
+
+        def zero(rows, cols, numeric=False):
+            if numeric:
+                return False if self._numeric(rows, cols, _ESCALATE[0])[0] else None
+            return self.minor_zero(rows, cols)
+
+        got = self.greedy(A.rows, A.cols, zero)
+        if got is None:
+            return None
+        P, _ = got
+        rows = _independent_rows(A, P)
+        if rows is None:  # the first independent rows of A[:, P], decided the same way (transposed)
+
+            def zero_t(rows_t, cols_t, numeric=False):
+                return zero(cols_t, [P[k] for k in rows_t], numeric)
+
+            got_t = self.greedy(len(P), A.rows, zero_t)
+            if got_t is None:
+                return None
+            rows = got_t[0]
+        return P, rows
+
+
+def _singular_pose(A: sp.Matrix):
+    """(the :class:`_SingularPose` analysis, (pivots, rows)) of A, or None when it does not apply (no sines and
+    cosines; an angle outside r + qπ; a minor it cannot decide): then elimination in K(t) decides."""
+    if not A.has(sp.sin, sp.cos):
+        return None
+    try:
+        pose = _SingularPose(A)
+        got = pose.analyse()
+    except (NotExact, NotTrigPolynomial):
+        return None
+    return None if got is None else (pose, got)

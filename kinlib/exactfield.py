@@ -22,8 +22,10 @@ certified numerics of :mod:`kinlib.exact`.
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 import threading
+from fractions import Fraction
 from typing import Any
 
 import sympy as sp
@@ -33,10 +35,11 @@ from sympy.polys.matrices import DomainMatrix
 from sympy.polys.polyerrors import CoercionFailed
 from sympy.polys.rings import ring as _ring
 
-from .trigpoly import normal_form_zero
+from .trigpoly import NotTrigPolynomial, TrigRing, normal_form_zero
 
 __all__ = [
     "ExactField",
+    "PointLift",
     "NotExact",
     "exact_is_zero",
     "decide_zero",
@@ -390,6 +393,128 @@ class ExactField:
         )
 
 
+# ----------------------------------------------------------------------------------------------
+# singular poses: zero through independent angles (no number field)
+# ----------------------------------------------------------------------------------------------
+#: the nice parts ν of an angle Σ n_i φ_i + ν: multiples of π/12 (sin ν, cos ν in Q(√2, √3))
+_NICE = 12
+#: at most this many independent angles φ_i (3^k sign patterns are tried for each new angle)
+MAX_LIFT_ANGLES = 9
+
+
+class PointLift:
+    """Zero tests at a configuration through angles taken as independent: what a singular pose needs.
+
+    At a singular pose a minor vanishes because of the arm's structure (sin θ3 = 0 at θ3 = π, whatever the
+    other joints are), not because of a coincidence between 2π/7 and 3π/11. Each sine or cosine in the matrix
+    is sin/cos of an angle a = r + qπ (r, q rational); the angles are written as a = Σ n_i φ_i + ν with
+    n_i ∈ {−1, 0, 1} (or ±2 on at most two φ_i), ν a multiple of π/12 and φ_i the matrix's own angles (smallest first: the joint values
+    before their sums), checked exactly (r and q compared as rationals). ``lifted(e)`` replaces every sine and
+    cosine by the polynomial in sin φ_i, cos φ_i (and sin ν, cos ν) it equals at the configuration. A
+    polynomial that is 0 for *every* φ (its normal form modulo sin² + cos² − 1 is 0,
+    :class:`kinlib.trigpoly.TrigRing`) is 0 at the configuration: a proof of "zero" that needs no number field
+    (Q(cos 2π/7, cos 3π/11, …) has degree in the hundreds). It proves nothing about "nonzero" (certified
+    numerics do that), and a zero by coincidence is left to the other exact routes.
+
+    >>> import sympy as sp
+    >>> a, b = 2 * sp.pi / 7, 3 * sp.pi / 11
+    >>> e = sp.sin(a + b) - sp.sin(a) * sp.cos(b) - sp.cos(a) * sp.sin(b)   # 0: sin(a + b) is sin(34π/77)
+    >>> lift = PointLift([e])
+    >>> lift.values   # 34π/77 = π − 2π/7 − 3π/11
+    [2*pi/7, 3*pi/11]
+    >>> lift.is_zero(e)
+    True
+    """
+
+    def __init__(self, exprs: list):
+
+        atoms: set = set()
+        for e in exprs:
+            atoms |= e.atoms(sp.sin, sp.cos)
+        if any(e.has(sp.tan, sp.cot, sp.sec, sp.csc) for e in exprs):
+            raise NotExact("tan/cot/sec/csc: not lifted")
+        parts = {}
+        for f in atoms:
+            r, q = _angle_parts(f.args[0])  # NotExact for √2, or an angle with parameters
+            parts[f] = (Fraction(int(r.p), int(r.q)), Fraction(int(q.p), int(q.q)))
+        order = sorted(
+            set(parts.values()),
+            key=lambda a: (max(abs(a[0].numerator), a[0].denominator) * max(abs(a[1].numerator), a[1].denominator), a),
+        )
+        basis: list = []
+        combo: dict = {}  # angle -> (coefficients, nu)
+        for a in order:
+            found = self._express(a, basis)
+            if found is None:
+                if len(basis) >= MAX_LIFT_ANGLES:
+                    raise NotExact(f"more than {MAX_LIFT_ANGLES} independent angles")
+                basis.append(a)
+                found = (tuple([0] * (len(basis) - 1) + [1]), Fraction(0))
+            combo[a] = found
+        self.values = [
+            sp.Rational(r.numerator, r.denominator) + sp.Rational(q.numerator, q.denominator) * sp.pi for r, q in basis
+        ]
+        self.angles = [sp.Dummy(f"phi{i}", real=True) for i in range(len(basis))]
+        self.table = {}
+        for f, a in parts.items():
+            coeffs, nu = combo[a]
+            arg = sum((n * p for n, p in zip(coeffs, self.angles) if n), sp.S.Zero)
+            arg += sp.Rational(nu.numerator, nu.denominator) * sp.pi
+            self.table[f] = sp.expand_trig(type(f)(arg))
+        self._back = {}
+        for p, v in zip(self.angles, self.values):
+            self._back[sp.sin(p)], self._back[sp.cos(p)] = sp.sin(v), sp.cos(v)
+
+    @staticmethod
+    def _express(a, basis):
+        """(coefficients, ν) with a = Σ n_i b_i + νπ, ν a multiple of 1/12: n_i ∈ {−1, 0, 1} (sums of joint
+        values), then n_i ∈ {±1, ±2} on at most two angles (θ3 = π/2 − 2θ2); None when neither fits."""
+        r, q = a
+        k = len(basis)
+        tries = [(size, (1, -1)) for size in range(1, k + 1)] + [(size, (2, -2, 1, -1)) for size in (1, 2)]
+        for size, choices in tries:
+            for support in itertools.combinations(range(k), size):
+                for signs in itertools.product(choices, repeat=size):
+                    if len(choices) == 4 and all(abs(s) == 1 for s in signs):
+                        continue  # tried already
+                    rr, qq = r, q
+                    for i, s in zip(support, signs):
+                        rr -= s * basis[i][0]
+                        qq -= s * basis[i][1]
+                    if rr == 0 and (qq * _NICE).denominator == 1:
+                        coeffs = [0] * k
+                        for i, s in zip(support, signs):
+                            coeffs[i] = s
+                        return tuple(coeffs), qq
+        return None
+
+    def lifted(self, e: sp.Expr) -> sp.Expr:
+        """e with every sine and cosine written in the independent angles (equal at the configuration)."""
+        return e.xreplace(self.table)
+
+    def ring(self, exprs: list) -> TrigRing:
+        """The exact :class:`TrigRing` of lifted expressions (the angles φ_i; parameters as variables)."""
+        ring = TrigRing(exprs, self.angles)
+        if ring.domain.is_EX:
+            raise NotExact("constants outside SymPy's exact domains")
+        return ring
+
+    def is_zero(self, e: sp.Expr) -> bool:
+        """True when e is 0 for every value of the independent angles (so 0 here); False: not shown. A quotient
+        is 0 where its numerator is (its denominator is the lift of e's own denominators, nonzero here)."""
+        try:
+            x = self.lifted(e)
+            if any(p.exp.is_negative for p in x.atoms(sp.Pow)):
+                x = sp.fraction(sp.together(x))[0]
+            return not self.ring([x]).normal_form(x)
+        except (NotTrigPolynomial, NotExact):
+            return False
+
+    def at_point(self, e: sp.Expr) -> sp.Expr:
+        """A lifted expression (in sin φ_i, cos φ_i) at the configuration again."""
+        return e.xreplace(self._back)
+
+
 def exact_is_zero(e: Any) -> bool:
     """Whether the number (or expression in positive parameters) e is exactly 0, proved.
 
@@ -447,6 +572,12 @@ def decide_zero(e: Any, what: str = "an entry") -> bool:
                 if abs(mp_value(e, {}, mpmath)) > mpmath.mpf(10) ** -30:
                     return False
         except (TypeError, ValueError):  # e.g. a complex intermediate: the exact routes below decide
+            pass
+    if e.has(sp.sin, sp.cos):  # zero for every value of the angles taken independently: zero (no number field)
+        try:
+            if PointLift([e]).is_zero(e):
+                return True
+        except NotExact:
             pass
     try:
         return not ExactField([e]).convert(e)
