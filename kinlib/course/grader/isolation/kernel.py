@@ -345,13 +345,16 @@ class Kernel:
         msg = _message_of(self.kc.get_iopub_msg, msg_id, wait)
         if msg is None:
             return False
-        mt, c = msg["msg_type"], msg["content"]
+        mt, c = msg.get("msg_type"), msg.get("content")
+        if not isinstance(c, dict):
+            return False
         if mt == "status" and c.get("execution_state") == "idle":
             return True
         if mt == "stream":
-            res.output_bytes += len(c.get("text", ""))
+            res.output_bytes += len(str(c.get("text", "")))
         elif mt in ("display_data", "execute_result", "update_display_data"):
-            res.output_bytes += sum(len(str(v)) for v in c.get("data", {}).values())
+            data = c.get("data")
+            res.output_bytes += sum(len(str(v)) for v in data.values()) if isinstance(data, dict) else 0
         elif mt == "error" and res.status == "ok":
             _record_error(res, c)
         return False
@@ -361,7 +364,9 @@ class Kernel:
         reply = _message_of(self.kc.get_shell_msg, msg_id, wait)
         if reply is None:
             return False
-        c = reply["content"]
+        c = reply.get("content")
+        if not isinstance(c, dict):
+            c = {"status": "error", "ename": "ProtocolError", "evalue": "the kernel's reply was malformed"}
         if c.get("status") == "error" and res.status == "ok":
             _record_error(res, c)
         elif c.get("status") == "aborted" and res.status == "ok":
@@ -410,12 +415,24 @@ class Kernel:
 
 def _message_of(get, msg_id: str, wait: float):
     """The next message ``get`` (a kernel client's iopub or shell reader) gives within ``wait`` seconds if it
-    belongs to the execution ``msg_id``, else None."""
+    belongs to the execution ``msg_id``, else None. The kernel holds the connection key, so a student's code can
+    send any signed message: one of the wrong shape (``parent_header = [1]``) is skipped, never an error here.
+
+    >>> _message_of(lambda timeout: {"parent_header": [1], "content": {}}, "m1", 0.1) is None
+    True
+    >>> _message_of(lambda timeout: {"parent_header": {"msg_id": "m1"}, "content": {}}, "m1", 0.1)["content"]
+    {}
+    """
     try:
         msg = get(timeout=wait)
     except queue.Empty:
         return None
-    return msg if msg.get("parent_header", {}).get("msg_id") == msg_id else None
+    except (ValueError, TypeError, KeyError, AttributeError, UnicodeError):  # undecodable: not ours
+        return None
+    if not isinstance(msg, dict):
+        return None
+    parent = msg.get("parent_header")
+    return msg if isinstance(parent, dict) and parent.get("msg_id") == msg_id else None
 
 
 def _record_error(res, content: dict) -> None:
