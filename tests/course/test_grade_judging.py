@@ -144,6 +144,11 @@ def test_hostile_trees_are_judged_or_refused_and_the_next_answer_is_judged_right
             assert v.status == "fail", (name, v)
         right = jp.judge("J", "expr", ex.exported(J), seconds=120)
         assert right.status == "pass", right
+        if not sandboxed:  # its memory, open files and writes are bounded (in the sandbox: the same command)
+            limits = Path(f"/proc/{jp.proc.pid}/limits").read_text().splitlines()
+            row = {line[:26].strip(): line[26:].split() for line in limits[1:]}
+            assert row["Max address space"][0] == str(judging.MEMORY_BYTES)
+            assert row["Max open files"][0] == str(judging.MAX_FILES) and row["Max file size"][0] == "0"
     finally:
         jp.close()
 
@@ -309,3 +314,74 @@ def test_a_gradescope_score_never_exceeds_the_maximum():
 
 def test_verdict_fields_are_what_the_rows_read():
     assert Verdict("J", "fail", "m").as_dict() == {"answer": "J", "status": "fail", "message": "m"}
+
+
+# ----------------------------------------------------------------------------------------- a batch with a victim
+
+FIX = Path(__file__).resolve().parents[1] / "fixtures" / "grade"
+SOLUTION = FIX / "notebooks" / "90_grade_fixture.ipynb"
+
+# what the hostile submission's cells set each answer to (after the solution's own cell for it)
+HOSTILE = {
+    "Js": "Js = sp.sin(sp.Float('1e1000000') * th1) * sp.ones(6, 3)",  # π to 3.3 Mbit: 134 s before
+    "detJ": "detJ = ((th2**99)**99)**99",  # nested powers
+    "moves": "_f = sp.Function('f')\nmoves = sp.Matrix(3, 3, lambda i, j: _f(th1 + i) ** (j + 1))",
+    "singular": (
+        "_n = sp.Symbol('n', integer=True)\n"  # 45 ImageSets: 47 s against 3 s before
+        "singular = [{th2: sp.ImageSet(sp.Lambda(_n, 2*_n*sp.pi + sp.Rational(k, 41)), sp.Integers)}"
+        " for k in range(45)]"
+    ),
+}
+# one signed IOPub message with parent_header = [1] (0/20 "internal error in the checker" before), then a flood
+# of IOPub messages that goes on while the grader exports the answers
+PROTOCOL = (
+    "import threading\n"
+    "_k = get_ipython().kernel\n"
+    "_m = _k.session.msg('stream', {'name': 'stdout', 'text': 'hi'})\n"
+    "_m['parent_header'] = [1]\n"
+    "_k.session.send(_k.iopub_socket, _m)\n"
+    "def _flood():\n"
+    "    while True:\n"
+    "        _k.session.send(_k.iopub_socket, 'stream', {'name': 'stdout', 'text': 'x' * 1000})\n"
+    "threading.Thread(target=_flood, daemon=True).start()\n"
+)
+
+
+def _hostile_notebook() -> dict:
+    nb = json.loads(SOLUTION.read_text())
+    cells = []
+    for c in nb["cells"]:
+        cells.append(c)
+        for name in (c.get("metadata", {}).get("kinlib", {}) or {}).get("answers", []):
+            if name in HOSTILE:
+                src = HOSTILE[name]
+                cells.append(
+                    {"cell_type": "code", "metadata": {}, "source": src, "outputs": [], "execution_count": None}
+                )
+    cells.append({"cell_type": "code", "metadata": {}, "source": PROTOCOL, "outputs": [], "execution_count": None})
+    nb["cells"] = cells
+    return nb
+
+
+@pytest.mark.slow
+def test_hostile_trees_and_an_iopub_flood_in_a_batch_leave_the_victim_graded_right(tmp_path, grader_reference_cache):
+    """Two workers: a submission with every hostile tree of the issue and a protocol attack, and a victim (the
+    solution itself). The hostile answers are judged or refused (fails, never errors, infrastructure or
+    'internal error'), its right answers still score, and the victim gets full marks."""
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "hostile.ipynb").write_text(json.dumps(_hostile_notebook()))
+    (subs / "victim.ipynb").write_bytes(SOLUTION.read_bytes())
+    summary = grade.grade_batch(
+        [subs], tmp_path / "out", jobs=2, timeout=600, cell_timeout=120, notebooks=FIX / "notebooks",
+        cache=grader_reference_cache, log=None, batch_timeout=3000,
+    )  # fmt: skip
+    res = {r["relpath"]: r for r in summary["results"]}
+    assert summary["infrastructure_errors"] == 0, [r.get("infrastructure") for r in res.values()]
+    victim = res["victim.ipynb"]["rows"]
+    assert [r["status"] for r in victim] == ["pass"] * 5 and all(r["points"] == r["max_points"] for r in victim)
+    hostile = {r["part"]: r for r in res["hostile.ipynb"]["rows"]}
+    assert [hostile[p]["status"] for p in ("1.1", "1.2", "1.3", "1.4")] == ["fail"] * 4, hostile
+    assert hostile["1.5"]["status"] == "pass"  # its untouched answers are graded as usual
+    text = json.dumps(res["hostile.ipynb"]["rows"])
+    assert "internal error" not in text and "reference could not" not in text

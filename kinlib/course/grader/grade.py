@@ -52,7 +52,9 @@ How it works
   their source text), which snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
   namespaces, then asks for each answer *as data*: a JSON tree of the SymPy expression, matrix, set, array,
   list, number or string (:mod:`kinlib.course.answers.wire`), and stops the kernel. Everything else happens in
-  the grader (:func:`kinlib.course.grader.judge.judge_answer`, per answer with caps and a time limit): the
+  the grader's judge process for the submission (:mod:`kinlib.course.grader.judging`: in the sandbox, holding no
+  secret, writing nothing; :func:`kinlib.course.grader.judge.judge_answer` per answer with caps, and the process
+  killed and replaced when an answer goes past its time limit): the
   tree is rebuilt by a whitelist parser (never ``eval``), evaluated at random points (joint angles in
   (-π, π), positive symbols in (0.5, 2); random per submission, seeded by HMAC(grader secret, submission
   bytes) (:mod:`kinlib.course.grader.secret`): reruns are reproducible, and nobody without the secret can
@@ -82,7 +84,9 @@ grades.csv and the feedback are written after every kernel of the batch, and eve
 started, is gone (checked: :func:`kinlib.course.grader.isolation.sandbox.reap_namespaces`). Without bubblewrap the grader
 refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.
 A kernel that cannot start is retried (:data:`kinlib.course.grader.isolation.kernel.START_ATTEMPTS`), judged by its
-process, not by heartbeats. The kernel is told nothing secret (no point, seed or reference: only the names of
+process, not by heartbeats. Only the supervisor holds the grader secret: it signs the reference cache and chooses
+each submission's points (:func:`plan`); grading workers and judge processes get the points and references, never
+the secret, and only the supervisor writes the output folder. The kernel is told nothing secret (no point, seed or reference: only the names of
 the answers), and what it reports is only a claim of "this is my answer": a JSON tree read from a size-capped
 file by a whitelist parser with caps, never evaluated as code. A submission that replaces or patches the
 in-kernel export (it is reachable from ``sys.modules``) can claim any answer, which scores only if it *is*
@@ -326,11 +330,13 @@ def _run_and_judge(job: Job, enc: Enclosure) -> list:
     code = code_cells(job.nb)
     part_of_cell = {i: part for i, c in enumerate(code) if (part := cell_part(cell_meta(c)))}
     run, cpu0 = None, time.process_time()
-    # the judge of this submission's answers: its own process, started now so that it imports SymPy while the
-    # kernel runs; without the sandbox it runs as the student's user when there is one (judging.JudgeProcess)
+    # the judge of this submission's answers: its own process (judging.JudgeProcess), in the sandbox started now,
+    # so that it imports SymPy while the kernel runs; as the student's user (no sandbox) only once every process
+    # of that user is gone (the kernel's could reach a process of their own user)
     judge = JudgeProcess(job.ref, job.points, job.seed, sandbox=job.sandbox or None, user=job.user)
     try:
-        judge.start()
+        if job.user is None:
+            judge.start()
         scratch = os.path.join(enc.folder, "work")
         os.makedirs(scratch)
         with open(os.path.join(scratch, job.path.name), "wb") as f:
