@@ -478,7 +478,7 @@ def test_the_cgroup_v2_path_on_a_fake_cgroup_filesystem(tmp_path, monkeypatch):
         (c,) = e.cgroups
         assert e.kind == "v2" and c.parent == base and "cgroup v2" in e.describe()
         assert [(c / f).read_text() for f in ("memory.max", "memory.swap.max", "pids.max")] == [str(2**30), "0", "64"]
-        assert e.rlimits() == {"as": 2**30 + 2 * 2**30, "fsize": lim.disk_bytes}  # no nproc: the cgroup counts
+        assert e.rlimits() == {"as": 2**30 + 2 * 2**30, "fsize": lim.disk_bytes, "nofile": lim.files}  # no nproc
         ran = subprocess.run(e.wrap([sys.executable, "-c", "import os; print(os.getpid())"]), capture_output=True)
         assert (c / "cgroup.procs").read_text().split() == ran.stdout.decode().split()  # joined, then exec'd
         (c / "memory.events").write_text("low 0\nhigh 0\nmax 7\noom 2\noom_kill 2\n")

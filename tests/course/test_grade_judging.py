@@ -323,7 +323,9 @@ SOLUTION = FIX / "notebooks" / "90_grade_fixture.ipynb"
 
 # what the hostile submission's cells set each answer to (after the solution's own cell for it)
 HOSTILE = {
-    "Js": "Js = sp.sin(sp.Float('1e1000000') * th1) * sp.ones(6, 3)",  # π to 3.3 Mbit: 134 s before
+    # a Float past the decoder's magnitude cap inside sin (1e1000000 took 134 s in the grader before; in a kernel
+    # its export alone goes past the export's time limit, so a smaller one shows the cap)
+    "Js": "Js = sp.Matrix(6, 3, lambda i, j: sp.sin(sp.Mul(sp.Float('1e2000'), th1, evaluate=False), evaluate=False))",
     "detJ": "detJ = ((th2**99)**99)**99",  # nested powers
     "moves": "_f = sp.Function('f')\nmoves = sp.Matrix(3, 3, lambda i, j: _f(th1 + i) ** (j + 1))",
     "singular": (
@@ -381,7 +383,37 @@ def test_hostile_trees_and_an_iopub_flood_in_a_batch_leave_the_victim_graded_rig
     victim = res["victim.ipynb"]["rows"]
     assert [r["status"] for r in victim] == ["pass"] * 5 and all(r["points"] == r["max_points"] for r in victim)
     hostile = {r["part"]: r for r in res["hostile.ipynb"]["rows"]}
-    assert [hostile[p]["status"] for p in ("1.1", "1.2", "1.3", "1.4")] == ["fail"] * 4, hostile
+    got = [(hostile[p]["status"], hostile[p]["message"][:200]) for p in ("1.1", "1.2", "1.3", "1.4")]
+    assert [g[0] for g in got] == ["fail"] * 4, got
+    assert "too large" in got[1][1], got  # the nested power: refused by the decoder's caps
     assert hostile["1.5"]["status"] == "pass"  # its untouched answers are graded as usual
     text = json.dumps(res["hostile.ipynb"]["rows"])
     assert "internal error" not in text and "reference could not" not in text
+
+
+# ----------------------------------------------------------------------------------------- kernels' own limits
+
+
+def test_each_kernel_process_has_a_cap_on_open_files(tmp_path):
+    from kinlib.course.grader.isolation.limits import Enclosure, Limits
+
+    with Enclosure(Limits(files=200), "t") as enc:
+        code = kernel.Kernel(cwd=str(tmp_path), conn_dir=str(tmp_path), enclosure=enc)._kernel_argv("c.json")[4]
+    assert "_lim(resource.RLIMIT_NOFILE, 200)" in code
+    code = kernel.Kernel(cwd=str(tmp_path), conn_dir=str(tmp_path))._kernel_argv("c.json")[4]
+    assert f"_lim(resource.RLIMIT_NOFILE, {kernel.MAX_FILES})" in code
+    # the launcher's code really sets it: run it up to the kernel's import
+    launcher = code.split("from ipykernel")[0] + "import resource; print(resource.getrlimit(resource.RLIMIT_NOFILE))"
+    out = subprocess.run([sys.executable, "-c", launcher], capture_output=True, text=True, timeout=120).stdout
+    assert out.strip() == f"({kernel.MAX_FILES}, {kernel.MAX_FILES})"
+
+
+def test_without_the_sandbox_each_kernel_has_its_own_compiled_code_cache(tmp_path):
+    envs = []
+    for who in ("ann", "bob"):
+        d = tmp_path / who
+        d.mkdir()
+        _, env, _, _ = kernel.Kernel(cwd=str(d), conn_dir=str(d))._isolate(["python"])
+        envs.append(env["KINLIB_CACHE"])
+        assert envs[-1].startswith(str(d) + os.sep)  # in the submission's own folder, removed with it
+    assert envs[0] != envs[1]
