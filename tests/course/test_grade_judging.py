@@ -219,6 +219,7 @@ def test_batch_workers_get_points_from_the_supervisor_never_the_secret(tmp_path,
     grade.grade_batch([subs], tmp_path / "out", jobs=2, secret=key, cache=None, log=None, sandbox=False)
     blob = pickle.dumps((sent["init"], sent["tasks"]))
     assert key not in blob and key.decode() not in repr(sent) and "secret" not in sent["init"]
+    assert str(tmp_path / "out") not in repr(sent)  # nor where the outputs go: the supervisor writes them
     plans = [t["plan"] for t in sent["tasks"]]
     assert all(len(p["points"]) >= 5 for p in plans) and plans[0]["seed"] != plans[1]["seed"]
     data = (subs / "ann.ipynb").read_bytes()
