@@ -93,6 +93,10 @@ def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS,
     """The verdict on answer ``name`` (of ``kind``) that a kernel exported (``{"tree"|"missing"|...}``),
     against the reference ``ref`` (:class:`kinlib.course.grader.refdata.Reference`), at ``points``.
 
+    No time limit here: ``seconds`` is the one the caller enforces by ending the process
+    (:class:`kinlib.course.grader.judging.JudgeProcess`). ``exact=False`` leaves the advisory exact check to a
+    separate request (``verdict.exact`` is then "?" when it applies); ``keep_value``: returns (verdict, value).
+
     >>> from kinlib.course.grader.refdata import Reference
     >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
     ...                                                      "symbols": {"x": {}}}})
