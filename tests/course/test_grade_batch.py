@@ -423,8 +423,9 @@ def test_a_stopped_worker_is_noticed_by_its_heartbeat(tmp_path, grader_reference
 
     init = {"refs": {k: grade.asdict(v) for k, v in refs.items()}, "timeout": 60, "cell_timeout": 30}
     init["handler"] = "kinlib.course.grader.grade:worker_handler"
-    init.update(sandbox=grade.Sandbox(), secret=b"k" * 32, limits=None)
+    init.update(sandbox=grade.Sandbox(), limits=None)  # no secret: the supervisor chooses the points (grade.plan)
     tasks = [{"i": 0, "path": str(subs[0].path), "name": "victim", "relpath": "victim.ipynb", "root": str(d)}]
+    tasks[0]["plan"] = grade.plan(subs[0].path, refs, b"k" * 32)
     events = []
     with _Alarm(600):
         (res,) = batch.Supervisor(
