@@ -423,8 +423,9 @@ def test_a_stopped_worker_is_noticed_by_its_heartbeat(tmp_path, grader_reference
 
     init = {"refs": {k: grade.asdict(v) for k, v in refs.items()}, "timeout": 60, "cell_timeout": 30}
     init["handler"] = "kinlib.course.grader.grade:worker_handler"
-    init.update(sandbox=grade.Sandbox(), secret=b"k" * 32, limits=None)
+    init.update(sandbox=grade.Sandbox(), limits=None)  # no secret: the supervisor chooses the points (grade.plan)
     tasks = [{"i": 0, "path": str(subs[0].path), "name": "victim", "relpath": "victim.ipynb", "root": str(d)}]
+    tasks[0]["plan"] = grade.plan(subs[0].path, refs, b"k" * 32)
     events = []
     with _Alarm(600):
         (res,) = batch.Supervisor(
@@ -478,7 +479,7 @@ def test_the_cgroup_v2_path_on_a_fake_cgroup_filesystem(tmp_path, monkeypatch):
         (c,) = e.cgroups
         assert e.kind == "v2" and c.parent == base and "cgroup v2" in e.describe()
         assert [(c / f).read_text() for f in ("memory.max", "memory.swap.max", "pids.max")] == [str(2**30), "0", "64"]
-        assert e.rlimits() == {"as": 2**30 + 2 * 2**30, "fsize": lim.disk_bytes}  # no nproc: the cgroup counts
+        assert e.rlimits() == {"as": 2**30 + 2 * 2**30, "fsize": lim.disk_bytes, "nofile": lim.files}  # no nproc
         ran = subprocess.run(e.wrap([sys.executable, "-c", "import os; print(os.getpid())"]), capture_output=True)
         assert (c / "cgroup.procs").read_text().split() == ran.stdout.decode().split()  # joined, then exec'd
         (c / "memory.events").write_text("low 0\nhigh 0\nmax 7\noom 2\noom_kill 2\n")

@@ -214,15 +214,28 @@ def test_a_huge_set_is_refused_or_compared_in_bounded_time():
     assert compare.compare_set(desc, {"conditions": desc["conditions"]}, "S")[0]
 
 
-def test_an_answer_that_takes_too_long_is_wrong_not_a_stopped_batch(monkeypatch):
-    def slow(*a, **k):
-        while True:
-            pass
+def test_an_answer_that_takes_too_long_is_wrong_not_a_stopped_batch():
+    """Judged in a judge process that is killed past the limit (tests/course/test_grade_judging.py has the
+    process's own tests): a judge that never answers makes the answer wrong, and the next one is judged."""
+    import sys
 
-    monkeypatch.setattr(judge.describe, "describe", slow)
+    from kinlib.course.grader import judging
+
+    hang = (
+        "import json, os, struct, sys\n"
+        "def send(o):\n    b = json.dumps(o).encode(); os.write(1, struct.pack('>I', len(b)) + b)\n"
+        "sys.stdin.buffer.read(4); send({'ready': True})\n"
+        "while True:\n    pass\n"
+    )
     entry = reference_answers({"a": ex.exported(x)}, {"a": "expr"})
-    v = judge.judge_answer("a", "expr", ex.exported(x), Reference("t", "t", "p", "0" * 64, [], entry), POINTS, 1, 1.0)
-    assert v.status == "fail" and "too large to grade" in v.message
+    jp = judging.JudgeProcess(
+        Reference("t", "t", "p", "0" * 64, [], entry), POINTS, 1, argv=[sys.executable, "-c", hang]
+    )
+    try:
+        v = jp.judge("a", "expr", ex.exported(x), seconds=1.0)
+    finally:
+        jp.close()
+    assert v.status == "fail" and "too large to grade" in v.message and jp.kills == 1
 
 
 # ----------------------------------------------------------------------------------------- attacks in a kernel

@@ -390,7 +390,7 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
         if not digits or not all(c in "0123456789.eE+-infa" for c in digits):
             raise WireError("malformed Float")
         try:  # mpmath's number syntax (never eval); malformed digits are a ValueError
-            return sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
+            return _check_number(sp.Float(digits, precision=small(args[1], MAX_PREC) or 53))
         except (ValueError, TypeError):
             raise WireError("malformed Float") from None
     if op == "Symbol" and len(args) == 2:
@@ -428,9 +428,29 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
             raise WireError("malformed Dict")
         return sp.Dict(*items)
     try:
-        return cls(*items)
+        made = cls(*items)
     except (TypeError, ValueError, AttributeError, NotImplementedError, IndexError, KeyError, ArithmeticError) as exc:
         raise WireError(f"{op} could not be rebuilt ({type(exc).__name__})") from None
+    return _check_number(made) if isinstance(made, sp.Number) else made
+
+
+def _check_number(x):
+    """Refuse a number whose magnitude is beyond 2**±MAX_PREC (about 10**±1200): a Float('1e1000000') inside
+    sin needs π to millions of bits (SymPy's argument reduction: minutes holding the GIL), and SymPy folds
+    products and powers of numbers as it builds them, so each number made is checked.
+
+    >>> _check_number(__import__("sympy").Float("1e300")) > 0
+    True
+    """
+    import sympy as sp
+
+    if isinstance(x, sp.Float):
+        sign, man, exp, bc = x._mpf_
+        if man and abs(exp + bc) > MAX_PREC:
+            raise WireError(f"a number too large to compute with (about 2**{exp + bc})")
+    elif isinstance(x, sp.Rational) and max(x.p.bit_length(), x.q.bit_length()) > 4 * MAX_PREC:
+        raise WireError("a number too large to compute with (more than 16000 bits)")
+    return x
 
 
 def _check_power(base, exp):

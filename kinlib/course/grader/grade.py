@@ -52,7 +52,9 @@ How it works
   their source text), which snapshots SymPy/NumPy/mpmath/builtins. After the last cell it restores those
   namespaces, then asks for each answer *as data*: a JSON tree of the SymPy expression, matrix, set, array,
   list, number or string (:mod:`kinlib.course.answers.wire`), and stops the kernel. Everything else happens in
-  the grader (:func:`kinlib.course.grader.judge.judge_answer`, per answer with caps and a time limit): the
+  the grader's judge process for the submission (:mod:`kinlib.course.grader.judging`: in the sandbox, holding no
+  secret, writing nothing; :func:`kinlib.course.grader.judge.judge_answer` per answer with caps, and the process
+  killed and replaced when an answer goes past its time limit): the
   tree is rebuilt by a whitelist parser (never ``eval``), evaluated at random points (joint angles in
   (-π, π), positive symbols in (0.5, 2); random per submission, seeded by HMAC(grader secret, submission
   bytes) (:mod:`kinlib.course.grader.secret`): reruns are reproducible, and nobody without the secret can
@@ -82,7 +84,9 @@ grades.csv and the feedback are written after every kernel of the batch, and eve
 started, is gone (checked: :func:`kinlib.course.grader.isolation.sandbox.reap_namespaces`). Without bubblewrap the grader
 refuses to run unless given ``--no-sandbox``, and then the summary and every feedback page say so.
 A kernel that cannot start is retried (:data:`kinlib.course.grader.isolation.kernel.START_ATTEMPTS`), judged by its
-process, not by heartbeats. The kernel is told nothing secret (no point, seed or reference: only the names of
+process, not by heartbeats. Only the supervisor holds the grader secret: it signs the reference cache and chooses
+each submission's points (:func:`plan`); grading workers and judge processes get the points and references, never
+the secret, and only the supervisor writes the output folder. The kernel is told nothing secret (no point, seed or reference: only the names of
 the answers), and what it reports is only a claim of "this is my answer": a JSON tree read from a size-capped
 file by a whitelist parser with caps, never evaluated as code. A submission that replaces or patches the
 in-kernel export (it is reachable from ``sys.modules``) can claim any answer, which scores only if it *is*
@@ -95,6 +99,7 @@ undone before the answers are exported, and cannot reach the grader's SymPy, whi
 
 from __future__ import annotations
 
+import hashlib
 import os
 import time
 from dataclasses import asdict, dataclass, field
@@ -106,6 +111,7 @@ from .isolation.kernel import NotebookRun
 from .isolation.limits import Enclosure, Limits, release
 from .isolation.sandbox import Sandbox, SandboxUnavailable, check, reap_namespaces
 from .judge import N_POINTS
+from .judging import JudgeProcess
 from .refdata import (
     GRADE_VERSION,
     Reference,
@@ -193,6 +199,7 @@ class Job:
     ref: Reference | None = None
     points: list = field(default_factory=list)  # the secret evaluation points (never sent to the kernel)
     seed: int = 0
+    plan: dict | None = None  # the points chosen by a batch's supervisor (:func:`plan`); then no secret here
 
     @property
     def sub(self) -> str:
@@ -242,9 +249,14 @@ def _identify(job: Job) -> bool:
 
 
 def _prepare(job: Job) -> bool:
-    """The secret, the sandbox, and the submission's secret evaluation points (seeded by HMAC(secret, bytes))."""
+    """The sandbox, and the submission's secret evaluation points: given (a batch's supervisor chose them,
+    :func:`plan`), else seeded here by HMAC(secret, bytes)."""
     try:
-        key = job.secret if isinstance(job.secret, bytes) else load_secret(job.secret)
+        key = None
+        if job.plan is None:
+            key = job.secret if isinstance(job.secret, bytes) else load_secret(job.secret)
+        elif job.plan.get("sha") != hashlib.sha256(job.data).hexdigest():
+            raise ValueError("the file changed while the batch was grading it")
         if job.sandbox is True:
             ok, why = check()
             if not ok:
@@ -253,12 +265,35 @@ def _prepare(job: Job) -> bool:
     except (OSError, ValueError, SandboxUnavailable) as exc:
         job.out["infrastructure"] = str(exc)
         return job.stop(_error_rows(job.sub, job.nid, job.ref.parts, f"not graded: infrastructure: {exc}"))
-    job.seed = evaluation_seed(key, job.data)
-    symbols: dict = {}
-    for a in job.ref.answers.values():
-        symbols.update(a.get("symbols", {}))
-    job.points = make_points(symbols, job.seed, N_POINTS)
+    if job.plan is not None:
+        job.seed, job.points = int(job.plan["seed"]), job.plan["points"]
+    else:
+        job.seed, job.points = _points(job.ref, key, job.data)
     return True
+
+
+def _points(ref: Reference, key: bytes, data: bytes) -> tuple[int, list]:
+    """(seed, points) of a submission with bytes ``data`` of the notebook ``ref``: HMAC(secret, bytes)."""
+    seed = evaluation_seed(key, data)
+    symbols: dict = {}
+    for a in ref.answers.values():
+        symbols.update(a.get("symbols", {}))
+    return seed, make_points(symbols, seed, N_POINTS)
+
+
+def plan(path, refs: dict, key: bytes) -> dict | None:
+    """What a grading worker needs from the secret to grade the file ``path``, chosen by the supervisor (which
+    alone holds the secret): {"seed", "points", "sha"} (sha: of the bytes the points are for), or None when the
+    file is not gradable (the worker's own steps then say why).
+
+    >>> plan("no-such-file.ipynb", {}, b"k" * 32) is None
+    True
+    """
+    job = Job(Path(path), refs, {"submission": str(path)})
+    if not (_read(job) and _identify(job)):
+        return None
+    seed, points = _points(job.ref, key, job.data)
+    return {"seed": seed, "points": points, "sha": hashlib.sha256(job.data).hexdigest()}
 
 
 def _grade(job: Job) -> bool:
@@ -285,7 +320,13 @@ def _run_and_judge(job: Job, enc: Enclosure) -> list:
     code = code_cells(job.nb)
     part_of_cell = {i: part for i, c in enumerate(code) if (part := cell_part(cell_meta(c)))}
     run, cpu0 = None, time.process_time()
+    # the judge of this submission's answers: its own process (judging.JudgeProcess), in the sandbox started now,
+    # so that it imports SymPy while the kernel runs; as the student's user (no sandbox) only once every process
+    # of that user is gone (the kernel's could reach a process of their own user)
+    judge = JudgeProcess(job.ref, job.points, job.seed, sandbox=job.sandbox or None, user=job.user)
     try:
+        if job.user is None:
+            judge.start()
         scratch = os.path.join(enc.folder, "work")
         os.makedirs(scratch)
         with open(os.path.join(scratch, job.path.name), "wb") as f:
@@ -301,16 +342,20 @@ def _run_and_judge(job: Job, enc: Enclosure) -> list:
             enclosure=enc,
             user=job.user,
         )
-        g = run_steps(Grading(run, job.sub, job.nid, job.ref, parts, job.points, job.seed, part_of_cell, out))
+        g = Grading(run, job.sub, job.nid, job.ref, parts, job.points, job.seed, part_of_cell, out, judge=judge)
+        g = run_steps(g)
         out["restarts"] = run.restarts
         out["cells"] = [asdict(r) | {"part": part_of_cell.get(i, "")} for i, r in sorted(run.results.items())]
         out["output_bytes"] = sum(r.output_bytes for r in run.results.values())
         out.setdefault("exact", {})
         return g.rows
-    except Exception as exc:  # noqa: BLE001  a checker bug must not stop the batch
+    except Exception as exc:  # noqa: BLE001  a checker bug must not stop the batch, nor pass as a grade
         out["exact"] = {}
-        return _error_rows(job.sub, job.nid, parts, f"internal error in the checker: {type(exc).__name__}: {exc}")
+        why = f"internal error in the checker: {type(exc).__name__}: {exc}"[:300]
+        out["infrastructure"] = why  # flagged (exit status 1, the summary counts it): run it again
+        return _error_rows(job.sub, job.nid, parts, f"not graded: infrastructure: {why}")
     finally:
+        judge.close()
         if run is not None:
             run.close()
             out["namespaces"], out["start_failures"] = run.namespaces, run.start_failures
@@ -353,6 +398,7 @@ def grade_submission(
     root: str | None = None,
     limits: Limits | None = None,
     user=None,
+    plan: dict | None = None,
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises), by the
     named steps of :data:`SUBMISSION_STEPS` (read, identify, prepare, grade: the last runs
@@ -361,7 +407,8 @@ def grade_submission(
     ``sandbox``: a :class:`~kinlib.course.grader.isolation.sandbox.Sandbox`, True (the default one) or False (no sandbox:
     said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
     :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points; ``user``:
-    without the sandbox, a :class:`~kinlib.course.grader.isolation.unprivileged.StudentUser` the kernel runs as.
+    without the sandbox, a :class:`~kinlib.course.grader.isolation.unprivileged.StudentUser` the kernel runs as;
+    ``plan``: the points a batch's supervisor chose (:func:`plan`; then ``secret`` is not used).
 
     A file that is not one of the notebooks gets one ``error`` row, without starting a kernel:
 
@@ -381,6 +428,7 @@ def grade_submission(
     t0 = time.monotonic()
     out = _new_result(path, display_name, sandbox, relpath, root, user)
     job = Job(Path(path), refs, out, cell_timeout, total_timeout, sandbox, secret, limits, user)
+    job.plan = plan
     for _, step in SUBMISSION_STEPS:
         if not step(job):
             break
@@ -422,7 +470,8 @@ def _peek_id(path: Path, unmatched: bool = False):
 
 def worker_handler(init: dict):
     """The function a grading worker (:mod:`kinlib.course.grader.batch`) applies to each task: ``init`` holds the
-    references (as dicts), the sandbox, the secret and the time limits; a task names one submission."""
+    references (as dicts), the sandbox and the time limits, never the secret; a task names one submission and
+    carries its evaluation points (:func:`plan`, chosen by the supervisor)."""
     refs = {k: Reference(**v) for k, v in init["refs"].items()}
 
     def handle(task: dict) -> dict:
@@ -433,10 +482,10 @@ def worker_handler(init: dict):
             init["timeout"],
             display_name=task["name"],
             sandbox=init["sandbox"],
-            secret=init["secret"],
             relpath=task["relpath"],
             root=task["root"],
             limits=init.get("limits"),
+            plan=task.get("plan") or {"seed": 0, "points": [], "sha": ""},
         )
 
     return handle
@@ -589,11 +638,14 @@ def _grade_all(done, subs, refs, jobs, opts, batch_timeout, on_event, log) -> No
             log(f"interrupted: writing the {len(done)} result(s) graded so far")
             raise
         return
+    # the supervisor alone holds the secret: it chooses each submission's points; a worker gets only those
     tasks = [
         {"i": k, "path": str(s.path), "name": s.relpath, "relpath": s.relpath, "root": s.root}
+        | {"plan": plan(s.path, refs, opts["secret"])}
         for k, s in enumerate(subs)
     ]
-    init = {"handler": f"{__name__}:worker_handler", "refs": {k: asdict(v) for k, v in refs.items()}, **opts}
+    init = {"handler": f"{__name__}:worker_handler", "refs": {k: asdict(v) for k, v in refs.items()}}
+    init.update({k: v for k, v in opts.items() if k != "secret"})
 
     def event(kind, pid, i):
         if kind in ("died", "stuck", "retry", "gave-up") and i is not None:

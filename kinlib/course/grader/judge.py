@@ -12,38 +12,25 @@ decides whether it is the answer, in named steps:
 4. **exact**: for a passing expression, whether SymPy proves it equal to the reference (advisory: it never
    turns a numeric failure into a pass).
 
-All of it runs under :func:`time_limit` (:data:`JUDGE_SECONDS` per answer): an answer that takes longer to
-judge is wrong ("too large to grade in N s"), never a stopped batch.
+The grader runs it in a judge process of the submission's own (:mod:`kinlib.course.grader.judging`), which is
+killed when an answer takes longer than :data:`JUDGE_SECONDS` (the answer is then wrong, "too large to grade");
+nothing here raises into SymPy (an exception from a timer was swallowed by ``except Exception`` in SymPy and in
+describe, and the answer ran on).
 """
 
 from __future__ import annotations
 
-import signal
-import threading
 import time
-from contextlib import contextmanager
 from dataclasses import dataclass
 
 from ..answers import compare, describe, kinds, wire
 from ..answers.expr import exact_equal, to_sympy
 
-__all__ = ["Verdict", "judge_answer", "time_limit", "JudgeTimeout", "JUDGE_SECONDS", "EXACT_SECONDS", "n_points"]
+__all__ = ["Verdict", "judge_answer", "exact_check", "JUDGE_SECONDS", "EXACT_SECONDS", "n_points"]
 
 JUDGE_SECONDS = 30.0  # the most one answer may take to read, evaluate and compare in the grader
 EXACT_SECONDS = 5.0  # of which the advisory exact check may take (SymPy simplify)
 N_POINTS = max(k.points for k in kinds.KINDS.values())  # secret points made per submission (each kind uses its own)
-
-
-class JudgeTimeout(Exception):
-    """The answer took longer than its time limit to judge.
-
-    >>> with time_limit(0.05):
-    ...     while True:
-    ...         pass
-    Traceback (most recent call last):
-    ...
-    kinlib.course.grader.judge.JudgeTimeout: over the 0.05 s limit
-    """
 
 
 @dataclass
@@ -78,35 +65,6 @@ def n_points(kind: str) -> int:
     return kinds.lookup(kind)[0].points
 
 
-@contextmanager
-def time_limit(seconds: float):
-    """Raise :class:`JudgeTimeout` in the block after ``seconds`` (SIGALRM; in the main thread only, elsewhere
-    the block runs without a limit). Nested limits keep the outer one's deadline.
-
-    >>> with time_limit(5):
-    ...     sum(range(10))
-    45
-    """
-    if threading.current_thread() is not threading.main_thread() or seconds <= 0:
-        yield
-        return
-
-    def alarm(signum, frame):
-        raise JudgeTimeout(f"over the {seconds:g} s limit")
-
-    start = time.monotonic()
-    old_handler = signal.signal(signal.SIGALRM, alarm)
-    old_left, _ = signal.getitimer(signal.ITIMER_REAL)
-    signal.setitimer(signal.ITIMER_REAL, min(seconds, old_left) if old_left > 0 else seconds)
-    try:
-        yield
-    finally:
-        signal.setitimer(signal.ITIMER_REAL, 0)
-        signal.signal(signal.SIGALRM, old_handler)
-        if old_left > 0:  # an outer limit: put its remaining time back (at least a moment)
-            signal.setitimer(signal.ITIMER_REAL, max(old_left - (time.monotonic() - start), 1e-3))
-
-
 def _read(exported, name):
     """(value, None) from the kernel's export, or (None, description of why it is not an answer)."""
     if not isinstance(exported, dict):
@@ -120,7 +78,9 @@ def _read(exported, name):
     try:
         return wire.load(exported["tree"]), None
     except WireError as exc:
-        big = str(exc).startswith(("more than", "nested more", "numbers with more", "a power too large"))
+        big = str(exc).startswith(
+            ("more than", "nested more", "numbers with more", "a power too large", "a number too large")
+        )
         return None, {"tag": "too-large" if big else "unreadable", "error": str(exc)[:200]}
     except RecursionError:
         return None, {"tag": "too-large", "error": "nested too deeply"}
@@ -129,9 +89,13 @@ def _read(exported, name):
 WireError = wire.WireError
 
 
-def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS) -> Verdict:
+def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS, exact=True, keep_value=False):
     """The verdict on answer ``name`` (of ``kind``) that a kernel exported (``{"tree"|"missing"|...}``),
     against the reference ``ref`` (:class:`kinlib.course.grader.refdata.Reference`), at ``points``.
+
+    No time limit here: ``seconds`` is the one the caller enforces by ending the process
+    (:class:`kinlib.course.grader.judging.JudgeProcess`). ``exact=False`` leaves the advisory exact check to a
+    separate request (``verdict.exact`` is then "?" when it applies); ``keep_value``: returns (verdict, value).
 
     >>> from kinlib.course.grader.refdata import Reference
     >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
@@ -147,31 +111,36 @@ def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS)
 
     t0 = time.monotonic()
     pts = points[: n_points(kind)]
+    value, whose = None, "your answer"
     try:
-        with time_limit(seconds):
-            value, stu = _read(exported, name)
-            if stu is None:
-                stu = describe.describe(kind, value, pts, seed)
-            rd = reference_description(ref, name, kind, pts, seed)
-            ok, msg = compare.compare(kind, stu, rd, name)
-            verdict = Verdict(name, "pass" if ok else "fail", msg if (ok and msg) or not ok else "")
-            if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "srepr" in ref.answers[name]:
-                verdict.exact = _exact(value, ref.answers[name]["srepr"], min(EXACT_SECONDS, seconds / 3))
-    except JudgeTimeout:
-        verdict = Verdict(name, "fail", f"{name} is too large to grade (it took over {seconds:g} s to evaluate)")
+        value, stu = _read(exported, name)
+        if stu is None:
+            stu = describe.describe(kind, value, pts, seed)
+        whose = "the reference"
+        rd = reference_description(ref, name, kind, pts, seed)
+        whose = "the comparison"
+        ok, msg = compare.compare(kind, stu, rd, name)
+        verdict = Verdict(name, "pass" if ok else "fail", msg if (ok and msg) or not ok else "")
+        if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "srepr" in ref.answers[name]:
+            verdict.exact = exact_check(value, ref.answers[name]["srepr"], EXACT_SECONDS) if exact else "?"
     except (MemoryError, RecursionError) as exc:
         verdict = Verdict(name, "fail", f"{name} is too large to grade ({type(exc).__name__})")
     except Exception as exc:  # noqa: BLE001  a grader bug on one answer must not stop the submission
-        verdict = Verdict(
-            name, "error", f"{name}: the reference could not be evaluated ({type(exc).__name__}: {exc})"[:300]
-        )
+        why = f"{name}: {whose} could not be evaluated by the grader ({type(exc).__name__}: {exc})"
+        verdict = Verdict(name, "error", why[:300])
     verdict.seconds = round(time.monotonic() - t0, 3)
-    return verdict
+    return (verdict, value) if keep_value else verdict
 
 
-def _exact(value, ref_text, seconds) -> str:
-    """'equal' | 'not proved' | 'timed out' | 'not sympy' (advisory). Not tried on powers of sums with large
-    exponents (expanding (a + b + c)**90 would take the grader's memory before its time limit)."""
+def exact_check(value, ref_text, seconds) -> str:
+    """'equal' | 'not proved' | 'not sympy' (advisory; ``seconds``: SymPy's simplify is not tried after it). Not
+    tried on powers of sums with large exponents (expanding (a + b + c)**90 would take the grader's memory
+    before its time limit). Its hard time limit is the judge process's (:mod:`.judging`): killed past it.
+
+    >>> import sympy as sp
+    >>> exact_check(sp.sin(sp.Symbol("x"))**2 + sp.cos(sp.Symbol("x"))**2, "Integer(1)", 5)
+    'equal'
+    """
     import sympy as sp
 
     obj = to_sympy(value)[1]
@@ -180,9 +149,6 @@ def _exact(value, ref_text, seconds) -> str:
     if any(p.base.is_Add and p.exp.is_Number and abs(p.exp) > 12 for p in obj.atoms(sp.Pow)):
         return "not proved"
     try:
-        with time_limit(seconds):
-            return exact_equal(value, ref_text, budget=seconds / 2)
-    except JudgeTimeout:
-        return "timed out"
+        return exact_equal(value, ref_text, budget=seconds / 2)
     except Exception:  # noqa: BLE001
         return "not proved"

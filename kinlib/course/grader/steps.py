@@ -7,8 +7,8 @@ preprocessors), each a small function of one :class:`Grading` state.
 ``export``   ask the kernel for each answer *as data* (``in_kernel.export``): no point, seed or reference
              is ever sent to the kernel
 ``stop``     stop the kernel: nothing it does from here on can change a grade
-``judge``    read, evaluate at the secret points, compare and check exactly, in this process
-             (:func:`~.judge.judge_answer`, with caps and a time limit per answer)
+``judge``    read, evaluate at the secret points, compare and check exactly, in the submission's judge
+             process (:class:`~.judging.JudgeProcess`: killed past the time limit of an answer)
 ``rows``     one :class:`Row` per part, from the answers' :class:`~.judge.Verdict`
 =========== =============================================================================================
 
@@ -21,7 +21,7 @@ import time
 from dataclasses import dataclass, field
 
 from .isolation.kernel import KernelStartError, NotebookRun
-from .judge import Verdict, judge_answer
+from .judge import Verdict
 
 __all__ = ["Grading", "Row", "STEPS", "run_steps", "EXPORT_TIMEOUT"]
 
@@ -71,6 +71,7 @@ class Grading:
     part_of_cell: dict  # code cell index -> part
     out: dict  # the submission's result dict (notes, restored, timing, ...)
     fatal: str = ""  # why no answer can be graded (the kernel died, could not start, ...)
+    judge: object = None  # the judge process (judging.JudgeProcess), started before the kernel ran
     exported: dict = field(default_factory=dict)  # answer -> what the kernel exported (or why it could not)
     verdicts: dict = field(default_factory=dict)  # answer -> Verdict
     rows: list = field(default_factory=list)  # [Row]
@@ -116,14 +117,50 @@ def _stop(g: Grading) -> None:
 def _judge(g: Grading) -> None:
     if g.fatal:
         return
-    for p in g.parts:
-        for name in p["answers"]:
-            got = g.exported.get(name)
-            if isinstance(got, dict) and "kernel_error" in got:
-                status = "error" if got.get("kernel_dead") else "fail"
-                g.verdicts[name] = Verdict(name, status, f"{name} could not be read: {got['kernel_error']}")
-                continue
-            g.verdicts[name] = judge_answer(name, g.kind(name, p), got, g.ref, g.points, g.seed)
+    if g.judge is None:
+        from .judging import JudgeProcess
+
+        g.judge = JudgeProcess(g.ref, g.points, g.seed)
+    try:
+        for p in g.parts:
+            for name in p["answers"]:
+                got = g.exported.get(name)
+                if isinstance(got, dict) and "kernel_error" in got:
+                    g.verdicts[name] = _unread(g, name, got)
+                    continue
+                g.verdicts[name] = g.judge.judge(name, g.kind(name, p), got)
+                if g.verdicts[name].message.startswith(f"{name} was not graded: infrastructure"):
+                    g.out["infrastructure"] = g.verdicts[name].message
+    finally:
+        g.judge.close()
+        g.out["judge_kills"] = g.judge.kills
+
+
+def _unread(g: Grading, name: str, got: dict) -> Verdict:
+    """The verdict on an answer the kernel did not report: the student's fault (a fail) only if the kernel is
+    alive and the grader's disk had room; a full disk (the answer's file could not be written) is flagged."""
+    err = str(got.get("kernel_error", ""))
+    full = "No space left" in err or "ENOSPC" in err or _disk_full(g.run.tmp)
+    if full and getattr(g.run.enclosure, "tmpfs", False):  # its own size-limited disk: it filled it itself
+        why = f"{name} could not be written: the submission had used all of its disk space ({err})"
+        return Verdict(name, "fail", why[:300])
+    if full:  # a disk the grader shares: not the student's fault, and another run may have room
+        why = f"{name} was not graded: infrastructure: no space left where the kernel writes its answers ({err})"
+        g.out["infrastructure"] = why[:300]
+        return Verdict(name, "error", why[:300])
+    status = "error" if got.get("kernel_dead") else "fail"
+    return Verdict(name, status, f"{name} could not be read: {err}")
+
+
+def _disk_full(folder) -> bool:
+    """Whether the file system of ``folder`` has less than 1 MiB free (a result file would not fit)."""
+    import os
+
+    try:
+        st = os.statvfs(folder)
+    except (OSError, TypeError):
+        return False
+    return st.f_bavail * st.f_frsize < 2**20
 
 
 def _rows(g: Grading) -> None:

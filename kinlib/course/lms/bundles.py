@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 import os
 import shutil
 import stat
@@ -304,6 +305,26 @@ def _summary(results: list, sandbox: bool) -> str:
     return "\n".join(lines)
 
 
+def _points(x, top: float) -> float:
+    """``x`` as points in [0, ``top``] (0 for anything that is not a finite number).
+
+    >>> _points(1000, 5.0), _points(-3, 5.0), _points(float("nan"), 5.0), _points("7", 5.0), _points(2.5, 5.0)
+    (5.0, 0.0, 0.0, 0.0, 2.5)
+    """
+    if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
+        return 0.0
+    return float(min(max(x, 0.0), top))
+
+
+def _clamped(res: dict) -> dict:
+    """A result whose rows' points are in [0, their maximum] (:func:`_points`)."""
+    rows = []
+    for r in res.get("rows", []):
+        top = _points(r.get("max_points"), math.inf)
+        rows.append(dict(r, points=_points(r.get("points"), top), max_points=top))
+    return dict(res, rows=rows)
+
+
 def gradescope_results(results: list, visibility: str = "visible", sandbox: bool = True, seconds: float = 0.0) -> dict:
     """Gradescope's ``results.json`` for graded results (one test per automatically graded part).
 
@@ -317,14 +338,16 @@ def gradescope_results(results: list, visibility: str = "visible", sandbox: bool
     """
     if visibility not in VISIBILITIES:
         raise ValueError(f"visibility must be one of {', '.join(VISIBILITIES)}, got {visibility!r}")
+    results = [_clamped(res) for res in results]  # the tests and the summary: the same points, never over the top
     tests = []
     for _, r, name in _auto_rows(results):
+        top = _points(r.get("max_points"), math.inf)
         tests.append(
             {
                 "name": name,
                 "number": str(r["part"]),
-                "score": float(r.get("points") or 0),
-                "max_score": float(r.get("max_points") or 0),
+                "score": _points(r.get("points"), top),  # in [0, max_score], whatever a row claims
+                "max_score": top,
                 "status": "passed" if r["status"] == "pass" else "failed",
                 "output": _row_output(r),
                 "visibility": visibility,

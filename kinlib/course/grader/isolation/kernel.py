@@ -61,6 +61,7 @@ SHIPPED = {name: (IN_KERNEL_DIR / f"{name}.py").read_text() for name in IN_KERNE
 MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
 MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
 START_ATTEMPTS = 3  # tries to start a kernel before it is an infrastructure failure
+MAX_FILES = 1024  # open files per kernel process (RLIMIT_NOFILE) without an enclosure's limits
 
 
 class KernelStartError(RuntimeError):
@@ -81,6 +82,7 @@ _LAUNCH = (
     "_lim(resource.RLIMIT_AS, {mem})\n"
     "_lim(resource.RLIMIT_FSIZE, {fsize})\n"
     "_lim(resource.RLIMIT_CORE, 0)\n"
+    "_lim(resource.RLIMIT_NOFILE, {nofile})\n"
     "if {nproc}:\n"
     "    _lim(resource.RLIMIT_NPROC, {nproc})\n"
     "sys.path[:] = [p for p in sys.path if p not in ('', '.')]\n"
@@ -185,11 +187,12 @@ class Kernel:
 
     def _kernel_argv(self, connection_file: str) -> list:
         """The kernel's command line: Python running the launcher that sets the rlimits, then the kernel."""
-        mem, fsize, nproc = int(self.mem_bytes), int(self.fsize_bytes), 0
+        mem, fsize, nproc, nofile = int(self.mem_bytes), int(self.fsize_bytes), 0, MAX_FILES
         if self.enclosure is not None:
             rl = self.enclosure.rlimits()
             mem, fsize, nproc = int(rl["as"]), int(rl["fsize"]), int(rl.get("nproc", 0))
-        code = _LAUNCH.format(mem=mem, fsize=fsize, nproc=nproc)
+            nofile = int(rl.get("nofile", MAX_FILES))
+        code = _LAUNCH.format(mem=mem, fsize=fsize, nproc=nproc, nofile=nofile)
         argv = [sys.executable, "-P", "-B", "-c", code, "-f", connection_file, "--HistoryManager.enabled=False"]
         return argv + ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
 
@@ -220,6 +223,9 @@ class Kernel:
             return argv, self.user.environment(home, extra), (), None
         env = {k: v for k, v in os.environ.items() if not k.startswith(("JPY_SESSION", "JUPYTER_TOKEN"))}
         env.update(extra, JPY_PARENT_PID=str(os.getpid()))
+        # a compiled-code cache of this kernel's own (kinlib.native): one student's compiled module in the shared
+        # cache was loaded by the next student's kernel
+        env["KINLIB_CACHE"] = os.path.join(self.conn_dir, f"kinlib-cache-{os.getpid()}-{os.urandom(4).hex()}")
         return argv, env, (), None
 
     def _launch(self) -> None:
@@ -345,13 +351,16 @@ class Kernel:
         msg = _message_of(self.kc.get_iopub_msg, msg_id, wait)
         if msg is None:
             return False
-        mt, c = msg["msg_type"], msg["content"]
+        mt, c = msg.get("msg_type"), msg.get("content")
+        if not isinstance(c, dict):
+            return False
         if mt == "status" and c.get("execution_state") == "idle":
             return True
         if mt == "stream":
-            res.output_bytes += len(c.get("text", ""))
+            res.output_bytes += len(str(c.get("text", "")))
         elif mt in ("display_data", "execute_result", "update_display_data"):
-            res.output_bytes += sum(len(str(v)) for v in c.get("data", {}).values())
+            data = c.get("data")
+            res.output_bytes += sum(len(str(v)) for v in data.values()) if isinstance(data, dict) else 0
         elif mt == "error" and res.status == "ok":
             _record_error(res, c)
         return False
@@ -361,7 +370,9 @@ class Kernel:
         reply = _message_of(self.kc.get_shell_msg, msg_id, wait)
         if reply is None:
             return False
-        c = reply["content"]
+        c = reply.get("content")
+        if not isinstance(c, dict):
+            c = {"status": "error", "ename": "ProtocolError", "evalue": "the kernel's reply was malformed"}
         if c.get("status") == "error" and res.status == "ok":
             _record_error(res, c)
         elif c.get("status") == "aborted" and res.status == "ok":
@@ -410,12 +421,24 @@ class Kernel:
 
 def _message_of(get, msg_id: str, wait: float):
     """The next message ``get`` (a kernel client's iopub or shell reader) gives within ``wait`` seconds if it
-    belongs to the execution ``msg_id``, else None."""
+    belongs to the execution ``msg_id``, else None. The kernel holds the connection key, so a student's code can
+    send any signed message: one of the wrong shape (``parent_header = [1]``) is skipped, never an error here.
+
+    >>> _message_of(lambda timeout: {"parent_header": [1], "content": {}}, "m1", 0.1) is None
+    True
+    >>> _message_of(lambda timeout: {"parent_header": {"msg_id": "m1"}, "content": {}}, "m1", 0.1)["content"]
+    {}
+    """
     try:
         msg = get(timeout=wait)
     except queue.Empty:
         return None
-    return msg if msg.get("parent_header", {}).get("msg_id") == msg_id else None
+    except (ValueError, TypeError, KeyError, AttributeError, UnicodeError):  # undecodable: not ours
+        return None
+    if not isinstance(msg, dict):
+        return None
+    parent = msg.get("parent_header")
+    return msg if isinstance(parent, dict) and parent.get("msg_id") == msg_id else None
 
 
 def _record_error(res, content: dict) -> None:

@@ -48,13 +48,14 @@ class Limits:
     """What one submission may use, in all.
 
     >>> Limits()
-    Limits(memory_bytes=2147483648, processes=256, disk_bytes=536870912, shm_bytes=67108864)
+    Limits(memory_bytes=2147483648, processes=256, disk_bytes=536870912, shm_bytes=67108864, files=1024)
     """
 
     memory_bytes: int = 2 * 2**30
     processes: int = 256
     disk_bytes: int = 512 * 2**20
     shm_bytes: int = 64 * 2**20  # the sandbox's /dev/shm when it is not on the submission's tmpfs
+    files: int = 1024  # open files per process of the submission (RLIMIT_NOFILE; one kernel opened 19,928)
 
     def words(self) -> str:
         """The limits in words.
@@ -355,11 +356,12 @@ class Enclosure:
     def rlimits(self) -> dict:
         """The kernel's rlimits: per-process address space (a backstop; the cgroup limits the sum), file size,
         and, without a cgroup, the number of processes."""
+        files = self.limits.files
         if self.cgroups:  # the cgroup stops the sum first; this only stops one runaway mapping
-            return {"as": self.limits.memory_bytes + 2 * 2**30, "fsize": self.limits.disk_bytes}
+            return {"as": self.limits.memory_bytes + 2 * 2**30, "fsize": self.limits.disk_bytes, "nofile": files}
         # without one: per process only (an IPython kernel with NumPy and SymPy maps ~1 GiB before any answer)
         as_ = max(self.limits.memory_bytes, 3 * 2**30)
-        return {"as": as_, "fsize": self.limits.disk_bytes, "nproc": self.limits.processes}
+        return {"as": as_, "fsize": self.limits.disk_bytes, "nproc": self.limits.processes, "nofile": files}
 
     def describe(self) -> str:
         """Which limits are in force, in words."""
