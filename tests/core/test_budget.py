@@ -255,8 +255,22 @@ def _num(M, digits=70):
 
 
 def _close(A, B, tol=1e-40):
+    """The same column space (bases may differ by scaling: an exact [1, tan g] and a 60-digit [cot g, 1]): equal
+    orthogonal projectors A (AᵀA)⁻¹ Aᵀ at 80 digits, in a private mpmath context."""
+    import mpmath
+
     A, B = sp.Matrix(A), sp.Matrix(B)
-    return A.shape == B.shape and all(abs(sp.N(a - b, 70)) < tol for a, b in zip(A, B))
+    if A.shape != B.shape:
+        return False
+    ctx = mpmath.MPContext()
+    ctx.dps = 80
+
+    def projector(X):
+        M = ctx.matrix([[ctx.mpf(str(sp.N(X[i, j], 90))) for j in range(X.cols)] for i in range(X.rows)])
+        return M * ctx.inverse(M.T * M) * M.T
+
+    D = projector(A) - projector(B)
+    return all(abs(D[i, j]) < tol for i in range(D.rows) for j in range(D.cols))
 
 
 def _cases():

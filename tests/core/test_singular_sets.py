@@ -452,10 +452,20 @@ def test_puma_elbow_factor_is_the_one_its_docstring_states():
     th3 = sp.atan2(-d4, a3)  # a3 sin θ3 + d4 cos θ3 = 0
     assert sp.simplify(a3 * sp.sin(th3) + d4 * sp.cos(th3)) == 0
     q = [sp.Rational(1, 3), sp.Rational(-2, 7), th3, sp.Rational(1, 5), sp.Rational(3, 4), sp.Rational(1, 2)]
-    J = r.jacobian_geometric(q)
-    with mpmath.workdps(60):
-        d = mpmath.det(mpmath.matrix([[mpmath.mpf(sp.N(J[i, j], 70)) for j in range(6)] for i in range(6)]))
-    assert abs(d) < mpmath.mpf(10) ** -50
+    f = sp.lambdify(r.thetas, r.jacobian_geometric(), "mpmath")  # J(θ) evaluated in mpmath at 60 digits
+
+    def det60(q):
+        with mpmath.workdps(60):
+            vals = [
+                mpmath.atan2(-mpmath.mpf(4318) / 10000, mpmath.mpf(203) / 10000)
+                if x == th3
+                else mpmath.mpf(x.p) / x.q
+                if x.is_Rational
+                else mpmath.mpf(str(sp.N(x, 70)))
+                for x in q
+            ]
+            return mpmath.det(mpmath.matrix(f(*vals)))
+
+    assert abs(det60(q)) < mpmath.mpf(10) ** -50
     q[2] = th3 + sp.Rational(1, 10)  # off the factor: regular
-    J = r.jacobian_geometric(q)
-    assert abs(sp.N(J.det(), 30)) > 1e-6
+    assert abs(det60(q)) > 1e-6

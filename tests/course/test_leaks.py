@@ -389,6 +389,11 @@ ALLOWED: list[tuple[str, str, str, str, str, str]] = [
         "7.4's question gives the cart-pole's configuration, the pole upright at θ2 = π/2: the question's own data, "
         "about another robot than 7.6's slide-and-2R arm",
     ),
+    (
+        "7.5", "scara_singular", r"the set", r"07_", r"singularconfigurations:\[theta3:imageset",
+        "the own-arm cell after 7.5 prints the singular set of its default elbow arm (waist, shoulder, elbow): its "
+        "elbow θ3 ∈ {kπ} is that arm's, spelled like a set of the SCARA's θ2 but about another joint and robot",
+    ),
     *(
         (part, name, r"theta2 = (0|pi) ", r"07_", r"armstretched\$?theta2=0\$?,folded\$?theta2=pi",
          "7.1's predict question offers the 2R arm stretched (θ2 = 0) or folded (θ2 = π) as choices for a circular "

@@ -390,9 +390,10 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
         if not digits or not all(c in "0123456789.eE+-infa" for c in digits):
             raise WireError("malformed Float")
         try:  # mpmath's number syntax (never eval); malformed digits are a ValueError
-            return _check_number(sp.Float(digits, precision=small(args[1], MAX_PREC) or 53))
+            made = sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
         except (ValueError, TypeError):
             raise WireError("malformed Float") from None
+        return _check_number(made)
     if op == "Symbol" and len(args) == 2:
         return sp.Symbol(_name(args[0]), **_assumptions(args[1]))
     if op == "Dummy" and len(args) == 3:

@@ -464,7 +464,7 @@ def make_workbook(source_nb, groups: list, fps: dict, pictures: set | None = Non
     >>> print(wb.cells[1].source.splitlines()[1])
     x = ...  # TODO: a number (part 1.1)
     >>> print(wb.cells[2].source.splitlines()[-1])
-    check("1.1", x="scalar||38d50d747d97fdc2")
+    check("1.1", x="scalar||7253401f7eb9fd2a")
     """
     nb = copy.deepcopy(source_nb)
     nb.metadata.pop("widgets", None)
