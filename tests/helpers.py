@@ -177,3 +177,59 @@ def random_thetas(rng: np.random.Generator, kinds: str, size=None) -> np.ndarray
     pr = np.array([k == "P" for k in kinds])
     th[..., pr] = rng.uniform(-1.0, 1.0, size=shape)[..., pr]
     return th
+
+
+# --------------------------------------------------------------------------------------------
+# the unseen-robot exercises (issue 30, "practice that transfers"): right, other-valid and wrong answers
+# --------------------------------------------------------------------------------------------
+_K = sp.Symbol("k", integer=True)
+
+
+def angle_family(*offsets, period=2 * sp.pi) -> sp.Set:
+    """The angles offset + period·k (k any integer), one ImageSet per offset: a `set` answer written by hand."""
+    return sp.Union(*[sp.ImageSet(sp.Lambda(_K, o + period * _K), sp.Integers) for o in offsets])
+
+
+def crossed(value):
+    """The value as the grader sees it: exported in the kernel, sent as JSON, read by the whitelist parser."""
+    import json
+
+    from kinlib.course.answers import wire
+    from kinlib.course.grader.in_kernel.export import export
+
+    return wire.load(json.loads(json.dumps(export(value))))
+
+
+def grader_verdict(kind, student, reference, name, points):
+    """(ok, message) of the instructor's grader: describe both sides at `points`, through JSON, then compare."""
+    import json
+
+    from kinlib.course.answers import compare, describe
+
+    stu = json.loads(json.dumps(describe.describe(kind, crossed(student), points, 0)))
+    ref = json.loads(json.dumps(describe.describe(kind, crossed(reference), points, 0)))
+    return compare.compare(kind, stu, ref, name)
+
+
+def assert_graded_right_and_wrong(name, case, points) -> None:
+    """Feed the workbook self-check and the grader the right answer, its other valid forms and the wrong ones.
+
+    `case` is (part, kind, right, [other valid forms], {label: wrong value}); the self-check is salted by
+    "part:name" as the workbook's is. Every right form must pass both, every wrong one fail both.
+    """
+    from kinlib.course.workbook.selfcheck import fingerprint, verdict
+
+    part, kind, right, others, wrong = case
+    sc_kind = "default" if kind == "expr" else kind
+    salt = f"{part}:{name}"
+    spec = fingerprint(right, sc_kind, salt=salt)
+    for value in [right, *others]:
+        status, msg = verdict(value, spec, salt=salt)
+        assert status == "correct", (name, value, msg)
+        ok, msg = grader_verdict(kind, value, right, name, points)
+        assert ok, (name, value, msg)
+    for label, value in wrong.items():
+        status, msg = verdict(value, spec, salt=salt)
+        assert status == "incorrect", (name, label, status, msg)
+        ok, msg = grader_verdict(kind, value, right, name, points)
+        assert not ok, (name, label, msg)

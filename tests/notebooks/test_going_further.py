@@ -19,13 +19,9 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
+from helpers import angle_family as family
+from helpers import assert_graded_right_and_wrong
 from kinlib.course import schema
-from kinlib.course.answers import compare as C
-from kinlib.course.answers import describe as probe
-from kinlib.course.answers import wire
-from kinlib.course.grader.in_kernel.export import export
-from kinlib.course.workbook.selfcheck import fingerprint
-from kinlib.course.workbook.selfcheck import verdict as sc_verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 NB = ROOT / "notebooks" / "07_going_further.ipynb"
@@ -33,7 +29,6 @@ pi = sp.pi
 t1, t2, t3, t4 = sp.symbols("theta1:5", real=True)
 L1, L2, L, a, h = sp.symbols("L1 L2 L a h", positive=True)
 b, c, Fx, Fy = sp.symbols("b c F_x F_y", real=True)
-k = sp.Symbol("k", integer=True)
 POINTS = [
     {
         "theta1": 0.3,
@@ -66,10 +61,6 @@ POINTS = [
         "F_y": 0.2,
     },
 ]
-
-
-def family(*offsets, period=2 * pi):
-    return sp.Union(*[sp.ImageSet(sp.Lambda(k, o + period * k), sp.Integers) for o in offsets])
 
 
 # by hand: the 2R arm, ṗ = J_v θ̇ with p = (L1 c1 + L2 c12, L1 s1 + L2 s12)
@@ -222,17 +213,6 @@ CASES = {
 }
 
 
-def _crossed(value):
-    """The value as the grader sees it: exported in the kernel, sent as JSON, read by the whitelist parser."""
-    return wire.load(json.loads(json.dumps(export(value))))
-
-
-def _grader(kind, student, reference, name):
-    stu = json.loads(json.dumps(probe.describe(kind, _crossed(student), POINTS, 0)))
-    ref = json.loads(json.dumps(probe.describe(kind, _crossed(reference), POINTS, 0)))
-    return C.compare(kind, stu, ref, name)
-
-
 def test_the_notebook_declares_these_answers():
     nb = json.loads(NB.read_text())
     assert schema.notebook_id(nb) == "07_going_further"
@@ -245,17 +225,4 @@ def test_the_notebook_declares_these_answers():
 
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_selfcheck_and_grader_on_right_other_valid_and_wrong_answers(name):
-    part, kind, right, others, wrong = CASES[name]
-    sc_kind = "default" if kind == "expr" else kind
-    salt = f"{part}:{name}"
-    spec = fingerprint(right, sc_kind, salt=salt)
-    for value in [right, *others]:
-        status, msg = sc_verdict(value, spec, salt=salt)
-        assert status == "correct", (name, value, msg)
-        ok, msg = _grader(kind, value, right, name)
-        assert ok, (name, value, msg)
-    for label, value in wrong.items():
-        status, msg = sc_verdict(value, spec, salt=salt)
-        assert status == "incorrect", (name, label, status, msg)
-        ok, msg = _grader(kind, value, right, name)
-        assert not ok, (name, label, msg)
+    assert_graded_right_and_wrong(name, CASES[name], POINTS)

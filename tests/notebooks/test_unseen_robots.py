@@ -19,27 +19,18 @@ from pathlib import Path
 import pytest
 import sympy as sp
 
+from helpers import angle_family as family
+from helpers import assert_graded_right_and_wrong
 from kinlib.course import schema
-from kinlib.course.answers import compare as C
-from kinlib.course.answers import describe as probe
-from kinlib.course.answers import wire
-from kinlib.course.grader.in_kernel.export import export
-from kinlib.course.workbook.selfcheck import fingerprint
-from kinlib.course.workbook.selfcheck import verdict as sc_verdict
 
 ROOT = Path(__file__).resolve().parents[2]
 pi = sp.pi
 t1, t2, t3 = sp.symbols("theta1:4", real=True)
 L = sp.Symbol("L", positive=True)
-k = sp.Symbol("k", integer=True)
 POINTS = [
     {"theta1": 0.3, "theta2": -1.1, "theta3": 2.0, "L": 1.2},
     {"theta1": -2.0, "theta2": 0.7, "theta3": -0.5, "L": 0.6},
 ]
-
-
-def family(*offsets, period=2 * pi):
-    return sp.Union(*[sp.ImageSet(sp.Lambda(k, o + period * k), sp.Integers) for o in offsets])
 
 
 def homog(x, y, z):
@@ -141,17 +132,6 @@ def test_the_hand_references_are_what_the_notebook_says():
     assert sp.simplify(DET_63 - (L + t3) ** 2 * sp.cos(t2)) == 0
 
 
-def _crossed(value):
-    """The value as the grader sees it: exported in the kernel, sent as JSON, read by the whitelist parser."""
-    return wire.load(json.loads(json.dumps(export(value))))
-
-
-def _grader(kind, student, reference, name):
-    stu = json.loads(json.dumps(probe.describe(kind, _crossed(student), POINTS, 0)))
-    ref = json.loads(json.dumps(probe.describe(kind, _crossed(reference), POINTS, 0)))
-    return C.compare(kind, stu, ref, name)
-
-
 @pytest.mark.parametrize(
     "stem, part", [("05_singularities_planar", "5.6"), ("06_singularities_spatial", "6.3")], ids=["5.6", "6.3"]
 )
@@ -170,17 +150,4 @@ def test_the_notebooks_declare_these_answers(stem, part):
 
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_selfcheck_and_grader_on_right_other_valid_and_wrong_answers(name):
-    part, kind, right, others, wrong = CASES[name]
-    sc_kind = "default" if kind == "expr" else kind
-    salt = f"{part}:{name}"
-    spec = fingerprint(right, sc_kind, salt=salt)
-    for value in [right, *others]:
-        status, msg = sc_verdict(value, spec, salt=salt)
-        assert status == "correct", (name, value, msg)
-        ok, msg = _grader(kind, value, right, name)
-        assert ok, (name, value, msg)
-    for label, value in wrong.items():
-        status, msg = sc_verdict(value, spec, salt=salt)
-        assert status == "incorrect", (name, label, status, msg)
-        ok, msg = _grader(kind, value, right, name)
-        assert not ok, (name, label, msg)
+    assert_graded_right_and_wrong(name, CASES[name], POINTS)
