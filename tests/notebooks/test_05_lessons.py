@@ -6,7 +6,8 @@ One notebook (and one workbook) per problem-set section; inside 05 the lessons a
 * the contents table after the objectives links every lesson heading (by the id JupyterLab and nbconvert give it);
 * each lesson holds the graded parts it names (5A: 5.1, 5.2; 5B: 5.3; 5C: 5.4; 5D: 5.5, 5.6), opens with what the
   student will be able to do and about how many minutes (at most 25; the lessons add up to the objectives' time), has
-  at most 32 cells, and ends with its "Before you stop" recap (5D's just before the notebook's summary);
+  at most 32 cells, asks at least one prediction before it shows the answer, and ends with its "Before you stop"
+  recap (5D's just before the notebook's summary);
 * the workbook keeps every lesson heading, set-up cell and recap;
 * each lesson runs from its start in a fresh kernel: the notebook's set-up cell, then the lesson's cells (its own
   set-up cell rebuilds what earlier lessons made). Slow (the whole notebook once, four kernels).
@@ -70,6 +71,11 @@ def test_each_lesson_opens_with_its_goal_and_time_and_ends_with_a_recap():
         total += int(m.group(1))
         assert ", ".join(PARTS[k]).replace(", ", " and ") in opening, k
         assert len(cells) <= 32, (k, len(cells))
+        # the student predicts before being shown: a predict cell, its folded answer right after it
+        predicts = [i for i, c in enumerate(cells) if "predict" in schema.cell_tags(c)]
+        assert predicts, k
+        for i in predicts:
+            assert "predict-answer" in schema.cell_tags(cells[i + 1]) and schema.is_source_hidden(cells[i + 1]), k
         assert cells[-1].cell_type == "markdown" and cells[-1].source.startswith(
             f"**Before you stop (Lesson 5{k}).**"
         ), k
@@ -106,19 +112,25 @@ def test_workbook_keeps_every_lesson_cell():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("letter", list(PARTS))
-def test_each_lesson_runs_from_its_start_in_a_fresh_kernel(letter):
+def test_each_lesson_runs_from_its_start_in_a_fresh_kernel():
+    """One kernel, its namespace emptied (``%reset -f``) at each lesson's start: the notebook's set-up cell, then the
+    lesson's code cells (a name only an earlier lesson binds is a NameError). The whole notebook runs once."""
     from kinlib.course.publish.execute import notebook_client
 
     nb = nbformat.read(NB05, as_version=4)
     setup = next(c for c in nb.cells if c.cell_type == "code")
-    cells = [setup] + [c for c in _lessons(nb)[letter][1] if c.cell_type == "code"]
-    run = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(c.source) for c in cells])
-    run.cells.insert(0, nbformat.v4.new_code_cell("import matplotlib\nmatplotlib.use('Agg')"))
-    run.metadata = nb.metadata
-    notebook_client(run, timeout=600, kernel_name="python3", cwd=str(ROOT / "notebooks")).execute()
-    errors = [o for c in run.cells for o in c.get("outputs", []) if o.get("output_type") == "error"]
-    assert not errors
+    run, starts = nbformat.v4.new_notebook(metadata=nb.metadata), {}
+    for letter, (_, cells) in _lessons(nb).items():
+        starts[len(run.cells)] = letter
+        run.cells.append(nbformat.v4.new_code_cell("%reset -f\nimport matplotlib\nmatplotlib.use('Agg')"))
+        run.cells += [nbformat.v4.new_code_cell(c.source) for c in [setup, *cells] if c.cell_type == "code"]
+    client = notebook_client(run, timeout=600, kernel_name="python3", cwd=str(ROOT / "notebooks"), allow_errors=True)
+    client.execute()
+    lesson, failed = None, []
+    for i, c in enumerate(run.cells):
+        lesson = starts.get(i, lesson)
+        failed += [(lesson, o["ename"], o["evalue"]) for o in c.outputs if o.get("output_type") == "error"]
+    assert not failed, failed
 
 
 def test_06_polar_arm_labels_sit_next_to_their_joints():
