@@ -450,6 +450,25 @@ def _favicons(dest: Path) -> None:
         shutil.copytree(src, dest, dirs_exist_ok=True)
 
 
+#: where ``make setup`` keeps the Pyodide kernel's front end (the lab extension ``jupyterlite-pyodide-kernel``
+#: installs into ``share/jupyter/labextensions``): out of JupyterLab's extension path, where `make lab` would load it
+#: and fail ("Shared module @jupyterlite/server doesn't exist in shared scope default": it runs only inside
+#: JupyterLite). The Makefile's ``lab-extensions`` target moves it here.
+KERNEL_EXTENSION_KEPT = Path("share/kinlib/lite-labextensions/@jupyterlite/pyodide-kernel-extension")
+
+
+def kernel_extension(prefix: Path | None = None) -> Path:
+    """The Pyodide kernel's lab extension for the site: where ``make setup`` keeps it (:data:`KERNEL_EXTENSION_KEPT`
+    under ``prefix``, default ``sys.prefix``), else where pip installed it.
+
+    >>> kernel_extension(Path("/nowhere")).as_posix()
+    '/nowhere/share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension'
+    """
+    prefix = Path(sys.prefix if prefix is None else prefix)
+    kept = prefix / KERNEL_EXTENSION_KEPT
+    return kept if (kept / "package.json").is_file() else prefix / "share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension"
+
+
 def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
     """Build the JupyterLite site ``out/lite`` from ``out/workbooks/*.ipynb`` and the solution notebooks
     ``notebooks`` (a folder of executed ``NN_*.ipynb``, or a list of them); return ``out/lite``.
@@ -511,7 +530,7 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
         home = tmp / "home"  # nothing from the developer's home or Jupyter settings goes into the site
         env = {k: v for k, v in os.environ.items() if not k.startswith(("JUPYTER", "JUPYTERLITE"))}
         env.update(HOME=str(home), JUPYTER_CONFIG_DIR=str(home / "config"), JUPYTER_DATA_DIR=str(home / "data"))
-        ext = Path(sys.prefix) / "share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension"
+        ext = kernel_extension()
         cmd = [sys.executable, "-m", "jupyter", "lite", "build", "--lite-dir", str(lite_dir)]
         cmd += ["--output-dir", str(site), "--contents", str(content), "--ignore-sys-prefix", "--no-sourcemaps"]
         cmd += [
