@@ -21,9 +21,14 @@ from __future__ import annotations
 import re
 
 import pytest
-from test_lite import WORKBOOK, Blocker, _FIRST_PICTURE, _READY, handouts_site, site_base  # noqa: F401 (fixtures)
+import test_lite
+from test_lite import _FIRST_PICTURE, _READY, WORKBOOK, Blocker
 
 from kinlib.course.publish import lite
+
+# the site of the run's real handouts build, served on loopback: test_lite.py's module fixtures, used here too
+handouts_site = test_lite.handouts_site
+site_base = test_lite.site_base
 
 #: console messages that are upstream's and cannot be fixed in this project: (pattern, upstream issue, why)
 ALLOWED = [

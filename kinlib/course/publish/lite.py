@@ -466,7 +466,11 @@ def kernel_extension(prefix: Path | None = None) -> Path:
     """
     prefix = Path(sys.prefix if prefix is None else prefix)
     kept = prefix / KERNEL_EXTENSION_KEPT
-    return kept if (kept / "package.json").is_file() else prefix / "share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension"
+    return (
+        kept
+        if (kept / "package.json").is_file()
+        else prefix / "share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension"
+    )
 
 
 def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
