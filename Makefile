@@ -16,11 +16,22 @@ TEST_JOBS ?= 2
 TESTS ?= tests
 XDIST := $(if $(filter-out 1,$(TEST_JOBS)),-n $(TEST_JOBS) --dist loadgroup)
 
-.PHONY: all setup lint format test test-fast lab lab-students notebooks handouts grade bench lock chromium webkit poppler bubblewrap compiler clean
+.PHONY: all setup lab-extensions lint format test test-fast lab lab-students notebooks handouts grade bench lock chromium webkit poppler bubblewrap compiler clean
 
 all: test
 
-setup: $(STAMP)
+setup: $(STAMP) lab-extensions
+
+# The JupyterLite kernel's front end (jupyterlite-pyodide-kernel installs it into .venv/share/jupyter/labextensions)
+# runs only inside JupyterLite: in JupyterLab (`make lab`) it fails to load ("Shared module @jupyterlite/server
+# doesn't exist in shared scope default", a console error on every page) and JupyterLab loads every extension in its
+# path, disabled or not. It is moved out of that path to where the site's build reads it
+# (kinlib.course.publish.lite.kernel_extension); again after pip reinstalls it.
+LITE_LABEXT := $(VENV)/share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension
+LITE_LABEXT_KEPT := $(VENV)/share/kinlib/lite-labextensions/@jupyterlite/pyodide-kernel-extension
+lab-extensions: $(STAMP)
+	@if [ -d $(LITE_LABEXT) ]; then rm -rf $(LITE_LABEXT_KEPT) && mkdir -p $(dir $(LITE_LABEXT_KEPT)) \
+	    && mv $(LITE_LABEXT) $(LITE_LABEXT_KEPT) && echo "lab-extensions: the JupyterLite kernel's extension moved out of JupyterLab's path"; fi
 
 # The exact pins, then kinlib itself as an editable install without dependencies (that is what puts the
 # `kinlib` console script into .venv/bin). Re-run when the pins or pyproject.toml change.
@@ -87,7 +98,7 @@ compiler:
 	  || echo "note: no Python.h for $(PYTHON): kinlib's compiled path is off (install the Python headers, e.g. python3-dev)"
 
 # The whole suite: lint, then unit and property tests, browser tests, and nbval over every notebook.
-test: $(STAMP) lint chromium webkit poppler bubblewrap compiler
+test: $(STAMP) lab-extensions lint chromium webkit poppler bubblewrap compiler
 	$(PY) -m pytest tests $(NOTEBOOKS) --nbval-lax --nbval-current-env \
 	    --nbval-sanitize-with notebooks/sanitize.cfg -p no:cacheprovider --durations=15 $(XDIST) $(PYTEST_ARGS)
 
@@ -100,7 +111,7 @@ test-fast: $(STAMP) bubblewrap compiler
 # it shows their text or static image), and notebooks/.lab-settings/overrides.json is used (widget state saved with
 # the notebook, so a saved notebook reopens with its pictures).
 LAB_ARGS ?=
-lab: $(STAMP)
+lab: $(STAMP) lab-extensions
 	@$(VENV)/bin/jupyter trust $(NOTEBOOKS) >/dev/null
 	$(VENV)/bin/jupyter lab --notebook-dir=notebooks --LabApp.app_settings_dir=$(CURDIR)/notebooks/.lab-settings \
 	    $(if $(filter 0,$(shell id -u)),--allow-root) $(LAB_ARGS)
@@ -112,7 +123,7 @@ lab: $(STAMP)
 # work), so a later build or `make clean` loses nothing. Extra options as for lab: LAB_ARGS=--no-browser.
 WORKBOOKS_DIR ?= $(HOME)/kinlib-workbooks
 STUDENT_WORKBOOKS := build/handouts-students/workbooks
-lab-students: $(STAMP)
+lab-students: $(STAMP) lab-extensions
 	@ls $(STUDENT_WORKBOOKS)/[0-9][0-9]_*.ipynb >/dev/null 2>&1 || \
 	    $(VENV)/bin/kinlib handouts notebooks --out build/handouts-students --audience students --no-site --no-pdf
 	@mkdir -p "$(WORKBOOKS_DIR)" && for f in $(STUDENT_WORKBOOKS)/[0-9][0-9]_*.ipynb; do \

@@ -87,10 +87,8 @@ def jupyterlab(
             (scratch / "untrusted" / f"{stem}.ipynb").write_text(json.dumps(nb, indent=1), encoding="utf-8")
     env = jupyter_env(work)
     bindir = Path(sys.executable).parent
-    # no "news" toast over the notebook (a user's own choice, not the project's)
-    notif = work / "settings" / "@jupyterlab" / "apputils-extension" / "notification.jupyterlab-settings"
-    notif.parent.mkdir(parents=True)
-    notif.write_text(json.dumps({"fetchNews": "false", "checkForUpdates": False}))
+    # no news toast and no update check: notebooks/.lab-settings/overrides.json says so, as for `make lab` (no
+    # setting of the test's own: tests/pictures/test_browser.py checks that the project's turns them off)
     if trust:
         nbs = sorted(str(p) for p in scratch.glob("[0-9][0-9]_*.ipynb"))
         subprocess.run([str(bindir / "jupyter"), "trust", *nbs], env=env, check=True, capture_output=True)
@@ -110,8 +108,6 @@ def jupyterlab(
             "--ServerApp.port_retries=0",
             f"--ServerApp.root_dir={scratch}",
             f"--LabApp.app_settings_dir={LAB_SETTINGS}",
-            "--LabApp.news_url=None",
-            "--LabApp.check_for_updates_class=jupyterlab.NeverCheckForUpdate",
         ],
         stdout=log,
         stderr=subprocess.STDOUT,

