@@ -103,6 +103,11 @@ def _browser_module(item) -> bool:
 _SPLIT = {
     # JupyterLab (module fixtures ``lab``/``lab_untrusted``) vs the static pages (the run's handouts build)
     "tests/pictures/test_browser.py": lambda item: "lab" if {"lab", "lab_untrusted"} & set(item.fixturenames) else "",
+    # each LMS bundle set up by its own setup.sh and graded in its container (minutes each) apart from each other
+    # and from the small tests: both workers run one at once (their references: the run's shared cache)
+    "tests/course/test_grade_lms.py": lambda item: (
+        item.originalname if item.originalname.startswith(("test_gradescope_bundle", "test_prairielearn_bundle")) else ""
+    ),
     # the two heavy hypothesis properties (no fixtures) apart from each other and from the small tests
     "tests/core/test_singular_sets.py": lambda item: (
         item.originalname if item.originalname.startswith("test_random_") else ""
