@@ -410,9 +410,7 @@ def six(tmp_path_factory, grader_reference_cache):
     for p in sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb")):
         shutil.copy(p, nbs / p.name)
     secret = Path(os.environ["KINLIB_GRADER_SECRET"])  # the run's (conftest's ``_grader_secret``)
-    kw = dict(
-        notebooks=nbs, cache=grader_reference_cache, secret=secret, sandbox=False, timeout=240, cell_timeout=120
-    )
+    kw = dict(notebooks=nbs, cache=grader_reference_cache, secret=secret, sandbox=False, timeout=240, cell_timeout=120)
     return {"dir": d, "kw": kw, "nbs": {p.stem: json.loads(p.read_text()) for p in sorted(nbs.glob("*.ipynb"))}}
 
 

@@ -54,7 +54,10 @@ def fake_step(monkeypatch):
 
 def _build(src, out, log=None, **kw):
     return handouts.build(
-        src, out, **{"site": False, "pdfs": False, "verify": False, "jobs": 1, **kw}, log=(log if log is not None else []).append
+        src,
+        out,
+        **{"site": False, "pdfs": False, "verify": False, "jobs": 1, **kw},
+        log=(log if log is not None else []).append,
     )
 
 
@@ -158,7 +161,9 @@ def test_a_students_build_takes_the_full_builds_current_sections_and_pdfs_never_
     assert not (students / "solutions").exists() and not (students / "pdf" / "solutions").exists()
     # 01's page has the full build's bytes: its PDF is copied; 02's is printed (its page changed)
     assert printed[4:] == ["students/problems/02_b"]
-    assert (students / "pdf" / "problems" / "01_a.pdf").read_bytes() == (full / "pdf" / "problems" / "01_a.pdf").read_bytes()
+    assert (students / "pdf" / "problems" / "01_a.pdf").read_bytes() == (
+        full / "pdf" / "problems" / "01_a.pdf"
+    ).read_bytes()
     # a second students' build reuses its own sections: nothing made, nothing printed
     _build(src, students, pdfs=True, audience="students", reuse_from=full)
     assert fake_step == ["01_a", "02_b", "02_b"] and len(printed) == 5

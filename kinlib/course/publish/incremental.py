@@ -41,7 +41,17 @@ import nbformat
 
 import kinlib
 
-__all__ = ["STAMP_DIR", "Stamps", "adopt_sections", "build_sections", "build_site", "code_key", "key", "print_changed_pdfs", "stamp_dir"]
+__all__ = [
+    "STAMP_DIR",
+    "Stamps",
+    "adopt_sections",
+    "build_sections",
+    "build_site",
+    "code_key",
+    "key",
+    "print_changed_pdfs",
+    "stamp_dir",
+]
 
 #: the folder beside ``out`` (in its parent) that holds the stamps of every output folder there
 STAMP_DIR = ".kinlib-build"
