@@ -310,6 +310,8 @@ def print_changed_pdfs(out: Path, stamps: Stamps, log, source: Path | None = Non
     pdf = {p: out / "pdf" / p.parent.name / f"{p.stem}.pdf" for p in pages}
     name = {p: f"pdf-{p.parent.name}-{p.stem}" for p in pages}
     todo = [p for p in pages if stamps.current(name[p], keys[p], [pdf[p]]) is None]
+    if len(todo) < len(pages):
+        log(f"  pdf: {len(pages) - len(todo)} of {len(pages)} reused (their pages did not change)")
     if source is not None and todo:
         src_stamps, copied = Stamps(Path(source)), []
         for p in todo:
@@ -323,8 +325,6 @@ def print_changed_pdfs(out: Path, stamps: Stamps, log, source: Path | None = Non
         if copied:
             log(f"  pdf: {len(copied)} of {len(pages)} taken from {source} (the same pages)")
         todo = [p for p in todo if p not in copied]
-    if len(todo) < len(pages):
-        log(f"  pdf: {len(pages) - len(todo)} of {len(pages)} reused (their pages did not change)")
     if not todo:
         return
     for p in todo:
