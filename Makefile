@@ -141,14 +141,16 @@ notebooks: $(STAMP)
 # Main batch job: HTML handouts (problems + solutions), student workbooks, index -> build/handouts/
 # make handouts AUDIENCE=students -> build/handouts-students/: the same without any solution (page, PDF or
 # notebook), the folder to publish to students; build/handouts/ is the instructors' (it has the solutions).
-# Incremental: a section, the site or a PDF whose inputs did not change is reused (the log says so).
+# Incremental: a section, the site or a PDF whose inputs did not change is reused (the log says so); the students'
+# build takes the sections and PDFs that are current in build/handouts (the same bytes; never a solution).
 # `make handouts ONLY=05` builds one section (ONLY="02 05": several); `make handouts FRESH=1` builds everything again.
 AUDIENCE ?= all
 ONLY ?=
 FRESH ?=
 HANDOUTS_OUT := $(if $(filter students,$(AUDIENCE)),build/handouts-students,build/handouts)
 handouts: $(STAMP) chromium
-	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE) $(if $(ONLY),--only $(ONLY)) $(if $(FRESH),--fresh)
+	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE) $(if $(ONLY),--only $(ONLY)) $(if $(FRESH),--fresh) \
+	    $(if $(filter students,$(AUDIENCE)),$(if $(wildcard build/handouts/index.html),--reuse-from build/handouts))
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
 # http://127.0.0.1:$(PORT)/ (loopback only; Ctrl-C stops); builds the handouts first if they are not there.

@@ -119,6 +119,13 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="build everything again (default: reuse each section, the site and each PDF whose inputs did not change)",
     )
+    h.add_argument(
+        "--reuse-from",
+        type=Path,
+        default=None,
+        help="with --audience students: a full build of the same notebooks (e.g. build/handouts) whose current "
+        "sections and PDFs are copied instead of made again (never a solution)",
+    )
     h.add_argument("--serve", action="store_true", help="then serve OUT on http://127.0.0.1:PORT/ (Ctrl-C stops)")
     h.add_argument("--port", type=int, default=8000, help="port for --serve (default 8000; loopback only)")
     h.set_defaults(run=_handouts, parser=h)
@@ -368,6 +375,7 @@ def _handouts(args) -> int:
             pdfs=args.pdfs,
             fresh=args.fresh,
             audience=args.audience,
+            reuse_from=args.reuse_from,
             log=lambda s: print(s, flush=True),
         )
     except NotebookFailed as e:  # names the notebook and the cell, with the cell's first lines

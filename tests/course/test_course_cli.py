@@ -41,7 +41,18 @@ def test_help_lists_the_subcommands(capsys):
     [
         (
             "handouts",
-            ["--out", "--vendor", "--jobs", "--timeout", "--no-verify", "--only", "--no-site", "--no-pdf", "--serve"],
+            [
+                "--out",
+                "--vendor",
+                "--jobs",
+                "--timeout",
+                "--no-verify",
+                "--only",
+                "--no-site",
+                "--no-pdf",
+                "--reuse-from",
+                "--serve",
+            ],
         ),
         ("grade", ["--out", "--timeout", "--cell-timeout", "--jobs", "--notebooks", "--cache", "--quiet"]),
     ],

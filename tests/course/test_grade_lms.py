@@ -397,8 +397,11 @@ def _hostile(mark: str, results: str, key: str) -> str:
 
 
 @pytest.fixture(scope="module")
-def six(tmp_path_factory):
-    """The six lesson notebooks (one consistent copy while others edit them), their references computed once."""
+def six(tmp_path_factory, grader_reference_cache):
+    """The six lesson notebooks (one consistent copy while others edit them), their references computed once per
+    run: the run's signed reference cache and secret (tests/conftest.py), which the xdist workers share (the
+    Gradescope and PrairieLearn tests run on both at once: conftest's ``_SPLIT``) with the other grading tests
+    (the cache is keyed by each notebook's bytes, so this copy hits the same entries)."""
     if len(sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb"))) != 6:
         pytest.skip("the six lesson notebooks are not all there")
     d = tmp_path_factory.mktemp("six")
@@ -406,9 +409,8 @@ def six(tmp_path_factory):
     nbs.mkdir()
     for p in sorted(NOTEBOOKS.glob("0[1-6]_*.ipynb")):
         shutil.copy(p, nbs / p.name)
-    (d / "secret").write_text("s" * 64 + "\n")
-    (d / "secret").chmod(0o600)
-    kw = dict(notebooks=nbs, cache=d / "cache", secret=d / "secret", sandbox=False, timeout=240, cell_timeout=120)
+    secret = Path(os.environ["KINLIB_GRADER_SECRET"])  # the run's (conftest's ``_grader_secret``)
+    kw = dict(notebooks=nbs, cache=grader_reference_cache, secret=secret, sandbox=False, timeout=240, cell_timeout=120)
     return {"dir": d, "kw": kw, "nbs": {p.stem: json.loads(p.read_text()) for p in sorted(nbs.glob("*.ipynb"))}}
 
 
@@ -454,7 +456,7 @@ def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
         "__pycache__" in n for n in names
     )
     assert "modern_robotics" in z.read("imports.txt").decode().split()  # the workbooks import it
-    assert (six["dir"] / "secret").read_bytes().strip() not in z.read("grader-secret")
+    assert six["kw"]["secret"].read_bytes().strip() not in z.read("grader-secret")
     box = Container(tmp_path, {"/autograder": "ag"})
     z.extractall(tmp_path / "ag" / "source")
     for f in ("run_autograder", "setup.sh"):

@@ -31,7 +31,7 @@ def fake_step(monkeypatch):
     def build_one(path, out, urls, timeout, verify, log=print, links=(), audience="all"):
         calls.append(path.stem)
         nb = nbformat.read(path, as_version=4)
-        for kind in ("solutions", "problems"):
+        for kind in ("solutions", "problems") if audience == "all" else ("problems",):
             (out / kind).mkdir(parents=True, exist_ok=True)
             (out / kind / f"{path.stem}.html").write_text(f"<p>{kind} of {nb.cells[0].source}</p>")
         (out / "workbooks").mkdir(parents=True, exist_ok=True)
@@ -54,7 +54,10 @@ def fake_step(monkeypatch):
 
 def _build(src, out, log=None, **kw):
     return handouts.build(
-        src, out, site=False, pdfs=False, verify=False, jobs=1, log=(log if log is not None else []).append, **kw
+        src,
+        out,
+        **{"site": False, "pdfs": False, "verify": False, "jobs": 1, **kw},
+        log=(log if log is not None else []).append,
     )
 
 
@@ -120,3 +123,47 @@ def test_the_key_covers_the_notebook_the_code_and_the_options(tmp_path):
     assert k(b"a", b"bc") != k(b"ab", b"c")  # parts are length-prefixed
     code = incremental.code_key()
     assert len(code) == 64 and code == incremental.code_key()
+
+
+def test_a_students_build_takes_the_full_builds_current_sections_and_pdfs_never_a_solution(
+    tmp_path, fake_step, monkeypatch
+):
+    """``reuse_from`` (``make handouts AUDIENCE=students`` after ``make handouts``): the sections made from the same
+    notebook, code and options are copied (problems page, workbook), not made again; a changed notebook is made; no
+    solution page or PDF comes along; a PDF is copied only for a page of the same bytes."""
+    from kinlib.course.publish import printing
+
+    printed: list = []
+
+    def print_pdfs(out, pages, log=print):
+        for p in pages:
+            pdf = out / "pdf" / p.parent.name / f"{p.stem}.pdf"
+            pdf.parent.mkdir(parents=True, exist_ok=True)
+            pdf.write_bytes(b"%PDF " + p.read_bytes())
+            printed.append(f"{out.name}/{p.parent.name}/{p.stem}")
+
+    monkeypatch.setattr(printing, "print_pdfs", print_pdfs)
+    src, full, students = tmp_path / "nb", tmp_path / "full", tmp_path / "students"
+    src.mkdir()
+    for stem, title in (("01_a", "A"), ("02_b", "B")):
+        _notebook(src / f"{stem}.ipynb", title)
+    _build(src, full, pdfs=True)
+    assert fake_step == ["01_a", "02_b"]
+    assert sorted(printed) == ["full/problems/01_a", "full/problems/02_b", "full/solutions/01_a", "full/solutions/02_b"]
+    _notebook(src / "02_b.ipynb", "B, edited")  # changed since the full build: made for the students
+    log: list = []
+    entries = _build(src, students, log, pdfs=True, audience="students", reuse_from=full)
+    assert fake_step == ["01_a", "02_b", "02_b"], "01 is taken from the full build, 02 (changed) is made"
+    assert [e["title"] for e in entries] == ["A", "B, edited"] and entries[0].get("reused")
+    assert any("01_a: taken from" in line for line in log)
+    for kind, ext in (("problems", "html"), ("workbooks", "ipynb")):
+        assert (students / kind / f"01_a.{ext}").read_bytes() == (full / kind / f"01_a.{ext}").read_bytes()
+    assert not (students / "solutions").exists() and not (students / "pdf" / "solutions").exists()
+    # 01's page has the full build's bytes: its PDF is copied; 02's is printed (its page changed)
+    assert printed[4:] == ["students/problems/02_b"]
+    assert (students / "pdf" / "problems" / "01_a.pdf").read_bytes() == (
+        full / "pdf" / "problems" / "01_a.pdf"
+    ).read_bytes()
+    # a second students' build reuses its own sections: nothing made, nothing printed
+    _build(src, students, pdfs=True, audience="students", reuse_from=full)
+    assert fake_step == ["01_a", "02_b", "02_b"] and len(printed) == 5

@@ -447,9 +447,13 @@ def _lock(path: Path):
 
 
 @pytest.fixture(scope="module")
-def students_build() -> Path:
+def students_build(real_handouts) -> Path:
     """``make handouts AUDIENCE=students`` (its code and options: pages, site, PDFs, workbooks run) into
-    build/handouts-students, once per run (a file lock; a build current for the notebooks and kinlib is reused)."""
+    build/handouts-students, once per run (a file lock; a build current for the notebooks and kinlib is reused).
+    As ``make handouts AUDIENCE=students`` after ``make handouts``, it takes the sections and PDFs that the run's
+    full build (``real_handouts``, tests/conftest.py) made from the same inputs (``reuse_from``: the same bytes,
+    never a solution) instead of executing and printing them again; the site is its own. (A fixture argument, so
+    that conftest's schedule hands this module out after the build has had its head start.)"""
     if os.environ.get("KINLIB_STUDENTS_HANDOUTS_DIR"):
         return Path(os.environ["KINLIB_STUDENTS_HANDOUTS_DIR"]).resolve()
     from kinlib.course.publish import handouts
@@ -458,7 +462,13 @@ def students_build() -> Path:
         pytest.fail("pdftotext is missing: `make poppler` installs it")
     with _lock(ROOT / "build" / ".handouts-students.lock"):
         handouts.build(
-            ROOT / "notebooks", OUT, vendor=ROOT / "build" / "vendor", jobs=2, audience="students", log=lambda s: None
+            ROOT / "notebooks",
+            OUT,
+            vendor=ROOT / "build" / "vendor",
+            jobs=2,
+            audience="students",
+            reuse_from=real_handouts,
+            log=lambda s: None,
         )
     return OUT
 

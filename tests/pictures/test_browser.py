@@ -173,7 +173,7 @@ def test_handout_page_renders_offline(sites, browser, static_pages, spec):
                 assert raw not in rendered, f"raw TeX {raw!r} visible"
             # the saved widgets are shown
             if "application/vnd.jupyter.widget-view+json" in html:
-                page.wait_for_selector(".jupyter-widgets", timeout=15000)
+                page.wait_for_selector(".jupyter-widgets", timeout=60000)
                 page.wait_for_timeout(300)
                 assert page.locator(".jupyter-widgets").count() > 0
                 assert page.get_by_text("Error displaying widget").count() == 0
@@ -184,7 +184,7 @@ def test_handout_page_renders_offline(sites, browser, static_pages, spec):
                 page.wait_for_function(
                     "(n) => document.querySelectorAll('.kinlib-explorer svg.kinlib-picture .kinlib-arm').length >= n",
                     arg=n_explorers,
-                    timeout=15000,
+                    timeout=60000,
                 )
             # figures: every image decoded; as many as the page embeds
             page.wait_for_function("() => Array.from(document.images).every(i => i.complete)")
@@ -245,7 +245,7 @@ def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser, static_
         page, watch = _open_static(browser, static_pages, path)
         try:
             root = page.locator(".kinlib-animation").first
-            root.locator(".kinlib-arm").wait_for(timeout=15000)
+            root.locator(".kinlib-arm").wait_for(timeout=60000)
             root.scroll_into_view_if_needed()
             arm = root.locator(".kinlib-arm")
             first = arm.get_attribute("d")
@@ -254,7 +254,7 @@ def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser, static_
             assert root.get_attribute("data-step") == "1" and arm.get_attribute("d") != first, path.name
             root.locator("button.kinlib-play").click()
             page.wait_for_function(
-                "(r) => +r.getAttribute('data-step') >= 3", arg=root.element_handle(), timeout=15000, polling=20
+                "(r) => +r.getAttribute('data-step') >= 3", arg=root.element_handle(), timeout=60000, polling=20
             )
             root.locator("button.kinlib-play").click()  # pause
             watch.assert_clean(path.name)
@@ -270,7 +270,7 @@ def test_an_animation_and_a_picker_play_without_a_kernel(sites, browser, static_
     page, watch = _open_static(browser, static_pages, pickers[0])
     try:
         root = page.locator(".kinlib-picker").first
-        root.locator(".kinlib-arm").wait_for(timeout=15000)
+        root.locator(".kinlib-arm").wait_for(timeout=60000)
         root.scroll_into_view_if_needed()
         before = root.locator(".kinlib-arm").get_attribute("d")
         second = root.locator("button.kinlib-config").nth(1)
@@ -288,7 +288,7 @@ def _explorer_on_static_page(sites, browser, static_pages, stem, index=-1):
     root = _site(sites, "handouts")
     path = root / "solutions" / f"{stem}.html"
     page, watch = _open_static(browser, static_pages, path)
-    page.wait_for_function("() => document.querySelectorAll('.kinlib-explorer .kinlib-arm').length > 0", timeout=15000)
+    page.wait_for_function("() => document.querySelectorAll('.kinlib-explorer .kinlib-arm').length > 0", timeout=60000)
     ex = page.locator(".kinlib-explorer").nth(index) if index >= 0 else page.locator(".kinlib-explorer").last
     ex.scroll_into_view_if_needed()
     return page, watch, ex

@@ -422,7 +422,7 @@ def test_animation_draws_fk_and_the_rule_at_every_step(chromium, r3, tmp_path):
         play.click()
         assert play.get_attribute("aria-pressed") == "true"
         page.wait_for_function("() => +document.querySelector('.kinlib-animation').getAttribute('data-step') >= 2",
-                               timeout=30000)  # fmt: skip
+                               timeout=60000)  # fmt: skip
         play.press("Enter")  # pause, from the keyboard
         assert play.get_attribute("aria-pressed") == "false"
         at = page.evaluate(_READ_STEP)["step"]

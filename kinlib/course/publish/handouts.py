@@ -73,7 +73,7 @@ from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
 from .aids import STUDENTS_OUTPUTS, show_students_version, stub, student_reading_aid, students_cell
 from .analysis import answer_dependents, loaded_names, trim_setup, worked_narrative
 from .execute import notebook_client
-from .incremental import Stamps, build_sections, build_site, code_key, key, print_changed_pdfs
+from .incremental import Stamps, adopt_sections, build_sections, build_site, code_key, key, print_changed_pdfs
 from .pages import CHEATSHEET, HTML_MANAGER, LINKS, REQUIREJS, build_assets, export_html, write_cheatsheet, write_index
 
 __all__ = [
@@ -648,6 +648,7 @@ def build(
     pdfs: bool = True,
     fresh: bool = False,
     audience: str = "all",
+    reuse_from: Path | None = None,
     log=print,
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
@@ -658,7 +659,11 @@ def build(
 
     ``audience="students"`` leaves out every solution: no ``solutions/`` pages or PDFs, no solution notebooks
     in the in-browser site, no link to them in the index (what a course publishes to its students; a
-    ``solutions/`` folder left in ``out`` by an earlier build is removed first).
+    ``solutions/`` folder left in ``out`` by an earlier build is removed first). With ``reuse_from`` (a full
+    build of the same notebooks, e.g. build/handouts) it takes from there each section made from the same
+    notebook, kinlib, pins and options (its problems page and workbook: the same bytes; never a solution), and
+    each PDF of a page with the same bytes, instead of executing, verifying and printing them again
+    (:func:`kinlib.course.publish.incremental.adopt_sections`).
 
     Incremental (:mod:`kinlib.course.publish.incremental`): a section whose notebook, kinlib code, pins and options
     are those of the outputs already in ``out/`` is reused, not executed again (the log says "reused"); the site
@@ -707,6 +712,10 @@ def build(
         stamps.clear()
     options = {"verify": verify, "links": list(links), "urls": urls, "audience": audience}
     keys = {p: key(code_key(), p.read_bytes(), options) for p in all_paths}
+    source = Path(reuse_from) if reuse_from is not None and audience == "students" else None
+    if source is not None:
+        full = {**options, "audience": "all"}
+        adopt_sections(out, paths, keys, stamps, source, {p: key(code_key(), p.read_bytes(), full) for p in paths}, log)
     entries, listed = build_sections(
         out,
         all_paths,
@@ -725,7 +734,7 @@ def build(
     if site:
         build_site(out, paths if audience == "all" else [], [keys[p] for p in paths], stamps, log)
     if pdfs:
-        print_changed_pdfs(out, stamps, log)
+        print_changed_pdfs(out, stamps, log, source)
     log(
         f"kinlib handouts: wrote {out / 'index.html'} and {(3 if audience == 'all' else 2) * len(paths)} handouts "
         f"in {time.perf_counter() - t0:.1f} s"

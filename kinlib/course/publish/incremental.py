@@ -41,7 +41,17 @@ import nbformat
 
 import kinlib
 
-__all__ = ["STAMP_DIR", "Stamps", "build_sections", "build_site", "code_key", "key", "print_changed_pdfs", "stamp_dir"]
+__all__ = [
+    "STAMP_DIR",
+    "Stamps",
+    "adopt_sections",
+    "build_sections",
+    "build_site",
+    "code_key",
+    "key",
+    "print_changed_pdfs",
+    "stamp_dir",
+]
 
 #: the folder beside ``out`` (in its parent) that holds the stamps of every output folder there
 STAMP_DIR = ".kinlib-build"
@@ -174,6 +184,42 @@ def _reused_section(path: Path, out: Path, k: str, stamps: Stamps, audience: str
     }
 
 
+def adopt_sections(out: Path, paths, keys: dict, stamps: Stamps, source: Path, source_keys: dict, log=print) -> int:
+    """A students' build (``out``) takes from a full build beside it (``source``, audience "all") each section
+    that is current there (``source_keys``: its keys for the same notebook, kinlib, pins and options but the
+    audience) and not current in ``out``: the problems page and the workbook (the same bytes a students' build
+    makes: neither depends on the audience) and the kept executions, never the solutions page; recorded under the
+    students' key (``keys``), so :func:`build_sections` reuses it instead of executing the notebook and running
+    its workbook again. Returns how many were taken.
+
+    >>> adopt_sections(Path("build/handouts-students"), paths, keys, stamps, Path("build/handouts"), src_keys)  # doctest: +SKIP
+    7
+    """
+    source = Path(source)
+    src_stamps, taken = Stamps(source), 0
+    for p in paths:
+        stem = p.stem
+        if stamps.current(f"section-{stem}", keys[p], _section_files(out, stem, "students")) is not None:
+            continue
+        data = src_stamps.current(f"section-{stem}", source_keys[p], _section_files(source, stem, "all"))
+        if data is None:
+            continue
+        stamps.forget(f"section-{stem}")
+        kept, src_kept = stamp_dir(out) / stem, stamp_dir(source) / stem
+        for a, b in (
+            (source / "problems" / f"{stem}.html", out / "problems" / f"{stem}.html"),
+            (source / "workbooks" / f"{stem}.ipynb", out / "workbooks" / f"{stem}.ipynb"),
+            (src_kept / "executed.ipynb", kept / "executed.ipynb"),
+            (src_kept / "problems.ipynb", kept / "problems.ipynb"),
+        ):
+            b.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(a, b)
+        stamps.record(f"section-{stem}", keys[p], data)
+        taken += 1
+        log(f"  {stem}: taken from {source} (the same notebook, kinlib, pins and options)")
+    return taken
+
+
 def build_sections(out: Path, all_paths, paths, keys: dict, stamps: Stamps, make, *, jobs=1, audience="all", log=print):
     """Reuse each section of ``paths`` that is current (its key in ``keys``), make the others with
     ``make(path) -> entry`` (``jobs`` at a time) and record them; return the entries of ``paths``, in order, and
@@ -250,8 +296,9 @@ def build_site(out: Path, paths: list, section_keys: list, stamps: Stamps, log) 
     stamps.record("site", k, {"notebooks": [p.name for p in paths]})
 
 
-def print_changed_pdfs(out: Path, stamps: Stamps, log) -> None:
-    """The PDFs of the pages, each printed again only when its page (or kinlib) changed.
+def print_changed_pdfs(out: Path, stamps: Stamps, log, source: Path | None = None) -> None:
+    """The PDFs of the pages, each printed again only when its page (or kinlib) changed. With ``source`` (another
+    build: :func:`adopt_sections`), a page whose PDF is current there for the same bytes is copied, not printed.
 
     >>> print_changed_pdfs(Path("build/handouts"), Stamps(Path("build/handouts")), print)  # doctest: +SKIP
       pdf: 13 of 13 reused (their pages did not change)
@@ -265,6 +312,19 @@ def print_changed_pdfs(out: Path, stamps: Stamps, log) -> None:
     todo = [p for p in pages if stamps.current(name[p], keys[p], [pdf[p]]) is None]
     if len(todo) < len(pages):
         log(f"  pdf: {len(pages) - len(todo)} of {len(pages)} reused (their pages did not change)")
+    if source is not None and todo:
+        src_stamps, copied = Stamps(Path(source)), []
+        for p in todo:
+            src_pdf = Path(source) / "pdf" / p.parent.name / f"{p.stem}.pdf"
+            if src_stamps.current(name[p], keys[p], [src_pdf]) is not None:  # the key holds the page's bytes
+                stamps.forget(name[p])
+                pdf[p].parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(src_pdf, pdf[p])
+                stamps.record(name[p], keys[p], {"page": f"{p.parent.name}/{p.name}"})
+                copied.append(p)
+        if copied:
+            log(f"  pdf: {len(copied)} of {len(pages)} taken from {source} (the same pages)")
+        todo = [p for p in todo if p not in copied]
     if not todo:
         return
     for p in todo:

@@ -408,6 +408,9 @@ def _kinlib_wheel(work: Path, log=print) -> Path:
         capture_output=True,
         text=True,
         cwd=work,
+        # reproducible: the same code gives the same bytes (zip times fixed), so its bytecode compiled in Pyodide
+        # is cached by sha256 like the other wheels' (a second build, e.g. the students', compiles nothing)
+        env={**os.environ, "SOURCE_DATE_EPOCH": "315532800"},
     )
     wheels = sorted(work.glob("kinlib-*.whl"))
     if r.returncode != 0 or not wheels:
@@ -585,8 +588,9 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
 
 def _with_bytecode(lock: dict, pyo: Path, pkg: Path, cache: Path, own: str, log=print) -> None:
     """Every wheel of the site (``pyo``, each verified) replaced by its copy with bytecode
-    (:func:`kinlib.course.publish.lite_bytecode.compile_wheels`, cached by the source's sha256 except ``own``,
-    kinlib's wheel of this build); ``lock`` gets the new sha256s."""
+    (:func:`kinlib.course.publish.lite_bytecode.compile_wheels`, cached by the source's sha256; ``own``, kinlib's
+    wheel, is reproducible (:func:`_kinlib_wheel`): its entry is kept while the code is the same); ``lock`` gets
+    the new sha256s."""
     from .lite_bytecode import compile_wheels
 
     entries = [e for e in lock["packages"].values() if e["file_name"].endswith(".whl")]
@@ -596,8 +600,6 @@ def _with_bytecode(lock: dict, pyo: Path, pkg: Path, cache: Path, own: str, log=
         if src in compiled:
             shutil.copyfile(compiled[src], src)
             e["sha256"] = _sha256(src)
-    if pyo / own in compiled:  # a new one each build: not kept
-        shutil.rmtree(compiled[pyo / own].parent, ignore_errors=True)
 
 
 def font_cache(wheel: bytes) -> bytes | None:
