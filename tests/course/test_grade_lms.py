@@ -307,10 +307,19 @@ class Container:
             cmd += ["--ro-bind", f"/opt/{d}", f"/opt/{d}"]
         cmd += ["--dev", "/dev", "--unshare-pid", "--proc", "/proc", "--perms", "1777", "--tmpfs", "/tmp"]
         cmd += ["--bind", _pip_cache(), _pip_cache()]
+        env = {"PATH": SIM_PATH, "HOME": "/tmp", "LANG": "C.UTF-8", "PIP_CACHE_DIR": _pip_cache()}
+        # this machine's pip configuration (its local indexes and wheel folder, as a platform's image has its own
+        # mirror settings): the user's pip.conf is not under the container's HOME, so it is named by
+        # PIP_CONFIG_FILE, and pip's own environment settings pass through. Without it pip fetched every package
+        # from PyPI in each set-up (85 s wall for 13 s CPU).
+        user_conf = Path.home() / ".config" / "pip" / "pip.conf"
+        if user_conf.is_file():
+            cmd += ["--ro-bind", str(user_conf), "/etc/pip-user.conf"]
+            env["PIP_CONFIG_FILE"] = "/etc/pip-user.conf"
+        env.update({k: v for k, v in os.environ.items() if k.startswith("PIP_") and k not in ("PIP_CACHE_DIR",)})
         for inside, sub in self.mounts.items():
             cmd += ["--bind", str(self.scratch / sub), inside]
         cmd += ["--die-with-parent", "--clearenv", "--chdir", "/"]
-        env = {"PATH": SIM_PATH, "HOME": "/tmp", "LANG": "C.UTF-8", "PIP_CACHE_DIR": _pip_cache()}
         for k, v in env.items():
             cmd += ["--setenv", k, v]
         return subprocess.run([*cmd, "bash", "-c", script], capture_output=True, text=True, timeout=timeout)
