@@ -49,6 +49,7 @@ __all__ = [
     "as_sympy_value",
     "home_canon",
     "home_verdict",
+    "home_hints",
     "stub_words",
 ]
 
@@ -397,6 +398,10 @@ def _diagnose(S, R, shape, stu, name="", ref=None) -> str:
                     return m.says
             except (ValueError, TypeError, IndexError):
                 pass
+    if mistakes.jacobian_like((r, c)):  # which Jacobian: the right angular rows, or the right one rotated
+        for inv in mistakes.FRAME_MISTAKES:
+            if close(inv.of(S3), inv.of(R3)):
+                return inv.says
     said = mistakes.concept_says(name, constant=not stu.get("symbols"), ref_constant=not (ref or {}).get("symbols"))
     if said:
         return said
@@ -593,6 +598,8 @@ def home_verdict(value, judge: fp.Judge) -> tuple[str, str]:
             return named(mistakes.ROUNDED.says)
     notes = _home_symbol_notes(v, judge.salt, judge.symhash)
     found = _home_mistake(v, form, shape, right, arr)
+    if found is None and mistakes.jacobian_like(arr.shape[1:]):  # which Jacobian (the spec's hints)
+        found = next((i.says for i in mistakes.FRAME_MISTAKES if judge.hint_right(i.name, _hint(i, arr))), None)
     if found is None:
         found = mistakes.concept_says(
             judge.salt.rpartition(":")[2], constant=not fp.symbols_of(v), ref_constant=judge.symhash is None
@@ -654,6 +661,29 @@ def _home_mistake(v, form, shape, right, arr=None):
         if fixed is not None and matches(fp.sampled(fixed)):
             return m.says
     return None
+
+
+def _hint(inv, arr) -> list:
+    return fp.canon_sampled(inv.of(arr), False)[2]
+
+
+def home_hints(value) -> dict:
+    """{invariant's name: its canonical form} of a right answer that may be a Jacobian (6 rows, 2 columns or
+    more): what the spec keeps, hashed, so that the self-check can tell, as the grader does, the right angular
+    rows with the wrong linear ones, or the right Jacobian in another frame's axes
+    (:data:`~.mistakes.FRAME_MISTAKES`); {} for any other answer.
+
+    >>> sorted(home_hints(sp.ones(6, 2))), home_hints(sp.ones(3, 3))
+    (['frame', 'linear-rows'], {})
+    """
+    try:
+        v = _home_value(value)
+    except fp.WrongForm:
+        return {}
+    if not isinstance(v, sp.MatrixBase) or not mistakes.jacobian_like(v.shape):
+        return {}
+    arr = fp.sampled(v)
+    return {inv.name: _hint(inv, arr) for inv in mistakes.FRAME_MISTAKES}
 
 
 def stub_words(value) -> str:

@@ -41,6 +41,7 @@ __all__ = [
     "canon_sampled",
     "digest",
     "sym_hash",
+    "hint_hash",
     "symbols_of",
     "shape_words",
     "Judge",
@@ -225,6 +226,16 @@ def digest(form, canon, salt: str = "") -> str:
     return hashlib.sha256(f"kinlib-selfcheck-v2:{salt}:{text}".encode()).hexdigest()[:16]
 
 
+def hint_hash(name: str, canon, salt: str) -> str:
+    """The salted hash (8 hex digits) of an invariant of the right answer (a kind's ``home_hints``), kept in the
+    spec so that a typical wrong answer sharing it can be named (never the answer itself).
+
+    >>> hint_hash("frame", [["1"]], "s") != hint_hash("linear-rows", [["1"]], "s")
+    True
+    """
+    return digest(f"hint:{name}", canon, salt)[:8]
+
+
 def sym_hash(names, salt: str) -> str:
     """The salted hash (8 hex digits) of a set of symbol names.
 
@@ -277,11 +288,18 @@ class Judge:
     (True, False, ('incorrect', 'not right yet: it has the wrong sign'))
     """
 
-    def __init__(self, form: str, shape: str, digest_: str, salt: str = "", symhash: str | None = None):
+    def __init__(
+        self, form: str, shape: str, digest_: str, salt: str = "", symhash: str | None = None, hints: dict | None = None
+    ):
         self.form, self.shape, self.digest, self.salt, self.symhash = form, shape, digest_, salt, symhash
+        self.hints = dict(hints or {})  # {invariant's name: hint_hash of the right answer's}
 
     def right(self, canon, form: str | None = None) -> bool:
         return digest(self.form if form is None else form, canon, self.salt) == self.digest
+
+    def hint_right(self, name: str, canon) -> bool:
+        """Whether ``canon`` is the right answer's invariant ``name`` (False when the spec holds none)."""
+        return name in self.hints and hint_hash(name, canon, self.salt) == self.hints[name]
 
     @staticmethod
     def named(says: str) -> tuple[str, str]:

@@ -65,6 +65,7 @@ class Kind:
     forms: tuple = ()  # the spec forms home_canon gives (a spec's form -> the kind that judges it)
     symbols: bool = False  # whether the spec records the answer's symbols (a missing variable, signed symbols)
     home_spec: Callable | None = None  # (value, argument, salt) -> spec, for a kind not judged by a hash
+    home_hints: Callable | None = None  # value -> {invariant: canonical form}: hashed into the spec (mistakes)
 
 
 def _subspace_normal(value):
@@ -80,6 +81,7 @@ KINDS = {
         expr.reference_expr,
         home_canon=expr.home_canon,
         home_verdict=expr.home_verdict,
+        home_hints=expr.home_hints,
         stub=expr.stub_words,
         forms=("matrix", "scalar", "bool"),
         symbols=True,

@@ -54,6 +54,7 @@ from ..answers.fingerprints import (
     Unanswered,
     WrongForm,
     digest,
+    hint_hash,
     sample_value,
     shape_words,
     sym_hash,
@@ -122,11 +123,14 @@ def fingerprint(value, kind: str = "default", salt: str = "") -> str:
     token = SIGNED.set(frozenset(signed))
     try:
         form, shape, canon = k.home_canon(value)
+        hints = k.home_hints(value) if k.home_hints is not None else {}
     finally:
         SIGNED.reset(token)
     spec = f"{form}|{shape}|{digest(form, canon, salt)}"
-    if syms:
-        spec += f"|{sym_hash([x.name for x in syms], salt)}|{','.join(signed)}"
+    if syms or hints:
+        spec += f"|{sym_hash([x.name for x in syms], salt) if syms else ''}|{','.join(signed)}"
+    if hints:
+        spec += "|" + ",".join(f"{n}={hint_hash(n, c, salt)}" for n, c in sorted(hints.items()))
     return spec
 
 
@@ -150,14 +154,16 @@ def describe_answer(value, kind: str = "default") -> str:
 
 
 def _parse_spec(spec: str):
-    """(form, shape, digest, symbols' hash or None, signed symbols) of a spec (3 fields: an answer without
-    symbols, or a spec made before the symbols were recorded)."""
+    """(form, shape, digest, symbols' hash or None, signed symbols, hints) of a spec (3 fields: an answer without
+    symbols, or a spec made before the symbols were recorded; 6: with the hashes of the right answer's invariants
+    that name a typical mistake, ``name=hash`` separated by commas)."""
     fields = spec.split("|") if isinstance(spec, str) else []
     if len(fields) == 3:
-        return (*fields, None, frozenset())
-    if len(fields) == 5:
-        form, shape, digest_, symhash, signed = fields
-        return form, shape, digest_, symhash, frozenset(x for x in signed.split(",") if x)
+        return (*fields, None, frozenset(), {})
+    if len(fields) in (5, 6):
+        form, shape, digest_, symhash, signed = fields[:5]
+        hints = dict(h.partition("=")[::2] for h in fields[5].split(",") if "=" in h) if len(fields) == 6 else {}
+        return form, shape, digest_, symhash or None, frozenset(x for x in signed.split(",") if x), hints
     raise ValueError(f"a self-check spec looks like 'matrix|6x3|<16 hex digits>', got {spec!r}")
 
 
@@ -179,7 +185,7 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
     >>> verdict(f, fingerprint(sp.Symbol("t")))
     ('error', 'cannot check it automatically: it does not evaluate to a number (Cannot convert expression to float)')
     """
-    form, shape, digest_, symhash, signed = _parse_spec(spec)
+    form, shape, digest_, symhash, signed, hints = _parse_spec(spec)
     if is_unanswered(value):
         return "unanswered", "not answered yet"
     if form == "none":
@@ -189,7 +195,7 @@ def verdict(value, spec: str, salt: str = "") -> tuple[str, str]:
         raise ValueError(f"unknown answer form {form!r} in spec {spec!r}")
     token = SIGNED.set(signed)
     try:
-        return kinds.KINDS[kind].home_verdict(value, Judge(form, shape, digest_, salt, symhash))
+        return kinds.KINDS[kind].home_verdict(value, Judge(form, shape, digest_, salt, symhash, hints))
     except WrongForm as e:
         return "incorrect", f"wrong form: {e}"
     except CannotCheck as e:
