@@ -151,7 +151,14 @@ def rows() -> list[Row]:
         Row("6.1", "rank_J", "expr", sp.Integer(4), [4], [(3, "generic rank")]),
         Row("6.1", "singular_set", "set", sp.EmptySet, [[], set()], [({th3: sp.FiniteSet(-L2)}, "")]),
         Row("6.2", "JtJ_62", "expr", JtJ, [], [(sp.simplify(Jg4 * Jg4.T), "other order")]),
-        Row("7.1", "A_v", "expr", A_v, [sp.expand(A_v)], [(A_v.xreplace({L1: L2, L2: L1}), "L1 and L2 swapped")]),
+        Row(
+            "7.1",
+            "A_v",
+            "expr",
+            A_v,
+            [sp.expand(A_v)],
+            [(A_v.xreplace({L1: L2, L2: L1}), "L1 and L2 swapped"), (J2.T * J2, "other order")],  # J square: Jᵀ J
+        ),
         Row("7.1", "length_ratio", "expr", L1 / L2, [L1 * L2**-1], [(L2 / L1, "upside down")]),
         Row("7.2", "removes_all", "choice", False, [0, sp.false], [(True, ""), (1, "")]),
         Row(

@@ -301,13 +301,13 @@ def test_every_named_mistake_has_a_case_in_the_table():
 
     said = [words for row in rows() for _, words in row.wrong if words]
     named = {m.name: m.says for m in (*mistakes.CONCEPT_MISTAKES, *mistakes.SYMBOLIC_MISTAKES)}
-    named |= {i.name: i.says for i in mistakes.FRAME_MISTAKES}
+    named |= {i.name: i.says for i in (*mistakes.FRAME_MISTAKES, *mistakes.SQUARE_MISTAKES)}
     named |= {
         "rank": mistakes.concept_says("rank", True, True),
         "constant": "is a constant",  # the constant's words (symbol notes, or concept_says for a constant answer)
         "rounded": mistakes.ROUNDED.says,
         "variable": mistakes.SET_VARIABLE.says,
-        "product-order": mistakes.PRODUCT_ORDER,
+        "product-order-shape": mistakes.PRODUCT_ORDER,
     }
     missing = {name: says for name, says in named.items() if not any(w in says for w in said)}
     assert not missing, f"mistakes with no case in tests/answer_table.py: {missing}"

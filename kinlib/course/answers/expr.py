@@ -398,10 +398,9 @@ def _diagnose(S, R, shape, stu, name="", ref=None) -> str:
                     return m.says
             except (ValueError, TypeError, IndexError):
                 pass
-    if mistakes.jacobian_like((r, c)):  # which Jacobian: the right angular rows, or the right one rotated
-        for inv in mistakes.FRAME_MISTAKES:
-            if close(inv.of(S3), inv.of(R3)):
-                return inv.says
+    for inv in mistakes.invariants_for((r, c)):  # which Jacobian; the product's order
+        if close(inv.of(S3), inv.of(R3)):
+            return inv.says
     said = mistakes.concept_says(name, constant=not stu.get("symbols"), ref_constant=not (ref or {}).get("symbols"))
     if said:
         return said
@@ -598,8 +597,9 @@ def home_verdict(value, judge: fp.Judge) -> tuple[str, str]:
             return named(mistakes.ROUNDED.says)
     notes = _home_symbol_notes(v, judge.salt, judge.symhash)
     found = _home_mistake(v, form, shape, right, arr)
-    if found is None and mistakes.jacobian_like(arr.shape[1:]):  # which Jacobian (the spec's hints)
-        found = next((i.says for i in mistakes.FRAME_MISTAKES if judge.hint_right(i.name, _hint(i, arr))), None)
+    if found is None:  # which Jacobian; the product's order (the spec's hints)
+        invs = mistakes.invariants_for(arr.shape[1:])
+        found = next((i.says for i in invs if judge.hint_right(i.name, _hint(i, arr))), None)
     if found is None:
         found = mistakes.concept_says(
             judge.salt.rpartition(":")[2], constant=not fp.symbols_of(v), ref_constant=judge.symhash is None
@@ -669,21 +669,22 @@ def _hint(inv, arr) -> list:
 
 def home_hints(value) -> dict:
     """{invariant's name: its canonical form} of a right answer that may be a Jacobian (6 rows, 2 columns or
-    more): what the spec keeps, hashed, so that the self-check can tell, as the grader does, the right angular
-    rows with the wrong linear ones, or the right Jacobian in another frame's axes
-    (:data:`~.mistakes.FRAME_MISTAKES`); {} for any other answer.
+    more) or is a symmetric square matrix: what the spec keeps, hashed, so that the self-check can tell, as the
+    grader does, the right angular rows with the wrong linear ones, the right Jacobian in another frame's axes, or
+    J Jᵀ for Jᵀ J (:func:`~.mistakes.invariants_for`); {} for any other answer.
 
-    >>> sorted(home_hints(sp.ones(6, 2))), home_hints(sp.ones(3, 3))
-    (['frame', 'linear-rows'], {})
+    >>> sorted(home_hints(sp.ones(6, 2))), sorted(home_hints(sp.ones(3, 3))), home_hints(sp.Matrix([[1, 2], [0, 1]]))
+    (['frame', 'linear-rows'], ['product-order'], {})
     """
     try:
         v = _home_value(value)
     except fp.WrongForm:
         return {}
-    if not isinstance(v, sp.MatrixBase) or not mistakes.jacobian_like(v.shape):
+    if not isinstance(v, sp.MatrixBase) or not mistakes.invariants_for(v.shape):
         return {}
     arr = fp.sampled(v)
-    return {inv.name: _hint(inv, arr) for inv in mistakes.FRAME_MISTAKES}
+    hints = {inv.name: inv.of(arr) for inv in mistakes.invariants_for(v.shape)}
+    return {n: fp.canon_sampled(x, False)[2] for n, x in hints.items() if np.isfinite(x).all()}
 
 
 def stub_words(value) -> str:

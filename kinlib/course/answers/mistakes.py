@@ -49,6 +49,8 @@ __all__ = [
     "CONCEPT_MISTAKES",
     "SYMBOLIC_MISTAKES",
     "FRAME_MISTAKES",
+    "SQUARE_MISTAKES",
+    "invariants_for",
     "Invariant",
     "jacobian_like",
     "is_force_name",
@@ -511,6 +513,16 @@ def _frame_gram(A):
     return np.einsum("pij,pik->pjk", B, B)
 
 
+def _spectrum(A):
+    """The eigenvalues of each symmetric A[k], ascending ((points, n, 1)); NaN where A[k] is not symmetric."""
+    A = np.asarray(A, dtype=complex)
+    out = np.full(A.shape[:2] + (1,), np.nan)
+    for k, X in enumerate(A):
+        if np.allclose(X, X.T, rtol=1e-9, atol=1e-12) and np.all(np.abs(X.imag) < 1e-12):
+            out[k, :, 0] = np.linalg.eigvalsh(X.real)
+    return out
+
+
 def jacobian_like(shape) -> bool:
     """Whether an answer of this shape may be a Jacobian (or screw list) of twists: 6 rows, 2 columns or more.
 
@@ -535,6 +547,29 @@ FRAME_MISTAKES = (
         _angular_rows,
     ),
 )
+SQUARE_MISTAKES = (  # a symmetric square answer (J Jᵀ, Jᵀ J of a square J: the same shape either way)
+    Invariant(
+        "product-order",
+        "has the right eigenvalues but is not the matrix asked: J Jᵀ and Jᵀ J share their eigenvalues: "
+        "the product in the other order?",
+        _spectrum,
+    ),
+)
+
+
+def invariants_for(shape) -> tuple:
+    """The invariants (:class:`Invariant`) that name a mistake in an answer of this shape (rows, columns): which
+    Jacobian for 6 rows, the product's order for a square matrix.
+
+    >>> [i.name for i in invariants_for((6, 3))], [i.name for i in invariants_for((2, 2))], invariants_for((1, 1))
+    (['frame', 'linear-rows'], ['product-order'], ())
+    """
+    if jacobian_like(shape):
+        return FRAME_MISTAKES
+    if len(shape) == 2 and shape[0] == shape[1] >= 2:
+        return SQUARE_MISTAKES
+    return ()
+
 
 ROUNDED_RTOL = 5e-3  # decimals this close to the answer (3 significant digits) are "right up to rounding"
 PRODUCT_ORDER = "J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?"
