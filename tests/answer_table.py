@@ -78,7 +78,9 @@ def rows() -> list[Row]:
             [(Js3.subs(L, 1), "does not depend on L"), (Js3.T, "transposed"), (Jb3, "")],
         ),
         Row("2.3", "Jb", "expr", Jb3, [], [(Js3, ""), (-Jb3, "wrong sign")]),
-        Row("2.4", "J", "expr", Jg3, [], [(Js3, ""), (Jb3, "")]),
+        Row(  # J_s or J_b for the geometric J: the same angular rows; the same columns in rotated axes
+            "2.4", "J", "expr", Jg3, [], [(Js3, "right angular rows"), (Jb3, "rotation of the axes")]
+        ),
         Row(
             "5.1",
             "detJ",
@@ -149,7 +151,14 @@ def rows() -> list[Row]:
         Row("6.1", "rank_J", "expr", sp.Integer(4), [4], [(3, "generic rank")]),
         Row("6.1", "singular_set", "set", sp.EmptySet, [[], set()], [({th3: sp.FiniteSet(-L2)}, "")]),
         Row("6.2", "JtJ_62", "expr", JtJ, [], [(sp.simplify(Jg4 * Jg4.T), "other order")]),
-        Row("7.1", "A_v", "expr", A_v, [sp.expand(A_v)], [(A_v.xreplace({L1: L2, L2: L1}), "L1 and L2 swapped")]),
+        Row(
+            "7.1",
+            "A_v",
+            "expr",
+            A_v,
+            [sp.expand(A_v)],
+            [(A_v.xreplace({L1: L2, L2: L1}), "L1 and L2 swapped"), (J2.T * J2, "other order")],  # J square: Jᵀ J
+        ),
         Row("7.1", "length_ratio", "expr", L1 / L2, [L1 * L2**-1], [(L2 / L1, "upside down")]),
         Row("7.2", "removes_all", "choice", False, [0, sp.false], [(True, ""), (1, "")]),
         Row(
@@ -160,7 +169,14 @@ def rows() -> list[Row]:
             [{th2: [0, pi, 2 * pi]}],
             [(sp.EmptySet, ""), ({th3: sp.FiniteSet(0, pi)}, "another joint")],
         ),
-        Row("7.4", "tau", "expr", tau, [sp.expand(tau)], [(-tau, "wrong sign")]),
+        Row(
+            "7.4",
+            "tau",
+            "expr",
+            tau,
+            [sp.expand(tau)],
+            [(-tau, "wrong sign"), (J2 * sp.Matrix([Fx, Fy]), "τ = Jᵀ F")],  # τ = J F for Jᵀ F (J is square here)
+        ),
         Row("7.4", "force_semi_axes", "expr", semi.applyfunc(lambda s: 1 / s), [], [(semi, "upside down")]),
         Row("4.1", "joint_a", "choice", (1, 3), [[3, 1], sp.Matrix([1, 3])], [((1,), ""), ((0, 2), "numbered from 1")]),
     ]

@@ -290,3 +290,24 @@ def test_the_selfcheck_and_the_grader_agree_on_the_table(row, value, right, word
     assert (status == "correct") == right, home
     if words:
         assert words in home and words in graded, (home, graded)
+
+
+def test_every_named_mistake_has_a_case_in_the_table():
+    """Each conceptual mistake the course is about (issue 31, item 5) has a wrong answer in the shared table whose
+    expected words are that mistake's: the table test above then proves that the self-check and the grader both
+    say them (and test_grade_verdicts that no message states a graded value)."""
+    from answer_table import rows
+    from kinlib.course.answers import mistakes
+
+    said = [words for row in rows() for _, words in row.wrong if words]
+    named = {m.name: m.says for m in (*mistakes.CONCEPT_MISTAKES, *mistakes.SYMBOLIC_MISTAKES)}
+    named |= {i.name: i.says for i in (*mistakes.FRAME_MISTAKES, *mistakes.SQUARE_MISTAKES)}
+    named |= {
+        "rank": mistakes.concept_says("rank", True, True),
+        "constant": "is a constant",  # the constant's words (symbol notes, or concept_says for a constant answer)
+        "rounded": mistakes.ROUNDED.says,
+        "variable": mistakes.SET_VARIABLE.says,
+        "product-order-shape": mistakes.PRODUCT_ORDER,
+    }
+    missing = {name: says for name, says in named.items() if not any(w in says for w in said)}
+    assert not missing, f"mistakes with no case in tests/answer_table.py: {missing}"

@@ -32,11 +32,44 @@ __all__ = [
     "symbol_notes",
     "fmt_shape",
     "NOT_ANSWERED",
+    "ANGLE_PREFIXES",
+    "DOMAINS",
+    "is_angle_name",
+    "symbol_domain",
     "RTOL",
     "ATOL",
 ]
 
 RTOL, ATOL = 1e-6, 1e-8
+
+# Where the symbols of an answer are evaluated: the one rule for the grader's secret points
+# (kinlib.course.grader.grade.make_points) and the self-check's public ones (kinlib.course.workbook.selfcheck),
+# so that a wrong answer cannot be right at home and wrong in the grade (|sin θ| for sin θ, a signed
+# manipulability): joint angles over a whole turn, across every sign change; lengths (positive symbols) in
+# (0.5, 2); other signed quantities (forces, velocities) on both sides of 0.
+ANGLE_PREFIXES = ("theta", "q", "phi", "alpha", "beta", "gamma")
+DOMAINS = {"angle": (-math.pi, math.pi), "positive": (0.5, 2.0), "signed": (-1.5, 1.5)}
+
+
+def is_angle_name(name: str) -> bool:
+    """Whether a symbol of this name is a joint angle (evaluated over a whole turn).
+
+    >>> is_angle_name("theta2"), is_angle_name("thetadot1"), is_angle_name("L1")
+    (True, True, False)
+    """
+    return str(name).startswith(ANGLE_PREFIXES)
+
+
+def symbol_domain(name: str, positive: bool) -> tuple[str, tuple[float, float]]:
+    """The domain a symbol is evaluated over by both judges: ``("positive", (0.5, 2))`` for a symbol the reference
+    declares positive (a length), ``("angle", (-π, π))`` for a joint angle's name, else ``("signed", (-1.5, 1.5))``.
+
+    >>> symbol_domain("L", True)[0], symbol_domain("theta1", False)[0], symbol_domain("F_x", False)
+    ('positive', 'angle', ('signed', (-1.5, 1.5)))
+    """
+    key = "positive" if positive else "angle" if is_angle_name(name) else "signed"
+    return key, DOMAINS[key]
+
 
 NOT_ANSWERED = {
     "missing": "is not defined after your notebook ran (never assigned, deleted, or its cell failed)",

@@ -17,9 +17,20 @@ import math
 import numpy as np
 import sympy as sp
 
+from . import fingerprints as fp
+from . import mistakes
 from .base import is_bool, not_answered, type_name
 
-__all__ = ["choice_value", "choice_key", "describe_choice", "compare_choice", "reference_choice"]
+__all__ = [
+    "choice_value",
+    "choice_key",
+    "describe_choice",
+    "compare_choice",
+    "reference_choice",
+    "home_canon",
+    "home_verdict",
+    "stub_words",
+]
 
 
 def choice_value(value):
@@ -152,3 +163,60 @@ def reference_choice(value):
     (1, 3)
     """
     return value
+
+
+# ----------------------------------------------------------------------------------------- the self-check
+# The workbook's side of the kind (kinlib.course.workbook.selfcheck): choice_key hashed (home_canon), and the
+# verdict against the spec (home_verdict), reading 0 / 1 for a yes/no answer and naming mistakes.CHOICE_MISTAKES.
+
+HOME_DIFFERS = "that is not the right choice"
+
+
+def _home_key(x):
+    try:
+        return choice_key(x)
+    except TypeError as e:
+        raise fp.WrongForm(str(e)) from None
+
+
+def home_canon(value) -> tuple:
+    """``("choice", "", choice_key)`` of a ``choice`` answer (:func:`choice_key`: the grader's definition too).
+
+    >>> home_canon((3, 1))
+    ('choice', '', ['i:1', 'i:3'])
+    """
+    return "choice", "", _home_key(choice_value(value))
+
+
+def home_verdict(value, judge: fp.Judge) -> tuple[str, str]:
+    """The self-check's ``(status, message)`` on a ``choice`` answer against the spec in ``judge``.
+
+    >>> j = fp.Judge("choice", "", fp.digest("choice", home_canon((1, 3))[2]))
+    >>> home_verdict([3, 1], j), home_verdict((0, 2), j)[1]
+    (('correct', 'correct'), 'not right yet: that counts joints from 0: joints are numbered from 1 (the first joint is 1)')
+    """
+    right = judge.right
+    _, _, canon = home_canon(value)
+    if right(canon):
+        return "correct", "correct"
+    cv = choice_value(value)
+    if isinstance(cv, int) and not isinstance(cv, bool) and cv in (0, 1) and right(_home_key(bool(cv))):
+        return "correct", "correct"  # 0 / 1 for a yes/no answer: False / True (as the grader reads it)
+    for m in mistakes.CHOICE_MISTAKES:
+        try:
+            if right(_home_key(next(m.candidates(cv))[1])):
+                return "incorrect", f"not right yet: that {m.message()}"
+        except fp.WrongForm:
+            continue
+    return "incorrect", f"not right yet: {HOME_DIFFERS}"
+
+
+def stub_words(value) -> str:
+    """What a ``choice`` answer is, for the workbook's stub.
+
+    >>> stub_words(3), stub_words(False), stub_words("joint two")
+    ('a joint number or a tuple of joint numbers (1-based)', 'True or False', 'a string')
+    """
+    if is_bool(value):  # a True/False answer is no joint number
+        return "True or False"
+    return "a joint number or a tuple of joint numbers (1-based)" if not isinstance(value, str) else "a string"

@@ -23,6 +23,7 @@ import re
 import numpy as np
 import sympy as sp
 
+from . import fingerprints as fp
 from . import mistakes
 from .base import (
     as_sympy,
@@ -39,7 +40,18 @@ from .base import (
 )
 from .srepr import parse_srepr
 
-__all__ = ["to_sympy", "describe_expr", "compare_expr", "reference_expr", "exact_equal"]
+__all__ = [
+    "to_sympy",
+    "describe_expr",
+    "compare_expr",
+    "reference_expr",
+    "exact_equal",
+    "as_sympy_value",
+    "home_canon",
+    "home_verdict",
+    "home_hints",
+    "stub_words",
+]
 
 
 def _is_vector(x) -> bool:
@@ -386,6 +398,9 @@ def _diagnose(S, R, shape, stu, name="", ref=None) -> str:
                     return m.says
             except (ValueError, TypeError, IndexError):
                 pass
+    for inv in mistakes.invariants_for((r, c)):  # which Jacobian; the product's order
+        if close(inv.of(S3), inv.of(R3)):
+            return inv.says
     said = mistakes.concept_says(name, constant=not stu.get("symbols"), ref_constant=not (ref or {}).get("symbols"))
     if said:
         return said
@@ -466,3 +481,226 @@ def exact_equal(value, ref, budget=5.0):
             continue
         return "not proved"
     return "equal"
+
+
+# ----------------------------------------------------------------------------------------- the self-check
+# The workbook's side of the kind (kinlib.course.workbook.selfcheck): the answer's canonical form at the public
+# sample points (home_canon), hashed into the workbook's spec, and the verdict on a student's answer against it
+# (home_verdict), naming the same mistakes in the same words as compare_expr.
+
+_FORM_WORDS = {
+    "array": "an array with more than 2 dimensions",
+    "empty": "an empty list",
+    "ragged": "a list of vectors of different lengths",
+}
+
+
+def as_sympy_value(value, vectors: bool = False):
+    """The answer as a SymPy Matrix or expression (:func:`to_sympy`), or :class:`~.fingerprints.WrongForm`.
+
+    >>> as_sympy_value([1, 2]).shape
+    (2, 1)
+    >>> as_sympy_value("J")
+    Traceback (most recent call last):
+    ...
+    kinlib.course.answers.fingerprints.WrongForm: it should be a SymPy Matrix, expression or number, yours is a str
+    """
+    tag, v = to_sympy(value, vectors=vectors)
+    if v is not None:
+        return v
+    what = _FORM_WORDS.get(tag, f"a {type(value).__name__}")
+    raise fp.WrongForm(f"it should be a SymPy Matrix, expression or number, yours is {what}")
+
+
+def _shape_of(v) -> str:
+    return f"{v.shape[0]}x{v.shape[1]}" if isinstance(v, sp.MatrixBase) else ""
+
+
+def _home_value(value, shape: str | None = None):
+    """The answer as a SymPy Matrix or expression with the expected ``shape`` ("rxc", "" for a scalar,
+    "dict"; None: any), or, for a yes/no or dict answer, its finished canonical form (a tuple)."""
+    if is_bool(value):  # a yes/no answer
+        return "bool", "", [str(bool(value))]
+    if isinstance(value, dict) or shape == "dict":  # e.g. {configuration name: row of J}
+        if not isinstance(value, dict):
+            raise fp.WrongForm(f"it should be a dict, yours is a {type(value).__name__}")
+        items = sorted(value.items(), key=lambda kv: str(kv[0]))
+        return "matrix", "dict", [[str(k), list(home_canon(v)[1:])] for k, v in items]
+    v = as_sympy_value(value)
+    if isinstance(v, sp.MatrixBase):
+        mine = _shape_of(v)
+        if shape == "" and v.shape == (1, 1):  # a 1x1 Matrix for a scalar answer
+            v, mine = v[0, 0], ""
+        elif shape not in (None, mine):
+            raise fp.WrongForm(f"it should be {fp.shape_words(shape)}, yours is {fp.shape_words(mine)}")
+    elif shape:
+        raise fp.WrongForm(f"it should be {fp.shape_words(shape)}, yours is {fp.shape_words('')}")
+    if not isinstance(v, (sp.MatrixBase, sp.Expr)):
+        raise fp.WrongForm(f"it should be a SymPy Matrix, expression or number, yours is {type(v).__name__}")
+    return v
+
+
+def home_canon(value, shape: str | None = None) -> tuple:
+    """``(form, shape, canonical values)`` of an ``expr`` answer at the public sample points: form ``matrix``,
+    ``scalar`` or ``bool`` (a dict of answers: shape ``dict``).
+
+    >>> home_canon(sp.Matrix([[1, 2]]))[:2], home_canon(True)
+    (('matrix', '1x2'), ('bool', '', ['True']))
+    """
+    v = _home_value(value, shape)
+    if isinstance(v, tuple):
+        return v
+    return fp.canon_sampled(fp.sampled(v), not isinstance(v, sp.MatrixBase))
+
+
+def _floats(v) -> list:
+    return sorted(v.atoms(sp.Float), key=float) if isinstance(v, (sp.Basic, sp.MatrixBase)) else []
+
+
+DECIMALS_NOTE = "it contains decimals (floats): exact values (sp.Rational, sp.sqrt, sp.pi) are safer"
+HOME_DIFFERS = "its values differ from the answer's at sample values of its symbols"
+
+
+def home_verdict(value, judge: fp.Judge) -> tuple[str, str]:
+    """The self-check's ``(status, message)`` on an ``expr`` answer against the spec in ``judge``: right, right up
+    to decimals (with a note), or the named mistake (:mod:`.mistakes`, the grader's words), never a value.
+
+    >>> j = fp.Judge("scalar", "", fp.digest("scalar", home_canon(2)[2]))
+    >>> home_verdict(2, j), home_verdict(-2, j)
+    (('correct', 'correct'), ('incorrect', 'not right yet: it has the wrong sign'))
+    """
+    form, shape, right, named = judge.form, judge.shape, judge.right, judge.named
+    try:
+        v = _home_value(value, shape)
+    except fp.WrongForm as e:
+        found = _home_mistake(value, form, shape, right)
+        if found is None:
+            mine = _shape_of(as_sympy_value(value)) if not isinstance(value, dict) and not is_bool(value) else ""
+            if "x" in mine and "x" in shape and len(set(mine.split("x"))) == 1 == len(set(shape.split("x"))):
+                raise fp.WrongForm(f"{e} ({mistakes.PRODUCT_ORDER})") from None  # n×n for m×m: JᵀJ for JJᵀ?
+            raise
+        yours = fp.shape_words(_shape_of(as_sympy_value(value)))
+        return "incorrect", f"wrong form: it {found}: yours is {yours}, it should be {fp.shape_words(shape)}"
+    if isinstance(v, tuple):  # yes/no, dict
+        mine_form, _, canon = v
+        return ("correct", "correct") if right(canon, mine_form) else ("incorrect", f"not right yet: {HOME_DIFFERS}")
+    arr = fp.sampled(v)
+    mine_form, _, canon = fp.canon_sampled(arr, not isinstance(v, sp.MatrixBase))
+    floats = _floats(v)
+    if right(canon, mine_form):
+        return ("correct", f"correct; note: {DECIMALS_NOTE}") if floats else ("correct", "correct")
+    if floats:  # rounded decimals: right once made exact? (the grader passes them within 1e-6, so do we)
+        exact, err = mistakes.exact_values(v)
+        if exact is not None and right(fp.canon_sampled(fp.sampled(exact), not isinstance(v, sp.MatrixBase))[2]):
+            if err <= mistakes.FLOAT_RTOL:
+                return "correct", f"correct; note: {DECIMALS_NOTE}"
+            return named(mistakes.ROUNDED.says)
+    notes = _home_symbol_notes(v, judge.salt, judge.symhash)
+    found = _home_mistake(v, form, shape, right, arr)
+    if found is None:  # which Jacobian; the product's order (the spec's hints)
+        invs = mistakes.invariants_for(arr.shape[1:])
+        found = next((i.says for i in invs if judge.hint_right(i.name, _hint(i, arr))), None)
+    if found is None:
+        found = mistakes.concept_says(
+            judge.salt.rpartition(":")[2], constant=not fp.symbols_of(v), ref_constant=judge.symhash is None
+        )
+    said = "; ".join(notes + ([found] if found else []))
+    if floats:
+        said = "; ".join(x for x in (said, mistakes.DECIMALS.says) if x)
+    return named(said) if said else ("incorrect", f"not right yet: {HOME_DIFFERS}")
+
+
+# names the course's answers are written in: what a missing or extra variable is searched among
+COURSE_SYMBOLS = ("L", "L1", "L2", "L3", "H", "a", "b", "c", "x", "F_x", "F_y") + tuple(
+    f"{p}{i}" for p in ("theta", "thetadot") for i in range(1, 7)
+)
+
+
+def _home_symbol_notes(v, salt, symhash) -> list:
+    """The grader's words (:func:`~.base.symbol_notes`) on a missing or extra variable, found by the symbols' hash
+    in the spec: the reference's symbols among the student's and the course's."""
+    import itertools
+
+    mine = sorted({x.name for x in fp.symbols_of(v)})
+    want = symhash if symhash is not None else fp.sym_hash([], salt)
+    if fp.sym_hash(mine, salt) == want:
+        return []
+    pool = sorted(set(COURSE_SYMBOLS) - set(mine))
+    for drop in itertools.chain([()], itertools.combinations(mine, 1), itertools.combinations(mine, 2)):
+        kept = [m for m in mine if m not in drop]
+        for k in range(0, 4):
+            for add in itertools.combinations(pool, k):
+                if fp.sym_hash(kept + list(add), salt) == want:
+                    return symbol_notes({"symbols": mine}, {"symbols": kept + list(add)})
+    if not mine:
+        return ["is a constant, but the answer depends on the problem's variables"]
+    return []
+
+
+def _home_mistake(v, form, shape, right, arr=None):
+    """The words naming the known mistake that makes ``v`` right, or None."""
+    if isinstance(v, dict) or is_bool(v) or shape == "dict" or form not in ("matrix", "scalar"):
+        return None
+    if not isinstance(v, (sp.MatrixBase, sp.Expr)):
+        v = as_sympy_value(v)
+    if isinstance(v, sp.MatrixBase) and v.shape == (1, 1) and shape == "":
+        v = v[0, 0]
+    want = tuple(int(x) for x in shape.split("x")) if shape else (1, 1)
+
+    def matches(X):
+        return X.shape[1:] == want and right(fp.canon_sampled(X, shape == "")[2])
+
+    arr = fp.sampled(v) if arr is None else arr
+    found = mistakes.search(arr, matches)
+    if found is None:
+        found = mistakes.search(arr, matches, mistakes.CONCEPT_MISTAKES, pairs=False)
+    if found is not None:
+        return found.says
+    for m in mistakes.SYMBOLIC_MISTAKES:
+        fixed = m.undo(v)
+        if fixed is not None and matches(fp.sampled(fixed)):
+            return m.says
+    return None
+
+
+def _hint(inv, arr) -> list:
+    return fp.canon_sampled(inv.of(arr), False)[2]
+
+
+def home_hints(value) -> dict:
+    """{invariant's name: its canonical form} of a right answer that may be a Jacobian (6 rows, 2 columns or
+    more) or is a symmetric square matrix: what the spec keeps, hashed, so that the self-check can tell, as the
+    grader does, the right angular rows with the wrong linear ones, the right Jacobian in another frame's axes, or
+    J Jᵀ for Jᵀ J (:func:`~.mistakes.invariants_for`); {} for any other answer.
+
+    >>> sorted(home_hints(sp.ones(6, 2))), sorted(home_hints(sp.ones(3, 3))), home_hints(sp.Matrix([[1, 2], [0, 1]]))
+    (['frame', 'linear-rows'], ['product-order'], {})
+    """
+    try:
+        v = _home_value(value)
+    except fp.WrongForm:
+        return {}
+    if not isinstance(v, sp.MatrixBase) or not mistakes.invariants_for(v.shape):
+        return {}
+    arr = fp.sampled(v)
+    hints = {inv.name: inv.of(arr) for inv in mistakes.invariants_for(v.shape)}
+    return {n: fp.canon_sampled(x, False)[2] for n, x in hints.items() if np.isfinite(x).all()}
+
+
+def stub_words(value) -> str:
+    """What an ``expr`` answer is, for the workbook's stub (never whether it is constant: that is a hint).
+
+    >>> stub_words(sp.zeros(6, 3)), stub_words(sp.Integer(3)), stub_words({"a": 1})
+    ('a 6×3 Matrix', 'a SymPy expression or a number', 'a dict {a: ...}')
+    """
+    if is_bool(value):
+        return "True or False"
+    if isinstance(value, dict):
+        return "a dict {" + ", ".join(map(str, value)) + ": ...}"
+    try:
+        v = as_sympy_value(value)
+    except fp.WrongForm:
+        return "a value"
+    if isinstance(v, sp.MatrixBase):
+        return f"a {v.shape[0]}×{v.shape[1]} Matrix"
+    return "a SymPy expression or a number"  # the same words for both: whether it is constant is a hint

@@ -22,12 +22,11 @@ The grader (:mod:`kinlib.course.grader.judge`, through :func:`kinlib.course.answ
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
 from . import choice, expr, properties, sets, subspace
-from .base import is_bool
+from .base import ANGLE_PREFIXES, is_angle_name, is_bool, symbol_domain
 
 __all__ = [
     "Kind",
@@ -35,6 +34,7 @@ __all__ = [
     "NAMES",
     "FORMS",
     "lookup",
+    "find",
     "resolve",
     "ANGLE_PREFIXES",
     "is_angle_name",
@@ -42,41 +42,14 @@ __all__ = [
     "draw_points",
 ]
 
-# Where the symbols of an answer are evaluated: the one rule for the grader's secret points
-# (kinlib.course.grader.grade.make_points) and the self-check's public ones (kinlib.course.workbook.selfcheck),
-# so that a wrong answer cannot be right at home and wrong in the grade (|sin θ| for sin θ, a signed
-# manipulability): joint angles over a whole turn, across every sign change; lengths (positive symbols) in
-# (0.5, 2); other signed quantities (forces, velocities) on both sides of 0.
-ANGLE_PREFIXES = ("theta", "q", "phi", "alpha", "beta", "gamma")
-DOMAINS = {"angle": (-math.pi, math.pi), "positive": (0.5, 2.0), "signed": (-1.5, 1.5)}
-
-
-def is_angle_name(name: str) -> bool:
-    """Whether a symbol of this name is a joint angle (evaluated over a whole turn).
-
-    >>> is_angle_name("theta2"), is_angle_name("thetadot1"), is_angle_name("L1")
-    (True, True, False)
-    """
-    return str(name).startswith(ANGLE_PREFIXES)
-
-
-def symbol_domain(name: str, positive: bool) -> tuple[str, tuple[float, float]]:
-    """The domain a symbol is evaluated over by both judges: ``("positive", (0.5, 2))`` for a symbol the reference
-    declares positive (a length), ``("angle", (-π, π))`` for a joint angle's name, else ``("signed", (-1.5, 1.5))``.
-
-    >>> symbol_domain("L", True)[0], symbol_domain("theta1", False)[0], symbol_domain("F_x", False)
-    ('positive', 'angle', ('signed', (-1.5, 1.5)))
-    """
-    key = "positive" if positive else "angle" if is_angle_name(name) else "signed"
-    return key, DOMAINS[key]
-
 
 @dataclass(frozen=True)
 class Kind:
-    """One kind of answer: what its functions are, and how many secret points it is evaluated at.
+    """One kind of answer: what its functions are, for the grader and for the workbook self-check, and how many
+    secret points it is evaluated at.
 
-    >>> KINDS["set"].points, KINDS["choice"].compare.__module__
-    (2, 'kinlib.course.answers.choice')
+    >>> KINDS["set"].points, KINDS["choice"].compare.__module__, KINDS["subspace"].forms
+    (2, 'kinlib.course.answers.choice', ('subspace',))
     """
 
     name: str  # the kind's name in the solution notebooks' metadata
@@ -85,6 +58,14 @@ class Kind:
     compare: Callable  # (student's description, reference's, name[, argument]) -> (ok, message)
     reference: Callable  # the reference value -> what the answer key keeps (srepr round-trips it)
     points: int = 5  # secret points the answer is evaluated at (0: none, the value alone)
+    # the workbook self-check (kinlib.course.workbook.selfcheck), at the public sample points:
+    home_canon: Callable | None = None  # value -> (form, shape, canonical form), hashed into the spec
+    home_verdict: Callable | None = None  # (value, fingerprints.Judge) -> (status, message)
+    stub: Callable | None = None  # value -> what the answer is, in words, for the workbook's stub
+    forms: tuple = ()  # the spec forms home_canon gives (a spec's form -> the kind that judges it)
+    symbols: bool = False  # whether the spec records the answer's symbols (a missing variable, signed symbols)
+    home_spec: Callable | None = None  # (value, argument, salt) -> spec, for a kind not judged by a hash
+    home_hints: Callable | None = None  # value -> {invariant: canonical form}: hashed into the spec (mistakes)
 
 
 def _subspace_normal(value):
@@ -92,17 +73,54 @@ def _subspace_normal(value):
 
 
 KINDS = {
-    "expr": Kind("expr", expr.to_sympy, expr.describe_expr, expr.compare_expr, expr.reference_expr),
+    "expr": Kind(
+        "expr",
+        expr.to_sympy,
+        expr.describe_expr,
+        expr.compare_expr,
+        expr.reference_expr,
+        home_canon=expr.home_canon,
+        home_verdict=expr.home_verdict,
+        home_hints=expr.home_hints,
+        stub=expr.stub_words,
+        forms=("matrix", "scalar", "bool"),
+        symbols=True,
+    ),
     "subspace": Kind(
         "subspace",
         _subspace_normal,
         subspace.describe_subspace,
         subspace.compare_subspace,
         subspace.reference_subspace,
+        home_canon=subspace.home_canon,
+        home_verdict=subspace.home_verdict,
+        stub=subspace.stub_words,
+        forms=("subspace",),
+        symbols=True,
     ),
-    "set": Kind("set", sets.set_conditions, sets.describe_set, sets.compare_set, sets.reference_set, points=2),
+    "set": Kind(
+        "set",
+        sets.set_conditions,
+        sets.describe_set,
+        sets.compare_set,
+        sets.reference_set,
+        points=2,
+        home_canon=sets.home_canon,
+        home_verdict=sets.home_verdict,
+        stub=sets.stub_words,
+        forms=("set",),
+    ),
     "choice": Kind(
-        "choice", choice.choice_value, choice.describe_choice, choice.compare_choice, choice.reference_choice, 0
+        "choice",
+        choice.choice_value,
+        choice.describe_choice,
+        choice.compare_choice,
+        choice.reference_choice,
+        0,
+        home_canon=choice.home_canon,
+        home_verdict=choice.home_verdict,
+        stub=choice.stub_words,
+        forms=("choice",),
     ),
     "property": Kind(
         "property",
@@ -110,13 +128,17 @@ KINDS = {
         properties.describe_property,
         properties.compare_property,
         properties.reference_property,
+        home_verdict=properties.home_verdict,
+        stub=properties.stub_words,
+        forms=("property",),
+        home_spec=properties.home_spec,
     ),
 }
 
 
 NAMES = ("default", *KINDS)  # the kind names a solution notebook may declare ("default" is "expr")
 # the self-check's spec forms (kinlib.course.workbook.selfcheck.fingerprint) -> the kind that judges them
-FORMS = {"matrix": "expr", "scalar": "expr", "bool": "expr", "choice": "choice", "set": "set", "subspace": "subspace"}
+FORMS = {form: name for name, k in KINDS.items() for form in k.forms}
 
 
 def draw_points(symbols: dict, seed: int, n: int) -> list[dict]:
@@ -125,6 +147,7 @@ def draw_points(symbols: dict, seed: int, n: int) -> list[dict]:
     symbol, so that a sign change half a turn wide always holds a point (|sin θ| is never right by luck). The
     grader's secret points (:func:`kinlib.course.grader.grade.make_points`); the same seed gives the same points.
 
+    >>> import math
     >>> pts = draw_points({"theta1": {}, "L": {"positive": True}}, seed=7, n=5)
     >>> sorted(int((p["theta1"] + math.pi) // (2 * math.pi / 5)) for p in pts)
     [0, 1, 2, 3, 4]
@@ -142,6 +165,20 @@ def draw_points(symbols: dict, seed: int, n: int) -> list[dict]:
         for k in range(n):
             pts[k][name] = lo + (order[k] + rng.uniform(0.02, 0.98)) * (hi - lo) / n
     return pts
+
+
+def find(kind: str) -> tuple[Kind, str]:
+    """The :class:`Kind` a solution notebook's kind name declares and its argument ("default" is ``expr``);
+    ValueError for a name not in the table (:func:`lookup` reads such a name as ``expr``).
+
+    >>> find("property:nonsingular")[0].name, find("default")[0].name
+    ('property', 'expr')
+    """
+    base, _, arg = str(kind).partition(":")
+    base = "expr" if base == "default" else base
+    if base not in KINDS or bool(arg) != (KINDS[base].home_spec is not None):
+        raise ValueError(f"kind must be one of {NAMES} (or property:<p>), got {kind!r}")
+    return KINDS[base], arg
 
 
 def lookup(kind: str) -> tuple[Kind, str]:

@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 
@@ -47,6 +48,12 @@ __all__ = [
     "CHOICE_MISTAKES",
     "CONCEPT_MISTAKES",
     "SYMBOLIC_MISTAKES",
+    "FRAME_MISTAKES",
+    "SQUARE_MISTAKES",
+    "invariants_for",
+    "Invariant",
+    "jacobian_like",
+    "is_force_name",
     "SET_VARIABLE",
     "ROUNDED",
     "DECIMALS",
@@ -419,6 +426,45 @@ def _swap_lengths(v):
     return None
 
 
+def is_force_name(name: str) -> bool:
+    """Whether a symbol of this name is a force component (F_x, Fy, f_z, F): what a statics answer maps.
+
+    >>> [is_force_name(n) for n in ("F_x", "Fy", "f_z", "F", "F1", "theta1", "L")]
+    [True, True, True, True, True, False, False]
+    """
+    return re.fullmatch(r"[Ff](_?[xyz0-9])?", str(name)) is not None
+
+
+_FORCE_MAP_NODES = 2000  # nodes of an answer beyond which τ = J F is not looked for
+
+
+def _larger_than(v, n: int) -> bool:
+    count = 0
+    for e in v:
+        for _ in sp.preorder_traversal(e):
+            count += 1
+            if count > n:
+                return True
+    return False
+
+
+def _force_map_transposed(v):
+    """``Aᵀ F`` for an answer ``A F`` linear in the force components F with a square A (τ = J F for Jᵀ F), else
+    None."""
+    if not isinstance(v, sp.MatrixBase) or v.shape[1] != 1:
+        return None
+    forces = sorted(
+        (s for s in v.free_symbols if isinstance(s, sp.Symbol) and is_force_name(s.name)), key=lambda s: s.name
+    )
+    if len(forces) != v.shape[0] or len(forces) < 2 or _larger_than(v, _FORCE_MAP_NODES):
+        return None  # (a large answer is not expanded: this runs on the grader's side too)
+    F = sp.Matrix(forces)
+    A = v.jacobian(F)
+    if A.free_symbols & set(forces) or sp.expand(v - A * F) != sp.zeros(*v.shape):
+        return None  # not linear in the forces (or a constant term)
+    return A.T * F
+
+
 SYMBOLIC_MISTAKES = (
     SymbolicMistake(
         "degrees",
@@ -426,7 +472,104 @@ SYMBOLIC_MISTAKES = (
         trig_degrees,
     ),
     SymbolicMistake("lengths", "has L1 and L2 swapped: which link is L1?", _swap_lengths),
+    SymbolicMistake(
+        "force-map",
+        "maps the force with the matrix itself where its transpose belongs: joint torques from a tip force are "
+        "τ = Jᵀ F (the transpose of J), not J F",
+        _force_map_transposed,
+    ),
 )
+
+
+# ----------------------------------------------------------------------------- which Jacobian (6-row matrices)
+# Not undone but recognised: an answer whose invariant equals the reference's. The grader compares the invariant
+# of the student's values with the reference's; the self-check compares hashes (the spec carries the reference's,
+# kinlib.course.answers.expr.home_hints).
+
+
+@dataclass(frozen=True)
+class Invariant:
+    """A property the right answer shares with a typical wrong one: ``of(A)`` for values ``A`` (points, rows,
+    columns); equal invariants and unequal answers name the mistake.
+
+    >>> J = np.arange(12.0).reshape(1, 6, 2)
+    >>> [i.name for i in FRAME_MISTAKES if np.allclose(i.of(J), i.of(J * [[1], [1], [1], [0], [0], [0]]))]
+    ['linear-rows']
+    """
+
+    name: str
+    says: str
+    of: Callable
+
+
+def _angular_rows(A):
+    return np.asarray(A, dtype=complex)[:, :3, :]
+
+
+def _frame_gram(A):
+    """The Gram matrix of the columns' angular and linear parts side by side: the same for J and R J per block."""
+    A = np.asarray(A, dtype=complex)
+    B = np.concatenate([A[:, :3, :], A[:, 3:, :]], axis=2)
+    return np.einsum("pij,pik->pjk", B, B)
+
+
+def _spectrum(A):
+    """The eigenvalues of each symmetric A[k], ascending ((points, n, 1)); NaN where A[k] is not symmetric."""
+    A = np.asarray(A, dtype=complex)
+    out = np.full(A.shape[:2] + (1,), np.nan)
+    for k, X in enumerate(A):
+        if np.allclose(X, X.T, rtol=1e-9, atol=1e-12) and np.all(np.abs(X.imag) < 1e-12):
+            out[k, :, 0] = np.linalg.eigvalsh(X.real)
+    return out
+
+
+def jacobian_like(shape) -> bool:
+    """Whether an answer of this shape may be a Jacobian (or screw list) of twists: 6 rows, 2 columns or more.
+
+    >>> jacobian_like((6, 3)), jacobian_like((6, 1)), jacobian_like((3, 3))
+    (True, False, False)
+    """
+    return len(shape) == 2 and shape[0] == 6 and shape[1] >= 2
+
+
+FRAME_MISTAKES = (
+    Invariant(
+        "frame",
+        "is right up to a rotation of the axes its columns are written in: the geometric J = blockdiag(R, R) J_b is "
+        "in the space frame's axes, the body Jacobian J_b in the end-effector frame's: which one is asked?",
+        _frame_gram,
+    ),
+    Invariant(
+        "linear-rows",
+        "has the right angular rows (1–3) but not the linear rows (4–6): the Jacobians differ in their linear part "
+        "(J_s: v_s, the velocity of the body point at the space origin; the geometric J: ṗ, the velocity of the "
+        "end-effector's origin; J_b: v_b, in the end-effector frame): which one is asked?",
+        _angular_rows,
+    ),
+)
+SQUARE_MISTAKES = (  # a symmetric square answer (J Jᵀ, Jᵀ J of a square J: the same shape either way)
+    Invariant(
+        "product-order",
+        "has the right eigenvalues but is not the matrix asked: J Jᵀ and Jᵀ J share their eigenvalues: "
+        "the product in the other order?",
+        _spectrum,
+    ),
+)
+
+
+def invariants_for(shape) -> tuple:
+    """The invariants (:class:`Invariant`) that name a mistake in an answer of this shape (rows, columns): which
+    Jacobian for 6 rows, the product's order for a square matrix.
+
+    >>> [i.name for i in invariants_for((6, 3))], [i.name for i in invariants_for((2, 2))], invariants_for((1, 1))
+    (['frame', 'linear-rows'], ['product-order'], ())
+    """
+    if jacobian_like(shape):
+        return FRAME_MISTAKES
+    if len(shape) == 2 and shape[0] == shape[1] >= 2:
+        return SQUARE_MISTAKES
+    return ()
+
 
 ROUNDED_RTOL = 5e-3  # decimals this close to the answer (3 significant digits) are "right up to rounding"
 PRODUCT_ORDER = "J Jᵀ is task × task, Jᵀ J joints × joints: the product in the other order?"

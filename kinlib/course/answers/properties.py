@@ -50,6 +50,9 @@ __all__ = [
     "judge_value",
     "property_spec",
     "property_verdict",
+    "home_spec",
+    "home_verdict",
+    "stub_words",
 ]
 
 MAX_TERMS_ESTIMATE = 50_000  # a bound on the terms of det(J Jᵀ) expanded (see _terms_estimate)
@@ -352,3 +355,39 @@ def reference_property(value):
         return screws
     obj = to_sympy(value)[1]
     return obj if obj is not None else sp.Integer(0)
+
+
+# ----------------------------------------------------------------------------------------- the self-check
+# The workbook's side of the kind (kinlib.course.workbook.selfcheck): the spec names the property only
+# (property_spec), and the student's own design is judged by it, as the grader judges it (property_verdict).
+
+
+def home_spec(value, prop: str, salt: str = "") -> str:
+    """The self-check spec of a ``property:<prop>`` answer (:func:`property_spec`; ``salt`` unused: it holds no
+    value to salt).
+
+    >>> from kinlib.robots import planar_rpp
+    >>> home_spec(planar_rpp(), "nonsingular")
+    'property|nonsingular|-'
+    """
+    return property_spec(value, prop)
+
+
+def home_verdict(value, judge) -> tuple[str, str]:
+    """The self-check's ``(status, message)``: :func:`property_verdict` of the property the spec names (``judge``:
+    a :class:`kinlib.course.answers.fingerprints.Judge`, its shape the property).
+
+    >>> from kinlib.course.answers.fingerprints import Judge
+    >>> home_verdict(2, Judge("property", "nonsingular", "-"))[0]
+    'incorrect'
+    """
+    return property_verdict(judge.shape, value)
+
+
+def stub_words(value) -> str:
+    """What a property answer is, for the workbook's stub.
+
+    >>> stub_words(None)
+    'your robot itself (a kinlib SerialChain: its screw axes and M)'
+    """
+    return "your robot itself (a kinlib SerialChain: its screw axes and M)"

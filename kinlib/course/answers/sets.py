@@ -17,6 +17,7 @@
 from __future__ import annotations
 
 import bisect
+import json
 import math
 import numbers
 from fractions import Fraction
@@ -24,8 +25,9 @@ from fractions import Fraction
 import numpy as np
 import sympy as sp
 
+from . import fingerprints as fp
 from .base import as_sympy, is_bool, not_answered, subs_for, to_complex, type_name
-from .mistakes import SET_VARIABLE
+from .mistakes import SET_MISTAKES, SET_VARIABLE
 
 __all__ = [
     "to_set",
@@ -36,6 +38,10 @@ __all__ = [
     "reference_set",
     "var_name",
     "MAX_SET_MEMBERS",
+    "JOINT_NAMES",
+    "home_canon",
+    "home_verdict",
+    "stub_words",
 ]
 
 MAX_SET_MEMBERS = 5000  # members of one set listed per point (more: the answer is too large to grade)
@@ -554,3 +560,151 @@ def _compare_component(s, r, periodic):
     if missing:
         return False, f"some values of the set are missing{where}"
     return False, "not the right set"
+
+
+# ----------------------------------------------------------------------------------------- the self-check
+# The workbook's side of the kind (kinlib.course.workbook.selfcheck): a set's points in [-2π, 2π] modulo 2π at
+# the public sample points (home_canon), and the verdict against the spec (home_verdict), naming the mistakes of
+# mistakes.SET_MISTAKES and the wrong variable as the grader does.
+
+
+def _angle_point(p, k):
+    """A point of a set, modulo 2π, as a stable string (tuples component-wise)."""
+    if isinstance(p, (sp.Tuple, tuple)):
+        return "(" + ",".join(_angle_point(q, k) for q in p) + ")"
+    p = sp.sympify(p)  # a member of a SymPy set, in the student's own kernel
+    pt = fp.sample_point(p, k)
+    if pt:
+        p = p.subs(pt)
+    if p.is_number and p.is_real is not False:
+        p = sp.Mod(p, 2 * sp.pi)
+        s = fp.fmt(p.evalf(30))
+        return "0" if s == fp.fmt(2 * math.pi) else s
+    return fp.fmt(p.evalf(30))
+
+
+def _canon_one_set(s, k, fmap=None):
+    try:
+        s = to_set(s)
+    except TypeError as e:
+        raise fp.WrongForm(str(e).replace("a set should be", "it should be")) from None
+    if fmap is not None:  # a mistake undone (mistakes.SET_MISTAKES)
+        s = fmap(s)
+    pt = fp.sample_point(s, k)
+    if pt:
+        s = s.subs(pt)
+    if not isinstance(s, sp.FiniteSet):
+        window = sp.Interval(-2 * sp.pi, 2 * sp.pi)
+        s = sp.Intersection(s, window)
+        if isinstance(s, sp.Intersection) or isinstance(s, sp.ConditionSet):
+            raise fp.CannotCheck("SymPy cannot list this set's points in [-2π, 2π]")
+    parts = s.args if isinstance(s, sp.Union) else (s,)
+    out = set()
+    for part in parts:
+        if isinstance(part, sp.FiniteSet):
+            out.update(_angle_point(p, k) for p in part)
+        elif isinstance(part, sp.Interval):
+            out.add(
+                f"I{'(' if part.left_open else '['}{fp.fmt(part.start.evalf(30))},"
+                f"{fp.fmt(part.end.evalf(30))}{')' if part.right_open else ']'}"
+            )
+        elif part is sp.S.EmptySet:
+            pass
+        else:
+            raise fp.CannotCheck(f"SymPy cannot list the points of {type(part).__name__} in [-2π, 2π]")
+    return sorted(out)
+
+
+def _canon_condition(cond: list, fmap=None, keys: dict | None = None) -> list:
+    """A condition {variable: Set} canonical per sample point; keys by their untypeset name (θ_2 is theta2, as
+    the grader reads them, :func:`var_name`), ``keys`` renaming some."""
+    keys = keys or {}
+    return [
+        [keys.get(var_name(key), var_name(key))] + [_canon_one_set(s, k, fmap) for k in range(fp.SAMPLE_POINTS)]
+        for key, s in sorted(cond, key=lambda kv: keys.get(var_name(kv[0]), var_name(kv[0])))
+    ]
+
+
+_EMPTY = [[] for _ in range(fp.SAMPLE_POINTS)]
+
+
+def home_canon(value, fmap=None, keys=None) -> tuple:
+    """``("set", shape, canonical points)`` of a ``set`` answer at the public sample points: a dict {symbol: Set}
+    is shape "dict", a list of several such dicts (a union) "union", the rest ""; a set with no member (an empty
+    Set, ``[]``, a condition that no value meets) is the empty bare set, whatever its form: an empty answer is
+    judged by being empty, never told "it should be a dict".
+
+    >>> home_canon({sp.Symbol("theta2"): {0}})[:2], home_canon([])
+    (('set', 'dict'), ('set', '', [[], [], [], [], []]))
+    """
+    conds = set_conditions(value)
+    if conds is None:
+        raise fp.WrongForm(f"it should be a SymPy Set (or a dict {{symbol: Set}}), yours is a {type(value).__name__}")
+    if len(conds) == 1 and conds[0] and conds[0][0][0] is None:
+        return "set", "", [_canon_one_set(conds[0][0][1], k, fmap) for k in range(fp.SAMPLE_POINTS)]
+    canon = [_canon_condition(c, fmap, keys) for c in conds]
+    live = [c for c in canon if not any(all(not pts for pts in entry[1:]) for entry in c)]
+    if not live:
+        return "set", "", _EMPTY
+    if len(conds) == 1:
+        return "set", "dict", canon[0]
+    return "set", "union", sorted(canon, key=json.dumps)
+
+
+# the joint variables a one-variable condition may be re-keyed to (a bare set for a dict, the right set on the
+# wrong variable): the names the course uses
+JOINT_NAMES = tuple(f"{p}{i}" for p in ("theta", "q") for i in range(1, 8))
+HOME_DIFFERS = "it holds different points"
+
+
+def home_verdict(value, judge: fp.Judge) -> tuple[str, str]:
+    """The self-check's ``(status, message)`` on a ``set`` answer against the spec in ``judge``: a bare set for a
+    one-variable dict and back are read as the grader reads them; the right set on another joint variable, and
+    degrees, are named (:data:`~.mistakes.SET_VARIABLE`, :data:`~.mistakes.SET_MISTAKES`).
+
+    >>> t2 = sp.Symbol("theta2")
+    >>> j = fp.Judge("set", "dict", fp.digest("set", home_canon({t2: {0}})[2]))
+    >>> home_verdict({t2: {0}}, j)[0], home_verdict({sp.Symbol("theta1"): {0}}, j)[1][:40]
+    ('correct', 'not right yet: it holds the right values')
+    """
+    shape, right, named = judge.shape, judge.right, judge.named
+    _, mine_shape, canon = home_canon(value)
+    if right(canon):
+        return "correct", "correct"
+    conds = set_conditions(value)
+    one_var = conds is not None and len(conds) == 1 and len(conds[0]) == 1
+    if mine_shape == "dict" and shape == "" and one_var:  # {θ2: S} for a bare S: the grader reads it as S
+        if right([_canon_one_set(conds[0][0][1], k) for k in range(fp.SAMPLE_POINTS)]):
+            return "correct", "correct"
+    if mine_shape == "" and shape == "dict" and canon is not _EMPTY:  # a bare S for {θk: S}: the grader too
+        bare = [[(sp.Symbol(v), conds[0][0][1])] for v in JOINT_NAMES]
+        if any(right(_canon_condition(c)) for c in bare):
+            return "correct", "correct"
+    if mine_shape == "dict" and one_var:  # the right set on the wrong variable (mistakes.SET_VARIABLE)
+        mine = var_name(conds[0][0][0])
+        for v in JOINT_NAMES:
+            if v != mine and right(_canon_condition(conds[0], keys={mine: v})):
+                return named(SET_VARIABLE.says)
+    if canon is not _EMPTY and mine_shape != shape and (mine_shape, shape) not in (("dict", ""), ("", "dict")):
+        want = {"dict": "a dict {symbol: Set}", "union": "a list of dicts {symbol: Set}"}.get(shape, "a single Set")
+        raise fp.WrongForm(f"it should be {want}")
+    for m in SET_MISTAKES:
+        try:
+            if right(home_canon(value, lambda s, m=m: next(m.candidates(s))[1])[2]):
+                return named(m.message())
+        except Exception:  # noqa: BLE001  SymPy may not map this set: not that mistake
+            continue
+    return "incorrect", f"not right yet: {HOME_DIFFERS}"
+
+
+def stub_words(value) -> str:
+    """What a ``set`` answer is, for the workbook's stub.
+
+    >>> stub_words({sp.Symbol("t"): {0}}), stub_words(sp.EmptySet)
+    ('a dict {symbol: SymPy Set}', 'a SymPy Set')
+    """
+    if isinstance(value, dict):
+        return "a dict {symbol: SymPy Set}"
+    if isinstance(value, (list, tuple)) and all(isinstance(v, dict) for v in value):
+        return "a list of dicts {symbol: SymPy Set}, one per condition ([] for none)"
+    return "a SymPy Set"

@@ -14,12 +14,24 @@
 from __future__ import annotations
 
 import numpy as np
+import sympy as sp
 
+from . import fingerprints as fp
+from . import mistakes
 from .base import not_answered, symbol_notes, type_name, values_array
 from .exacttree import exact_ranks, expr_tree
-from .expr import describe_expr, to_sympy
+from .expr import as_sympy_value, describe_expr, to_sympy
 
-__all__ = ["describe_subspace", "compare_subspace", "reference_subspace", "exact_tree", "SUBSPACE_TOL"]
+__all__ = [
+    "describe_subspace",
+    "compare_subspace",
+    "reference_subspace",
+    "exact_tree",
+    "SUBSPACE_TOL",
+    "home_canon",
+    "home_verdict",
+    "stub_words",
+]
 
 SUBSPACE_TOL = 1e-7  # rank cut-off on singular values of unit columns; largest principal angle (sine)
 
@@ -173,3 +185,106 @@ def compare_subspace(stu: dict, ref: dict, name: str) -> tuple[bool, str]:
     if exact is not None:
         return exact
     return _compare_numeric(S, R, name, sshape, rshape, symbol_notes(stu, ref))
+
+
+# ----------------------------------------------------------------------------------------- the self-check
+# The workbook's side of the kind (kinlib.course.workbook.selfcheck): the orthogonal projector onto the span at
+# the public sample points (home_canon), and the verdict against the spec (home_verdict), naming the mistakes of
+# mistakes.SUBSPACE_MISTAKES as the grader does.
+
+_PROJ_DECIMALS = 6  # decimals kept of a subspace's projector
+HOME_DIFFERS = "it spans a different subspace"
+
+
+def _home_value(value, shape=None):
+    v = as_sympy_value(value, vectors=True)  # a list of spanning vectors: side by side
+    if not isinstance(v, sp.MatrixBase):
+        raise fp.WrongForm("it should be a Matrix whose columns span the subspace")
+    m = str(v.shape[0])
+    if shape not in (None, m):
+        raise fp.WrongForm(f"its columns should be {shape}-vectors, yours are {m}-vectors")
+    return v
+
+
+def _home_sampled(v) -> np.ndarray:
+    """The spanning vectors at the sample points, as floats (points, m, vectors)."""
+    out = []
+    for k in range(fp.SAMPLE_POINTS):
+        try:
+            A = np.array(fp.evaluate(v, k).tolist(), dtype=complex).reshape(v.shape)
+        except TypeError as e:
+            raise fp.CannotCheck(f"it does not evaluate to numbers ({e})") from None
+        if np.abs(A.imag).max(initial=0.0) > fp.ZERO:
+            raise fp.CannotCheck("it has complex entries")
+        out.append(A.real)
+    return np.array(out).reshape(fp.SAMPLE_POINTS, *v.shape)
+
+
+def _canon_spans(As) -> tuple:
+    """(form, ambient dimension, canonical projectors) of the spans of the arrays ``As`` (one per point)."""
+    pts = []
+    for A in As:
+        if A.size == 0 or np.abs(A).max() < fp.ZERO:
+            P = np.zeros((A.shape[0], A.shape[0]))
+        else:
+            U, s, _ = np.linalg.svd(A)
+            r = int((s > 1e-9 * max(1.0, s[0])).sum())
+            Q = U[:, :r]
+            P = Q @ Q.T
+        P = np.round(P, _PROJ_DECIMALS) + 0.0
+        pts.append([f"{x:.{_PROJ_DECIMALS}f}" for x in P.ravel()])
+    return "subspace", str(As[0].shape[0]), pts
+
+
+def home_canon(value, shape=None) -> tuple:
+    """``("subspace", ambient dimension, canonical projectors)`` of a ``subspace`` answer at the sample points.
+
+    >>> home_canon([[1, 0, 0]])[:2], home_canon([[2, 0, 0]]) == home_canon(sp.Matrix([1, 0, 0]))
+    (('subspace', '3'), True)
+    """
+    return _canon_spans(_home_sampled(_home_value(value, shape)))
+
+
+def _home_mistake(arr, shape, right):
+    m = int(shape)
+
+    def matches(As):
+        return all(A.shape[0] == m for A in As) and right(_canon_spans(As)[2])
+
+    found = mistakes.search(arr, matches, mistakes.SUBSPACE_MISTAKES, pairs=False)
+    return found.says if found is not None else None
+
+
+def home_verdict(value, judge: fp.Judge) -> tuple[str, str]:
+    """The self-check's ``(status, message)`` on a ``subspace`` answer against the spec in ``judge``.
+
+    >>> j = fp.Judge("subspace", "3", fp.digest("subspace", home_canon([[1, 0, 0]])[2]))
+    >>> home_verdict(sp.Matrix([5, 0, 0]), j), home_verdict([[0, 1, 0]], j)
+    (('correct', 'correct'), ('incorrect', 'not right yet: it spans a different subspace'))
+    """
+    shape, right, named = judge.shape, judge.right, judge.named
+    try:
+        v = _home_value(value, shape)
+    except fp.WrongForm:
+        v = _home_value(value)
+        found = _home_mistake(_home_sampled(v), shape, right)
+        if found is None:
+            raise
+        return named(found)
+    arr = _home_sampled(v)
+    if right(_canon_spans(arr)[2]):
+        return "correct", "correct"
+    found = _home_mistake(arr, shape, right)
+    return named(found) if found else ("incorrect", f"not right yet: {HOME_DIFFERS}")
+
+
+def stub_words(value) -> str:
+    """What a ``subspace`` answer is, for the workbook's stub.
+
+    >>> stub_words(sp.Matrix([1, 0, 0]))
+    'a Matrix whose columns span the subspace (3-vectors)'
+    """
+    try:
+        return f"a Matrix whose columns span the subspace ({as_sympy_value(value, True).shape[0]}-vectors)"
+    except Exception:  # noqa: BLE001
+        return "a Matrix whose columns span the subspace"
