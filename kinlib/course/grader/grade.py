@@ -31,8 +31,8 @@ How it works
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
   :mod:`kinlib.course.schema` reads them) the
   reference kernel (the grader's own, never a student's) exports each answer as data exactly as a student's
-  kernel does (below); the grader reads it and keeps it as ``sympy.srepr`` text (read back by the strict parser
-  :mod:`kinlib.course.answers.srepr`, never ``eval``); the result is
+  kernel does (below); the grader reads it and keeps it in the same wire format (read back by the same whitelist parser,
+  :func:`kinlib.course.answers.wire.load`, never ``eval``); the result is
   cached in ``--cache/<id>-<hash>.json`` with an HMAC tag keyed by the grader secret
   (:mod:`kinlib.course.grader.refdata`), keyed by the notebook's bytes and the checker's version. Points per part:
   ``points`` in the solution cell's ``kinlib`` metadata if present, else "(N points)" parsed from the

@@ -124,7 +124,7 @@ def _child() -> int:
         return 2
     from ..answers import describe  # noqa: F401  imported now: the parent's time limits count judging only
     from .judge import exact_check, judge_answer
-    from .refdata import Reference
+    from .refdata import Reference, reference_value
 
     ref = Reference(**init["ref"])
     points, seed = init["points"], init["seed"]
@@ -141,7 +141,7 @@ def _child() -> int:
             values = {msg["name"]: value}  # only the last answer's: kept for its exact check
             _send(out, {"status": v.status, "message": v.message, "exact": v.exact, "wants_exact": v.exact == "?"})
         elif msg.get("op") == "exact":
-            word = exact_check(values.get(msg["name"]), ref.answers[msg["name"]]["srepr"], float(msg["seconds"]))
+            word = exact_check(values.get(msg["name"]), reference_value(ref, msg["name"]), float(msg["seconds"]))
             _send(out, {"exact": word})
         else:
             return 0
