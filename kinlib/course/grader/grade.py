@@ -347,6 +347,7 @@ def _run_and_judge(job: Job, enc: Enclosure) -> list:
         out["restarts"] = run.restarts
         out["cells"] = [asdict(r) | {"part": part_of_cell.get(i, "")} for i, r in sorted(run.results.items())]
         out["output_bytes"] = sum(r.output_bytes for r in run.results.values())
+        out["output_dropped"] = sum(r.dropped for r in run.results.values())  # messages over the size cap
         out.setdefault("exact", {})
         return g.rows
     except Exception as exc:  # noqa: BLE001  a checker bug must not stop the batch, nor pass as a grade
