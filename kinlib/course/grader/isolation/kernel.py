@@ -69,8 +69,8 @@ MAX_FILES = 1024  # open files per kernel process (RLIMIT_NOFILE) without an enc
 # hundreds of MB): ZeroMQ refuses a message over MAX_MESSAGE_BYTES before the grader holds it (it drops the
 # connection, which ZeroMQ makes again; the drop is counted and flagged on the cell), and queues at most
 # MAX_QUEUED messages per channel, so a client holds at most about MAX_QUEUED x MAX_MESSAGE_BYTES per channel.
-MAX_MESSAGE_BYTES = 2 * 2**20
-MAX_QUEUED = 32
+MAX_MESSAGE_BYTES = 16 * 2**20
+MAX_QUEUED = 8
 
 
 class KernelStartError(RuntimeError):
