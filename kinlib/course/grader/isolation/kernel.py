@@ -303,7 +303,7 @@ class Kernel:
                     self.kc.iopub_channel.socket.disable_monitor()
                     self.monitor.close(0)
                 self.kc.stop_channels()
-                self.kc.context.term()
+                self.kc.context.destroy(linger=0)
             except Exception:  # noqa: BLE001
                 pass
             self.kc, self.monitor = None, None
