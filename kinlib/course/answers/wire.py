@@ -510,7 +510,7 @@ def _exact_node(e) -> None:
     if isinstance(e, (sp.Add, sp.Mul)):
         return
     if isinstance(e, sp.Pow):
-        x = e.exp
+        x = sp.Rational(e.exp) if isinstance(e.exp, sp.Float) and e.exp.is_finite else e.exp  # its exact value
         if x.is_Rational and abs(x.p) <= 12 and x.q <= 2:
             return
         raise ValueError("a power that is not a small whole number or half")
