@@ -363,7 +363,7 @@ def test_a_replaced_or_patched_export_gains_nothing(kernel_attacks, name):
 @pytest.mark.slow
 def test_no_point_seed_or_reference_is_ever_sent_to_the_kernel(kernel_attacks):
     ref = kernel_attacks["ref"]
-    keys = [a["srepr"] for a in ref.answers.values() if "srepr" in a]
+    keys = [json.dumps(a["tree"]) for a in ref.answers.values() if "tree" in a]
     for name, messages in kernel_attacks["sent"].items():
         text = "\n".join(messages)
         assert "export_answer" in text  # the spy saw the grader's requests

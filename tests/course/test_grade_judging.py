@@ -392,6 +392,70 @@ def test_hostile_trees_and_an_iopub_flood_in_a_batch_leave_the_victim_graded_rig
     assert "internal error" not in text and "reference could not" not in text
 
 
+# a submission that prints 100 MB and displays 100 MB (each one IOPub message), then is graded as usual
+FLOOD = (
+    "from IPython.display import display\n"
+    "print('x' * 100_000_000)\n"
+    "display({'text/plain': 'y' * 100_000_000}, raw=True)\n"
+)
+WORKER_HWM_BOUND = 250 * 2**20  # a worker's peak RSS: ~90 MiB measured with the cap, 376 MiB without
+
+
+def _workers_peak(stop, peak) -> None:
+    """Poll every grader worker process (``kinlib.course.grader.batch --worker``) for its VmHWM (its peak RSS)."""
+    import re
+    import time
+
+    while not stop.is_set():
+        for pid in (p for p in os.listdir("/proc") if p.isdigit()):
+            try:
+                cmd = Path(f"/proc/{pid}/cmdline").read_bytes()
+                if b"kinlib.course.grader.batch" not in cmd or b"--worker" not in cmd:
+                    continue
+                m = re.search(r"VmHWM:\s+(\d+) kB", Path(f"/proc/{pid}/status").read_text())
+            except OSError:
+                continue
+            if m:
+                peak[pid] = max(peak.get(pid, 0), int(m.group(1)) * 1024)
+        time.sleep(0.2)
+
+
+@pytest.mark.slow
+def test_an_iopub_flood_is_dropped_and_flagged_with_the_graders_memory_bounded(tmp_path, grader_reference_cache):
+    """200 MB of output (two messages of 100 MB) from one submission, a victim beside it: the grader's workers
+    never hold it (ZeroMQ refuses a message over kernel.MAX_MESSAGE_BYTES: without the cap a worker peaked at
+    ~+290 MB per 100 MB message), the flood is flagged, both are graded right."""
+    import threading
+
+    nb = json.loads(SOLUTION.read_text())
+    nb["cells"].append({"cell_type": "code", "metadata": {}, "source": FLOOD, "outputs": [], "execution_count": None})
+    subs = tmp_path / "subs"
+    subs.mkdir()
+    (subs / "flood.ipynb").write_text(json.dumps(nb))
+    (subs / "victim.ipynb").write_bytes(SOLUTION.read_bytes())
+    stop, peak = threading.Event(), {}
+    watcher = threading.Thread(target=_workers_peak, args=(stop, peak), daemon=True)
+    watcher.start()
+    try:
+        summary = grade.grade_batch(
+            [subs], tmp_path / "out", jobs=2, timeout=600, cell_timeout=300, notebooks=FIX / "notebooks",
+            cache=grader_reference_cache, log=None, batch_timeout=3000,
+        )  # fmt: skip
+    finally:
+        stop.set()
+        watcher.join()
+    res = {r["relpath"]: r for r in summary["results"]}
+    assert summary["infrastructure_errors"] == 0
+    for name in ("flood.ipynb", "victim.ipynb"):
+        rows = res[name]["rows"]
+        assert [r["status"] for r in rows] == ["pass"] * 5 and all(r["points"] == r["max_points"] for r in rows), rows
+    assert peak, "no worker process seen"
+    print("worker peaks (MiB):", {p: v // 2**20 for p, v in peak.items()})
+    assert max(peak.values()) < WORKER_HWM_BOUND, {p: v // 2**20 for p, v in peak.items()}
+    assert res["flood.ipynb"]["output_dropped"] >= 1 and res["victim.ipynb"]["output_dropped"] == 0
+    assert "over the grader's size cap" in Path(res["flood.ipynb"]["feedback"]).read_text()
+
+
 # ----------------------------------------------------------------------------------------- kernels' own limits
 
 

@@ -519,6 +519,37 @@ def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
     # no notebook in the submission: still a valid results file, score 0
     r, d = grade({})
     assert r.returncode == 0 and d["score"] == 0 and "No .ipynb" in d["output"]
+    # issue 31's end-to-end attack: answers made of strings that run if sympified, hostile symbol and function
+    # names, in a workbook graded by the bundle; nothing runs on the trusted side (root, who alone can write
+    # /autograder), the score stays within the maximum and nothing of the key is printed
+    from kinlib.course.answers import wire
+
+    pwned = f"/autograder/pwned-{mark}"
+    code = f"__import__('os').system('touch {pwned}') or 0"
+    names = [n for c in nbs[first]["cells"] for n in c["metadata"].get("kinlib", {}).get("answers", [])]
+    evil = untouched(nbs[first])
+    evil["cells"].append(
+        _code_cell(
+            "import numpy as np, sympy as sp\n"
+            f"_c = {code!r}\n"
+            "_x = sp.Symbol('x')\n"
+            "_vals = [[_c], [[_c, 1]], {'a': _c}, {_x: {(_c, 0)}}, np.array([_c], dtype=object), sp.Symbol(_c),\n"
+            '         sp.Function("f\') or " + _c + " or (\'")(_x), _c]\n'
+            f"for _i, _n in enumerate({names!r}):\n"
+            "    globals()[_n] = _vals[_i % len(_vals)]\n"
+        )
+    )
+    r, d = grade({"evil": evil}, AFTER)
+    assert not (tmp_path / "ag" / f"pwned-{mark}").exists(), "code from the submission ran in the grader"
+    assert 0 <= d["score"] <= sum(t["max_score"] for t in d["tests"]) and d["score"] == 0, d
+    assert all(0 <= t["score"] <= t["max_score"] for t in d["tests"]), d["tests"]
+    shown = r.stdout + r.stderr + json.dumps(d)
+    assert (six["dir"] / "secret").read_bytes().strip().decode() not in shown
+    for ref in json.loads(z.read("references.json")).values():
+        for a in ref["answers"].values():
+            if "tree" in a:
+                value = str(wire.load(a["tree"], max_nodes=10 * wire.MAX_NODES))
+                assert len(value) < 8 or value not in shown, value[:80]
 
 
 def _code_cell(src):

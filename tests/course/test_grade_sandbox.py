@@ -1,4 +1,4 @@
-"""The grader's sandbox and key (kinlib.course.grader.isolation.sandbox, secret, refdata, srepr): each attack of issue 14 kept.
+"""The grader's sandbox and key (kinlib.course.grader.isolation.sandbox, secret, refdata, wire): each attack of issue 14 kept.
 
 A batch of hostile submissions (an unanswered workbook plus one attack cell from tests/fixtures/grade/attacks)
 is graded once, sandboxed, two at a time. Each attack must gain nothing (every part still fails, and the
@@ -24,9 +24,9 @@ from pathlib import Path
 
 import pytest
 
-from kinlib.course.answers.srepr import parse_srepr
+from kinlib.course.answers import describe, wire
 from kinlib.course.cli import main
-from kinlib.course.grader import grade
+from kinlib.course.grader import grade, refdata
 from kinlib.course.grader.isolation import sandbox
 from kinlib.course.grader.isolation.kernel import Kernel
 from kinlib.course.grader.refdata import reference_description
@@ -291,7 +291,7 @@ def test_evaluation_points_depend_on_the_secret_not_the_file_alone(tmp_path, mon
 
 
 def _no_dummies(answers) -> str:
-    return re.sub(r"dummy_index=\d+", "", json.dumps(answers, sort_keys=True))
+    return re.sub(r'(\["Dummy", "[^"]*", \{[^}]*\}, )\d+', r"\1", json.dumps(answers, sort_keys=True))
 
 
 @pytest.mark.slow
@@ -307,9 +307,9 @@ def test_a_poisoned_cache_is_rejected_and_nothing_runs_in_the_grader(tmp_path, g
     payload = f"__import__('os').system('touch {marker}')"
     good = json.loads(cfile.read_text())
 
-    def poisoned(mac):
+    def poisoned(mac, answer=None):
         d = copy.deepcopy(good)
-        d["reference"]["answers"]["Js"]["srepr"] = payload
+        d["reference"]["answers"]["Js"] = answer or {"kind": "expr", "tree": ["sin", ["str", payload]], "symbols": {}}
         d["mac"] = mac(d["reference"])
         cfile.write_text(json.dumps(d))
 
@@ -324,50 +324,93 @@ def test_a_poisoned_cache_is_rejected_and_nothing_runs_in_the_grader(tmp_path, g
         ref = grade.load_references(FIX / "notebooks", cache, secret=key, log=logs.append)["90_grade_fixture"]
         assert _no_dummies(ref.answers) == _no_dummies(fresh.answers) and "does not verify" in " ".join(logs)
         assert not marker.exists()
-    # even a correctly signed payload (a leaked secret) is data that does not parse, never code that runs
-    poisoned(lambda r: sign(key, "kinlib-reference-cache", canonical(r)))
-    ref = grade.load_references(FIX / "notebooks", cache, secret=key)["90_grade_fixture"]
-    assert ref.answers["Js"]["srepr"] == payload
-    with pytest.raises(ValueError, match="not reference data"):
-        reference_description(ref, "Js", "expr", [{"L": 1.0, "theta1": 0.1, "theta2": 0.2, "theta3": 0.3}], 0)
+    # even a correctly signed payload (a leaked secret), or an older version's srepr text, is data that the one
+    # parser refuses: the cache is rebuilt, nothing runs
+    signed = lambda r: sign(key, "kinlib-reference-cache", canonical(r))
+    for answer in (None, {"kind": "expr", "srepr": payload, "symbols": {}}):
+        poisoned(signed, answer)
+        ref = grade.load_references(FIX / "notebooks", cache, secret=key)["90_grade_fixture"]
+        assert _no_dummies(ref.answers) == _no_dummies(fresh.answers)
+        assert "tree" in ref.answers["Js"] and "srepr" not in ref.answers["Js"]
+        assert not marker.exists()
+    bad = grade.Reference("n", "t", "p", "0", [], {"Js": {"kind": "expr", "tree": ["sin", ["str", payload]]}})
+    with pytest.raises(wire.WireError, match="takes SymPy values"):
+        reference_description(bad, "Js", "expr", [{"L": 1.0, "theta1": 0.1, "theta2": 0.2, "theta3": 0.3}], 0)
     assert not marker.exists()
 
 
+CODE = '__import__("os").system("true")'
+
+
 @pytest.mark.parametrize(
-    "text",
+    "tree",
     [
-        "__import__('os').system('true')",
-        'ImmutableDenseMatrix([[\'__import__("os").system("true")\']])',  # SymPy would sympify (eval) this
-        "Tuple('x')",
-        "Symbol('x').__class__",
-        "(lambda: 1)()",
-        "Float('1e5; import os')",
-        "Symbol('x', **{'a': 1})",
-        "Add(*[Integer(1)])",
-        "[x for x in ()]",
-        "S.Pi",
-        "{'k': '__import__(\"os\")'}",  # a string value: only keys may be strings
-        "{**{}}",
+        ["str", CODE],
+        ["Matrix", 1, 1, ["str", CODE]],  # SymPy would sympify (eval) this
+        ["Tuple", ["str", "x"]],
+        ["Symbol", "x').__class__", {}],
+        ["Symbol", "__class__", {}],
+        ["Float", "1e5; import os", 53],
+        ["Symbol", "x", {"a": 1}],
+        ["UndefinedFunction", "exec", ["Symbol", "x", {}]],
+        ["Add", ["list", ["Integer", "1"]]],
+        ["Lambda", ["str", "x"], ["str", CODE]],
+        ["call", "__import__", "os"],
+        "Integer(1)",  # an older cache's srepr text
     ],
 )
-def test_reference_text_is_parsed_as_data_never_evaluated(text):
-    with pytest.raises(ValueError, match="not reference data"):
-        parse_srepr(text)
+def test_a_reference_tree_is_read_as_data_never_evaluated(tree):
+    """A cache entry that is not a tree the one parser reads is refused: the cache is not in format (rebuilt)."""
+    ref = grade.Reference("n", "t", "p", "0", [], {"a": {"kind": "expr", "tree": tree, "symbols": {}}})
+    with pytest.raises(wire.WireError):
+        refdata.reference_value(ref, "a")
+    assert not refdata.in_format(ref)
 
 
-def test_reference_text_round_trips():
+def test_reference_values_round_trip_exactly_through_the_wire_format():
+    """The answer key keeps each reference as a wire tree (describe.dump_reference) only when it reads back
+    structurally equal; every form the course's answers take does (the real key: test_the_real_answer_key_...)."""
     import sympy as sp
 
     th, n = sp.Symbol("theta2", real=True), sp.Dummy("n", integer=True)
+    L = sp.Symbol("L", positive=True)
     for obj in [
         sp.Matrix([[sp.cos(th), sp.Rational(-1, 2)], [sp.pi, sp.Float(0.25)]]),
+        sp.ImmutableMatrix([[L * sp.Float("0.1", 200), sp.sqrt(2) * L**2 * sp.Abs(sp.sin(th + sp.pi / 4))]]),
         {th: sp.ImageSet(sp.Lambda(n, sp.pi / 2 + n * sp.pi), sp.S.Integers)},
+        sp.Union(sp.ImageSet(sp.Lambda(n, 2 * n * sp.pi + sp.pi / 4), sp.S.Integers), sp.FiniteSet(0, sp.pi)),
         [{th: sp.FiniteSet(0, sp.pi)}, {th: sp.Interval(0, 1, True)}],
         sp.S.EmptySet,
+        sp.ConditionSet(th, sp.Eq(sp.sin(th), 0), sp.S.Reals),
         sp.Function("f")(th) + sp.oo * sp.I,
         {"case_a": sp.Matrix([[1, th]]), "case_b": sp.Integer(0)},  # answers keyed by name (4.1)
+        sp.FiniteSet(sp.ImmutableMatrix([1, 2])),
     ]:
-        assert parse_srepr(sp.srepr(obj)) == obj
+        assert describe.same_reference(wire.load(wire.dump(obj)), obj), obj
+    kinds = {"J": "expr", "S": "set", "cases": "expr"}
+    ns = {"J": sp.Matrix([[L * sp.cos(th)]]), "S": {th: sp.ImageSet(sp.Lambda(n, n * sp.pi), sp.S.Integers)}}
+    ns["cases"] = {"a": sp.Matrix([[1, th]]), "b": 0}
+    dumped = describe.dump_reference(ns, kinds)
+    ref = grade.Reference("n", "t", "p", "0", [], dumped)
+    for name in kinds:
+        assert set(dumped[name]) == {"kind", "tree", "symbols"}, dumped[name]
+        want = describe.normalize_reference(kinds[name], ns[name])
+        assert describe.same_reference(refdata.reference_value(ref, name), want), name
+
+
+@pytest.mark.slow
+def test_the_real_answer_key_round_trips_through_the_wire_format(grader_reference_cache):
+    """Every reference answer of every solution notebook is kept (dump_reference keeps one only when its wire tree
+    reads back structurally equal to the solution's value, else the answer is an error) and reads back."""
+    refs = grade.load_references(ROOT / "notebooks", grader_reference_cache, secret=load_secret(), jobs=2)
+    assert refs
+    for nid, ref in refs.items():
+        assert not ref.error, (nid, ref.error)
+        for name, a in ref.answers.items():
+            assert "error" not in a and "srepr" not in a, (nid, name, a)
+            if "tree" in a:
+                value = refdata.reference_value(ref, name)
+                assert describe.same_reference(wire.load(wire.dump(value)), value), (nid, name)
 
 
 def test_the_secret_file_is_private_and_refused_when_not(tmp_path):
@@ -449,7 +492,7 @@ def test_a_kernel_that_never_starts_is_an_infrastructure_error(tmp_path, monkeyp
     sub = tmp_path / "s.ipynb"
     sub.write_text(json.dumps(_workbook()))
     parts = [{"part": p, "points": 5.0, "answers": [f"a{k}"], "kinds": {f"a{k}": "expr"}} for k, p in enumerate(PARTS)]
-    answers = {f"a{k}": {"kind": "expr", "srepr": "Integer(1)", "symbols": {}} for k in range(len(PARTS))}
+    answers = {f"a{k}": {"kind": "expr", "tree": ["Integer", "1"], "symbols": {}} for k in range(len(PARTS))}
     refs = {"90_grade_fixture": grade.Reference("90_grade_fixture", "t", "p", "0" * 64, parts, answers)}
     res = grade.grade_submission(sub, refs, sandbox=_FlakySandbox())
     assert {r["status"] for r in res["rows"]} == {"error"}

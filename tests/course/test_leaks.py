@@ -185,13 +185,13 @@ WORDS = {
 
 
 def forms(notebook: str, part: str, name: str, ans: dict) -> list[Form]:
-    """Every form of the graded answer ``name`` (the grader's reference ``ans``: srepr or choice)."""
-    from kinlib.course.answers.srepr import parse_srepr
+    """Every form of the graded answer ``name`` (the grader's reference ``ans``: a wire tree or a choice)."""
+    from kinlib.course.answers import wire
 
     out = [Form(notebook, part, name, label, regex=rx, strong=False) for label, rx in WORDS.get((part, name), [])]
     if "choice" in ans:
         return out
-    value = parse_srepr(ans["srepr"])
+    value = wire.load(ans["tree"], max_nodes=10 * wire.MAX_NODES)
 
     def strong(label, text, min_len=10):
         t = normalise(text)
@@ -494,8 +494,10 @@ def test_forms_of_a_set_and_an_expression():
     k = sp.Symbol("k", integer=True)
     S = {th2: sp.ImageSet(sp.Lambda(k, sp.pi * k - sp.pi / 4), sp.Integers)}
     det = sp.sqrt(2) * L**2 * sp.sin(th2 + sp.pi / 4)
-    fs = forms("05", "5.1", "singular_configs", {"srepr": sp.srepr(S)})
-    fs += forms("05", "5.1", "detJ", {"srepr": sp.srepr(det)})
+    from kinlib.course.answers import wire
+
+    fs = forms("05", "5.1", "singular_configs", {"tree": wire.dump(S)})
+    fs += forms("05", "5.1", "detJ", {"tree": wire.dump(det)})
     found = find_hits(fs, {"05/problems.html": "the mistake misses the drop at θ<sub>2</sub>=&minus;π/4"}, ["05"])
     assert {h.form.name for h in found} == {"singular_configs"}
     found = find_hits(fs, {"05.html": r"$$\det J = \sqrt{2}\,L^2 \sin\left(\theta_2 + \frac{\pi}{4}\right)$$"}, ["05"])

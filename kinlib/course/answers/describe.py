@@ -8,12 +8,12 @@ at the points for ``expr``, ``subspace``, ``property``; members per point for ``
 never leave the grader. Non-finite values are described as ``None`` (cannot be evaluated): a wrong answer.
 
 The reference side: :func:`normalize_reference` (each kind's reference form) and :func:`dump_reference` (the
-answer key as ``srepr`` text, instructor side only).
+answer key as trees of the one wire format, :mod:`.wire`; instructor side only).
 """
 
 import sympy as sp
 
-from . import kinds
+from . import kinds, wire
 from .choice import describe_choice
 from .expr import describe_expr, exact_equal
 from .properties import describe_property
@@ -29,6 +29,7 @@ __all__ = [
     "describe_property",
     "normalize_reference",
     "dump_reference",
+    "same_reference",
     "exact_equal",
     "DESCRIBE",
     "MAX_SET_MEMBERS",
@@ -47,7 +48,7 @@ def describe(kind, value, points, seed=0):
 
 
 def normalize_reference(kind, value):
-    """The reference value as something ``srepr`` round-trips (instructor side only): the kind's own reference form.
+    """The reference value as something the wire format round-trips (instructor side only): the kind's own reference form.
 
     >>> normalize_reference("set", [0, 1]), normalize_reference("expr", [1, 2]).shape
     ({0, 1}, (2, 1))
@@ -73,9 +74,40 @@ def _symbols(obj) -> set:
     return syms
 
 
+def same_reference(a, b) -> bool:
+    """Structural equality of two reference values (SymPy objects, or dicts and lists of them); a matrix
+    equals its immutable copy, an ImageSet's bound Dummy may be another one (each read makes a fresh one).
+
+    >>> n = sp.Dummy("n")
+    >>> same_reference(sp.ImageSet(sp.Lambda(n, n * sp.pi), sp.S.Integers), wire.load(wire.dump(sp.ImageSet(
+    ...     sp.Lambda(n, n * sp.pi), sp.S.Integers)))), same_reference({"a": sp.Integer(1)}, {"a": 1})
+    (True, False)
+    """
+    if isinstance(a, dict) and isinstance(b, dict):
+        return a.keys() == b.keys() and all(same_reference(a[k], b[k]) for k in a)
+    if isinstance(a, (list, tuple)) and isinstance(b, (list, tuple)):
+        return type(a) is type(b) and len(a) == len(b) and all(map(same_reference, a, b))
+    if isinstance(a, sp.MatrixBase) and isinstance(b, sp.MatrixBase):
+        return a == b
+    return type(a) is type(b) and (a == b or _undummied(a) == _undummied(b))
+
+
+def _undummied(e):
+    """``e`` with its Dummies (an ImageSet's bound variable: a fresh one each time it is read) replaced, in order
+    of appearance, by symbols named for their place, so two reads of one tree compare equal."""
+    if not isinstance(e, sp.Basic):
+        return e
+    seen = []
+    for x in sp.preorder_traversal(e):
+        if isinstance(x, sp.Dummy) and x not in seen:
+            seen.append(x)
+    return e.xreplace({d: sp.Symbol(f"_dummy{i}_{d.name}", **d.assumptions0) for i, d in enumerate(seen)})
+
+
 def dump_reference(ns, kinds_of):
-    """{name: {"kind", "srepr", "symbols": {name: {"positive": bool}}} | {"kind", "choice"} | {"error"}}
-    for the reference answers ``kinds_of`` = {name: kind} found in ``ns``.
+    """{name: {"kind", "tree", "symbols": {name: {"positive": bool}}} | {"kind", "choice"} | {"error"}}
+    for the reference answers ``kinds_of`` = {name: kind} found in ``ns``: each value in the one wire format
+    (:func:`kinlib.course.answers.wire.dump`, read back by :func:`~kinlib.course.answers.wire.load`).
 
     >>> dump_reference({"n": 2, "ok": True}, {"n": "choice", "ok": "expr", "x": "expr"})["ok"]
     {'choice': {'tag': 'choice', 'type': 'bool', 'value': True}, 'kind': 'choice'}
@@ -91,11 +123,15 @@ def dump_reference(ns, kinds_of):
                 out[name] = {"choice": describe_choice(ns[name]), "kind": kind}
                 continue
             obj = normalize_reference(kind, ns[name])
-            text = sp.srepr(obj)
+            tree = wire.dump(obj, max_nodes=10 * wire.MAX_NODES)
+            if not same_reference(
+                wire.load(tree, max_nodes=10 * wire.MAX_NODES), obj
+            ):  # kept only if it reads back as is
+                raise ValueError("the reference does not read back exactly from the wire format")
             syms = _symbols(obj)
             out[name] = {
                 "kind": kind,
-                "srepr": text,
+                "tree": tree,
                 "symbols": {s.name: {"positive": bool(s.is_positive)} for s in syms if isinstance(s, sp.Symbol)},
             }
         except Exception as exc:  # noqa: BLE001

@@ -56,7 +56,7 @@ class Kind:
     normalise: Callable  # value -> its normal form (a SymPy object, plain data, or a tag saying why not)
     describe: Callable  # (value, points, seed) -> description, in the grader (values at the secret points)
     compare: Callable  # (student's description, reference's, name[, argument]) -> (ok, message)
-    reference: Callable  # the reference value -> what the answer key keeps (srepr round-trips it)
+    reference: Callable  # the reference value -> what the answer key keeps (the wire format round-trips it)
     points: int = 5  # secret points the answer is evaluated at (0: none, the value alone)
     # the workbook self-check (kinlib.course.workbook.selfcheck), at the public sample points:
     home_canon: Callable | None = None  # value -> (form, shape, canonical form), hashed into the spec

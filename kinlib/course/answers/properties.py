@@ -6,11 +6,11 @@ has no singular configuration").
 
 * **normalise** (:func:`property_answer`): a robot (any object with a 6×n ``screws`` matrix, a kinlib
   ``SerialChain``, found by duck typing: :func:`robot_screws`), its task Jacobian as a matrix, or an expression,
-  as its exact tree (:func:`kinlib.course.answers.exacttree.expr_tree`).
+  as its exact tree (:func:`kinlib.course.answers.wire.exact_dump`: the wire format's exact subset).
 * **wire form**: ``robot`` (only its screw axes cross the kernel boundary), ``Matrix``, SymPy expressions.
 * **describe** (:func:`describe_property`): the exact tree (and, for a matrix or an expression, its values).
 * **compare** (:func:`compare_property` → :func:`judge`): :data:`PROPERTIES` maps each property to its decision,
-  ``(ok, message)``, on the tree rebuilt by a whitelist (:func:`~.exacttree.from_tree`, never ``eval``); the
+  ``(ok, message)``, on the tree read back by the wire format's parser (:func:`~.wire.exact_load`, never ``eval``); the
   message talks about the student's own answer only. The reference is not used (:func:`reference_property`).
 
 * ``nonsingular`` (problem 5.5): the student's redesigned robot (the judge computes its J from its screw axes)
@@ -33,8 +33,8 @@ import numpy as np
 import sympy as sp
 
 from .base import not_answered, type_name
-from .exacttree import expr_tree, from_tree
 from .expr import describe_expr, to_sympy
+from .wire import exact_dump, exact_load
 
 __all__ = [
     "robot_screws",
@@ -116,14 +116,12 @@ _A_MATRIX = (
 MAX_ROBOT_JOINTS = 6  # a redesign with more joints is not decided here (the proof's cost grows fast)
 
 
-def _matrix(tree, syms: dict, budget: list, name: str):
-    """A matrix rebuilt from its tree, or a message (str) saying why not."""
+def _matrix(tree, name: str):
+    """A matrix read back from its exact tree (:func:`~.wire.exact_load`), or a message (str) saying why not."""
     if len(tree) < 3 or not all(isinstance(x, int) and 0 < x <= 12 for x in tree[1:3]):
         return f"{name} could not be read (malformed matrix)"
-    r, c = tree[1], tree[2]
-    if len(tree) != 3 + r * c:
-        return f"{name} could not be read (malformed matrix)"
-    return sp.Matrix(r, c, [from_tree(x, syms, budget) for x in tree[3:]])
+    M = exact_load(tree)
+    return M if isinstance(M, sp.MatrixBase) else f"{name} could not be read (malformed matrix)"
 
 
 def _robot_task_jacobian(S, name: str):
@@ -170,18 +168,17 @@ def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
     claimed J or det(J Jᵀ), e.g. sp.eye(3) or 1) is refused: it belongs to no robot. Proofs by
     :func:`kinlib.singularities.singular_configurations` on J: no condition and complete ⇔ never singular.
 
-    >>> rpp = ["matrix", 6, 3, *[["int", str(x)] for x in (0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0)]]
+    >>> rpp = ["Matrix", 6, 3, *[["Integer", str(x)] for x in (0, 0, 0, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0)]]
     >>> nonsingular({"tag": "robot", "tree": rpp}, "redesign")
     (True, 'det(J Jᵀ) ≠ 0 for every joint value: proved')
-    >>> nonsingular({"tag": "scalar", "tree": ["int", "1"]}, "redesign")[0]
+    >>> nonsingular({"tag": "scalar", "tree": ["Integer", "1"]}, "redesign")[0]
     False
     """
-    syms: dict = {}
     tree = stu.get("tree")
     tag = stu.get("tag")
-    if not isinstance(tree, list) or tree[:1] != ["matrix"]:
+    if not isinstance(tree, list) or tree[:1] != ["Matrix"]:
         return False, _NOT_A_ROBOT.format(name=name)
-    M = _matrix(tree, syms, [20_000], name)
+    M = _matrix(tree, name)
     if isinstance(M, str):
         return False, M
     if tag != "robot":  # a bare matrix (sp.eye(3): any constant invertible matrix) is no robot
@@ -191,7 +188,7 @@ def nonsingular(stu: dict, name: str) -> tuple[bool, str]:
     J = _robot_task_jacobian(M, name)
     if isinstance(J, str):
         return False, J
-    return _judge_task_jacobian(J, syms, name, f"{name}: det(J Jᵀ) of your robot")
+    return _judge_task_jacobian(J, {s.name: s for s in M.free_symbols}, name, f"{name}: det(J Jᵀ) of your robot")
 
 
 PROPERTIES = {"nonsingular": nonsingular}
@@ -283,11 +280,11 @@ def property_answer(value) -> dict:
     """An answer judged by a property of the student's own design (problem 5.5: "your redesign has no singular
     configuration") as plain JSON data for the judge (:mod:`kinlib.course.answers.properties`): ``{"tag": "robot",
     "tree": …}`` for a robot (its screw axes, :func:`robot_screws`), ``{"tag": "matrix"|"scalar", "tree": …}``
-    for a matrix (its task Jacobian) or an expression, with the exact :func:`expr_tree`; ``tree_error`` says
+    for a matrix (its task Jacobian) or an expression, with the exact tree (:func:`~.wire.exact_dump`); ``tree_error`` says
     why there is none; other tags as :func:`to_sympy`.
 
     >>> property_answer(sp.Matrix([[1, 0], [0, 1]]))["tree"][:3]
-    ['matrix', 2, 2]
+    ['Matrix', 2, 2]
     >>> property_answer(...)["tag"], property_answer("robot")["tag"]
     ('ellipsis', 'other')
     """
@@ -299,7 +296,7 @@ def property_answer(value) -> dict:
     out = {"tag": tag, "type": type_name(value)}
     if obj is not None:
         try:
-            out["tree"] = expr_tree(obj)
+            out["tree"] = exact_dump(obj)
         except Exception as exc:  # noqa: BLE001  (any failure is reported, not raised)
             out["tree_error"] = str(exc)[:200]
     return out
@@ -308,10 +305,10 @@ def property_answer(value) -> dict:
 def describe_property(value, points, seed=0):
     """An answer graded by a property (``kind`` "property:<name>"): a robot as its screw axes' exact tree
     (:func:`property_answer`), anything else described as an expression plus its exact expression tree
-    (:func:`~.exacttree.expr_tree`), for the grader's proof.
+    (:func:`~.wire.exact_dump`), for the grader's proof.
 
     >>> describe_property(sp.Rational(1, 2), [{}])["tree"]
-    ['rat', '1', '2']
+    ['Rational', '1', '2']
     """
     prop = property_answer(value)  # a robot (its screw axes), a matrix or an expression, as a tree
     if prop["tag"] == "robot":
@@ -327,13 +324,13 @@ def compare_property(stu: dict, ref: dict, name: str, prop: str = "nonsingular")
     redesigned robot, whose det(J Jᵀ) must be nonzero for every joint value, proved
     exactly (kinlib.singularities); a bare value of det(J Jᵀ) belongs to no robot and fails.
 
-    >>> compare_property({"tag": "scalar", "tree": ["int", "1"]}, {}, "d")[0]
+    >>> compare_property({"tag": "scalar", "tree": ["Integer", "1"]}, {}, "d")[0]
     False
-    >>> col = lambda *xs: [["int", str(x)] for x in xs]
+    >>> col = lambda *xs: [["Integer", str(x)] for x in xs]
     >>> three_r = col(0, 0, 0, 0, 0, 0, 1, 1, 1, 0, 0, 0, 0, -1, -2, 0, 0, 0)   # joints at x = 0, 1, 2
-    >>> compare_property({"tag": "robot", "tree": ["matrix", 6, 3, *three_r]}, {}, "d")[1][:58]
+    >>> compare_property({"tag": "robot", "tree": ["Matrix", 6, 3, *three_r]}, {}, "d")[1][:58]
     'd: det(J Jᵀ) of your robot is 0 at some joint values: your'
-    >>> compare_property({"tag": "matrix", "tree": ["matrix", 1, 1, ["int", "1"]]}, {}, "d")[1][:42]
+    >>> compare_property({"tag": "matrix", "tree": ["Matrix", 1, 1, ["Integer", "1"]]}, {}, "d")[1][:42]
     'd is a matrix: the answer is your redesign'
     """
     na = not_answered(stu)

@@ -277,7 +277,7 @@ def _as_set(v):
 
 
 def reference_set(value):
-    """The reference value of a ``set`` answer as something ``srepr`` round-trips: a Set, a dict {symbol: Set} or
+    """The reference value of a ``set`` answer as something the wire format round-trips: a Set, a dict {symbol: Set} or
     a list of those, as it was given.
 
     >>> reference_set([0, 1]), reference_set({sp.Symbol("t"): [0]})

@@ -4,10 +4,10 @@
   matrices, is the list of spanning vectors (or blocks of them), side by side.
 * **wire form**: as :mod:`.expr` (``Matrix``, ``ndarray``, lists of vectors).
 * **describe** (:func:`describe_subspace`): the spanning vectors' values at the secret points; a constant exact
-  matrix also as its exact tree (:func:`kinlib.course.answers.exacttree.expr_tree`), compared exactly.
+  matrix also as its exact tree (:func:`kinlib.course.answers.wire.exact_dump`), compared exactly.
 * **compare** (:func:`compare_subspace`): each column normalised first (no scaling of a basis matters), then
   orthonormal bases of one dimension with principal angles ~0 between them, at every point; constant exact
-  bases by exact ranks (:func:`~.exacttree.exact_ranks`).
+  bases by exact ranks (:func:`exact_ranks`).
 * **reference** (:func:`reference_subspace`).
 """
 
@@ -18,15 +18,16 @@ import sympy as sp
 
 from . import fingerprints as fp
 from . import mistakes
-from .base import not_answered, symbol_notes, type_name, values_array
-from .exacttree import exact_ranks, expr_tree
+from .base import as_sympy, not_answered, symbol_notes, type_name, values_array
 from .expr import as_sympy_value, describe_expr, to_sympy
+from .wire import exact_dump, exact_load
 
 __all__ = [
     "describe_subspace",
     "compare_subspace",
     "reference_subspace",
     "exact_tree",
+    "exact_ranks",
     "SUBSPACE_TOL",
     "home_canon",
     "home_verdict",
@@ -40,10 +41,10 @@ def exact_tree(obj):
     """The exact tree of a spanning matrix (for a constant exact one: compared exactly), or None.
 
     >>> exact_tree([[1, 0], [0, 1]])[:3], exact_tree("not a matrix")
-    (['matrix', 2, 2], None)
+    (['Matrix', 2, 2], None)
     """
     try:
-        return expr_tree(to_sympy(obj, vectors=True)[1], max_nodes=600)
+        return exact_dump(to_sympy(obj, vectors=True)[1], max_nodes=600)
     except Exception:  # noqa: BLE001  (compared numerically then)
         return None
 
@@ -54,7 +55,7 @@ def describe_subspace(value, points, seed=0):
 
     >>> d = describe_subspace([[1, 0], [0, 1]], [{}])
     >>> d["shape"], d["tree"][:3]
-    ([2, 2], ['matrix', 2, 2])
+    ([2, 2], ['Matrix', 2, 2])
     """
     out = describe_expr(value, points, seed, vectors=True)
     if out.get("tag") == "matrix" and not out.get("symbols") and not out.get("has_float"):
@@ -74,6 +75,43 @@ def reference_subspace(value):
     if obj is None:
         raise TypeError(f"reference answer of kind 'subspace' is {tag} ({type_name(value)})")
     return obj
+
+
+def exact_ranks(stu_tree, ref_tree):
+    """(rank A, rank B, rank [A B]) computed exactly for two constant exact matrices given as exact trees
+    (:func:`exact_tree`; both sides must have one), or None (then the spans are compared numerically): when
+    a tree is missing or malformed, has symbols, or SymPy cannot decide whether a pivot is zero. Equal spans ⇔
+    rank A = rank B = rank [A B].
+
+    >>> exact_ranks(exact_tree([[1, 0, 10**30], [0, 0, 1]]), exact_tree([[0, 0, 1]])), exact_ranks(None, None)
+    ((2, 1, 2), None)
+    """
+    import sympy as sp
+
+    mats = []
+    for t in (stu_tree, ref_tree):
+        if not isinstance(t, list) or t[:1] != ["Matrix"]:
+            return None
+        try:
+            M = exact_load(t, max_nodes=600)
+        except (ValueError, TypeError, RecursionError):
+            return None
+        if not isinstance(M, sp.MatrixBase) or M.free_symbols or not (0 < M.rows <= 12 and 0 < M.cols <= 12):
+            return None
+        mats.append(M)
+    A, B = mats
+    if A.rows != B.rows:
+        return None
+    unsure = []
+
+    def iszero(x):
+        z = as_sympy(x).equals(0)
+        if z is None:
+            unsure.append(x)
+        return bool(z)
+
+    ranks = tuple(M.rank(iszerofunc=iszero) for M in (A, B, A.row_join(B)))
+    return None if unsure else ranks
 
 
 def _orthonormal(A):

@@ -33,6 +33,12 @@ T, ...]``
                                         :data:`SINGLETONS` (``["Pi"]``, ``["Reals"]``, ``["BooleanTrue"]``)
 ====================================  =================================================================
 
+**One format.** The same trees carry a student's answer out of a kernel (:func:`dump` is the kernel's own
+encoder, :func:`kinlib.course.grader.in_kernel.export.export`), the reference answers in the grader's signed
+cache (:func:`kinlib.course.answers.describe.dump_reference`) and, restricted to the subset a proof reads
+(numbers, symbols, π, +, ×, small powers, sin/cos/tan: :func:`exact_dump`, :func:`exact_load`), the exact
+matrices of ``property`` and ``subspace`` answers; every one is read back by :func:`load`.
+
 **Typed, never evaluated.** SymPy's constructors ``sympify`` their arguments, and ``sympify`` of a string is
 ``parse_expr``, i.e. ``eval``. So a SymPy node (``Matrix``, ``UndefinedFunction`` and every one of
 :data:`CLASSES`) is built only from arguments that are already SymPy objects made by this parser (numbers,
@@ -67,6 +73,9 @@ import unicodedata
 
 __all__ = [
     "load",
+    "dump",
+    "exact_dump",
+    "exact_load",
     "safe_name",
     "WireError",
     "Other",
@@ -462,3 +471,106 @@ def _check_power(base, exp):
         raise WireError(f"a power too large to compute (exponent {exp.p})")
     if isinstance(exp, sp.Rational) and abs(exp.p) > MAX_POWER // 10:
         raise WireError(f"a power too large to compute (exponent {exp.p})")
+
+
+# ----------------------------------------------------------------------------- encoding, and the exact subset
+
+
+def dump(value, max_nodes: int = MAX_NODES):
+    """``value`` as a tree of this format: the kernel's own encoder
+    (:func:`kinlib.course.grader.in_kernel.export.export`), so what the grader keeps (its reference answers) is
+    written exactly as a student's answer is; raises ValueError past ``max_nodes``.
+
+    >>> import sympy as sp
+    >>> dump(sp.pi / 2)
+    ['Mul', ['Rational', '1', '2'], ['Pi']]
+    >>> n = sp.Dummy("n")
+    >>> load(dump(sp.ImageSet(sp.Lambda(n, sp.pi * n), sp.Integers))).base_set
+    Integers
+    """
+    from ..grader.in_kernel.export import export
+
+    return export(value, max_nodes=max_nodes)
+
+
+_EXACT_FUNCS = ("sin", "cos", "tan")
+
+
+def _exact_node(e) -> None:
+    """Refuse (ValueError) a node outside the exact subset: numbers, symbols, π, +, ×, powers with a small
+    whole or half exponent, sin/cos/tan of one argument."""
+    import sympy as sp
+
+    if (
+        isinstance(e, (sp.Rational, sp.Float))
+        or e is sp.pi
+        or (isinstance(e, sp.Symbol) and not isinstance(e, sp.Dummy))
+    ):
+        return
+    if isinstance(e, (sp.Add, sp.Mul)):
+        return
+    if isinstance(e, sp.Pow):
+        x = sp.Rational(e.exp) if isinstance(e.exp, sp.Float) and e.exp.is_finite else e.exp  # its exact value
+        if x.is_Rational and abs(x.p) <= 12 and x.q <= 2:
+            return
+        raise ValueError("a power that is not a small whole number or half")
+    if type(e).__name__ in _EXACT_FUNCS and len(e.args) == 1:
+        return
+    raise ValueError(f"{type(e).__name__} is not supported here")
+
+
+def _exact_walk(obj, max_nodes: int) -> None:
+    import sympy as sp
+
+    stack = list(obj) if isinstance(obj, sp.MatrixBase) else [obj]
+    seen = 0
+    while stack:
+        e = stack.pop()
+        seen += 1
+        if seen > max_nodes:
+            raise ValueError(f"more than {max_nodes} nodes")
+        if not isinstance(e, sp.Basic):
+            raise ValueError(f"{type(e).__name__} is not supported here")
+        _exact_node(e)
+        stack += e.args if isinstance(e, (sp.Add, sp.Mul, sp.Pow, sp.Function)) else []
+
+
+def exact_dump(obj, max_nodes: int = 4000):
+    """A SymPy expression or matrix in the exact subset of the format (what a proof reads: numbers, symbols, π,
+    +, ×, small powers, sin/cos/tan), as its tree; ValueError for anything else or more than ``max_nodes`` nodes.
+
+    >>> import sympy as sp
+    >>> exact_dump(sp.Matrix([[sp.Symbol("L", positive=True), sp.pi]]))
+    ['Matrix', 1, 2, ['Symbol', 'L', {'positive': True}], ['Pi']]
+    >>> exact_dump(sp.exp(sp.Symbol("t")))
+    Traceback (most recent call last):
+    ...
+    ValueError: exp is not supported here
+    """
+    _exact_walk(obj, max_nodes)
+    return dump(obj, max_nodes=max_nodes)
+
+
+def exact_load(tree, max_nodes: int = 20_000):
+    """The value of an exact-subset tree (:func:`exact_dump`) read by :func:`load`, checked to be in the subset
+    (ValueError otherwise), with each symbol real (positive when it says so) and each Float its exact binary
+    value, as a proof takes them.
+
+    >>> exact_load(["Add", ["Rational", "1", "2"], ["cos", ["Symbol", "theta1", {}]]])
+    cos(theta1) + 1/2
+    >>> exact_load(["exp", ["Symbol", "t", {}]])
+    Traceback (most recent call last):
+    ...
+    ValueError: exp is not supported here
+    """
+    import sympy as sp
+
+    obj = load(tree, max_nodes=max_nodes)
+    if not isinstance(obj, (sp.Basic, sp.MatrixBase)):
+        raise ValueError(f"{type(obj).__name__} is not supported here")
+    _exact_walk(obj, max_nodes)
+    syms = {
+        s: sp.Symbol(s.name, positive=True) if s.is_positive else sp.Symbol(s.name, real=True) for s in obj.free_symbols
+    }
+    syms.update({f: sp.Rational(f) for f in obj.atoms(sp.Float)})
+    return obj.xreplace(syms)

@@ -31,8 +31,8 @@ How it works
   then ``solution`` code cells whose ``kinlib`` metadata lists ``answers`` and optional ``kinds``, as
   :mod:`kinlib.course.schema` reads them) the
   reference kernel (the grader's own, never a student's) exports each answer as data exactly as a student's
-  kernel does (below); the grader reads it and keeps it as ``sympy.srepr`` text (read back by the strict parser
-  :mod:`kinlib.course.answers.srepr`, never ``eval``); the result is
+  kernel does (below); the grader reads it and keeps it in the same wire format (read back by the same whitelist parser,
+  :func:`kinlib.course.answers.wire.load`, never ``eval``); the result is
   cached in ``--cache/<id>-<hash>.json`` with an HMAC tag keyed by the grader secret
   (:mod:`kinlib.course.grader.refdata`), keyed by the notebook's bytes and the checker's version. Points per part:
   ``points`` in the solution cell's ``kinlib`` metadata if present, else "(N points)" parsed from the
@@ -347,6 +347,7 @@ def _run_and_judge(job: Job, enc: Enclosure) -> list:
         out["restarts"] = run.restarts
         out["cells"] = [asdict(r) | {"part": part_of_cell.get(i, "")} for i, r in sorted(run.results.items())]
         out["output_bytes"] = sum(r.output_bytes for r in run.results.values())
+        out["output_dropped"] = sum(r.dropped for r in run.results.values())  # messages over the size cap
         out.setdefault("exact", {})
         return g.rows
     except Exception as exc:  # noqa: BLE001  a checker bug must not stop the batch, nor pass as a grade

@@ -98,7 +98,7 @@ def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS,
     separate request (``verdict.exact`` is then "?" when it applies); ``keep_value``: returns (verdict, value).
 
     >>> from kinlib.course.grader.refdata import Reference
-    >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
+    >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "tree": ["Pow", ["Symbol", "x", {}], ["Integer", "2"]],
     ...                                                      "symbols": {"x": {}}}})
     >>> pts = [{"x": 0.3}, {"x": -1.1}]
     >>> x2 = ["Pow", ["Symbol", "x", {}], ["Integer", "2"]]
@@ -107,7 +107,7 @@ def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS,
     >>> judge_answer("x2", "expr", {"tree": ["Infinity"]}, ref, pts, 0).message
     'x2 could not be evaluated at some joint values (division by zero, or undefined symbols?)'
     """
-    from .refdata import reference_description
+    from .refdata import reference_description, reference_value
 
     t0 = time.monotonic()
     pts = points[: n_points(kind)]
@@ -121,8 +121,8 @@ def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS,
         whose = "the comparison"
         ok, msg = compare.compare(kind, stu, rd, name)
         verdict = Verdict(name, "pass" if ok else "fail", msg if (ok and msg) or not ok else "")
-        if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "srepr" in ref.answers[name]:
-            verdict.exact = exact_check(value, ref.answers[name]["srepr"], EXACT_SECONDS) if exact else "?"
+        if ok and kind == "expr" and stu.get("tag") in ("matrix", "scalar") and "tree" in ref.answers[name]:
+            verdict.exact = exact_check(value, reference_value(ref, name), EXACT_SECONDS) if exact else "?"
     except (MemoryError, RecursionError) as exc:
         verdict = Verdict(name, "fail", f"{name} is too large to grade ({type(exc).__name__})")
     except Exception as exc:  # noqa: BLE001  a grader bug on one answer must not stop the submission
@@ -132,13 +132,13 @@ def judge_answer(name, kind, exported, ref, points, seed, seconds=JUDGE_SECONDS,
     return (verdict, value) if keep_value else verdict
 
 
-def exact_check(value, ref_text, seconds) -> str:
+def exact_check(value, ref_value, seconds) -> str:
     """'equal' | 'not proved' | 'not sympy' (advisory; ``seconds``: SymPy's simplify is not tried after it). Not
     tried on powers of sums with large exponents (expanding (a + b + c)**90 would take the grader's memory
     before its time limit). Its hard time limit is the judge process's (:mod:`.judging`): killed past it.
 
     >>> import sympy as sp
-    >>> exact_check(sp.sin(sp.Symbol("x"))**2 + sp.cos(sp.Symbol("x"))**2, "Integer(1)", 5)
+    >>> exact_check(sp.sin(sp.Symbol("x"))**2 + sp.cos(sp.Symbol("x"))**2, sp.Integer(1), 5)
     'equal'
     """
     import sympy as sp
@@ -149,6 +149,6 @@ def exact_check(value, ref_text, seconds) -> str:
     if any(p.base.is_Add and p.exp.is_Number and abs(p.exp) > 12 for p in obj.atoms(sp.Pow)):
         return "not proved"
     try:
-        return exact_equal(value, ref_text, budget=seconds / 2)
+        return exact_equal(value, ref_value, budget=seconds / 2)
     except Exception:  # noqa: BLE001
         return "not proved"

@@ -36,6 +36,7 @@ import time
 from dataclasses import asdict, is_dataclass
 from pathlib import Path
 
+from .isolation.limits import launch_prelude
 from .isolation.reap import kill_group
 from .judge import EXACT_SECONDS, JUDGE_SECONDS, Verdict
 
@@ -48,19 +49,6 @@ MAX_REPLY = 2**20  # bytes of one reply
 _STATUSES = ("pass", "fail", "error")
 _EXACT_WORDS = ("", "equal", "not proved", "timed out", "not sympy")
 
-_LAUNCH = (
-    "import resource, sys\n"
-    "def _lim(r, v):\n"
-    "    try:\n"
-    "        resource.setrlimit(r, (v, v))\n"
-    "    except (ValueError, OSError):\n"
-    "        pass\n"
-    "_lim(resource.RLIMIT_AS, {mem})\n"
-    "_lim(resource.RLIMIT_NOFILE, {nofile})\n"
-    "_lim(resource.RLIMIT_CORE, 0)\n"
-    "_lim(resource.RLIMIT_FSIZE, 0)\n"
-    "sys.path[:] = [{top!r}] + [p for p in sys.path if p not in ('', '.')]\n"
-)
 _MAIN = "from kinlib.course.grader.judging import _child\nsys.exit(_child())\n"
 
 
@@ -75,7 +63,7 @@ def judge_command(memory: int = MEMORY_BYTES, nofile: int = MAX_FILES, main: str
     import kinlib
 
     top = str(Path(kinlib.__file__).resolve().parent.parent)
-    code = _LAUNCH.format(mem=int(memory), nofile=int(nofile), top=top) + main
+    code = launch_prelude(memory, 0, nofile, path_first=top) + main
     return [sys.executable, "-P", "-B", "-c", code]
 
 
@@ -124,7 +112,7 @@ def _child() -> int:
         return 2
     from ..answers import describe  # noqa: F401  imported now: the parent's time limits count judging only
     from .judge import exact_check, judge_answer
-    from .refdata import Reference
+    from .refdata import Reference, reference_value
 
     ref = Reference(**init["ref"])
     points, seed = init["points"], init["seed"]
@@ -141,7 +129,7 @@ def _child() -> int:
             values = {msg["name"]: value}  # only the last answer's: kept for its exact check
             _send(out, {"status": v.status, "message": v.message, "exact": v.exact, "wants_exact": v.exact == "?"})
         elif msg.get("op") == "exact":
-            word = exact_check(values.get(msg["name"]), ref.answers[msg["name"]]["srepr"], float(msg["seconds"]))
+            word = exact_check(values.get(msg["name"]), reference_value(ref, msg["name"]), float(msg["seconds"]))
             _send(out, {"exact": word})
         else:
             return 0

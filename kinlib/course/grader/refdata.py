@@ -2,10 +2,13 @@
 
 * **Computed by the instructor's side only.** :func:`build_reference` executes a solution notebook in a
   kernel of the grader's own (instructor code; never a student kernel) and reads each answer as data:
-  a SymPy expression tree in ``srepr`` form, a choice's JSON value, the symbols and their assumptions.
-* **Data, never code.** The trees are read back with :func:`kinlib.course.parse_srepr`, a strict
-  parser (only SymPy class calls, singletons, numbers, lists, tuples and dicts; nothing is ``eval``-ed),
-  and evaluated at a submission's points here, in the grader (:func:`reference_description`).
+  a SymPy value as a tree of the one wire format (:func:`kinlib.course.answers.wire.dump`, the encoder a
+  student's kernel runs), a choice's JSON value, the symbols and their assumptions.
+* **Data, never code.** The trees are read back by the parser that reads a student's answer
+  (:func:`kinlib.course.answers.wire.load`: a whitelist with caps, nothing is ``eval``-ed), and evaluated at a
+  submission's points here, in the grader (:func:`reference_description`).
+* **Untrusted until verified.** A cache file whose tag does not verify, or that is not in this format (an
+  older version's ``srepr`` text, a tree the parser refuses), is ignored and rebuilt (:func:`read_cache`).
 * **Signed.** The cache (``<cache>/<id>-<hash>.json``) holds the reference and an HMAC-SHA256 tag keyed
   by the instructor's secret (:mod:`kinlib.course.grader.secret`); a file whose tag does not verify (edited,
   planted, or made with another secret) is ignored and rebuilt. The cache folder is never visible to a
@@ -26,7 +29,6 @@ from pathlib import Path
 
 from ..answers import describe, wire
 from ..answers.expr import to_sympy
-from ..answers.srepr import parse_srepr
 from ..answers.subspace import exact_tree
 from ..schema import notebook_id, notebook_title, parse_parts, stash_points
 from .isolation.kernel import SHIPPED, NotebookRun
@@ -40,11 +42,13 @@ __all__ = [
     "default_notebooks",
     "code_cells",
     "reference_description",
+    "reference_value",
+    "in_format",
     "read_cache",
     "reference_answers",
 ]
 
-GRADE_VERSION = "3"  # 3: answers exported as data (in_kernel.export), described in the grader
+GRADE_VERSION = "4"  # 3: answers exported as data (in_kernel.export), described in the grader; 4: key as wire trees
 _CACHE_PURPOSE = "kinlib-reference-cache"
 
 
@@ -56,7 +60,7 @@ class Reference:
 
     >>> ref = Reference("02_planar", "Planar arms", "notebooks/02_planar.ipynb", "0" * 64,
     ...                 parts=[{"part": "2.1", "points": 5.0, "answers": ["L"], "kinds": {"L": "expr"}}],
-    ...                 answers={"L": {"kind": "expr", "srepr": "Symbol('L', positive=True)",
+    ...                 answers={"L": {"kind": "expr", "tree": ["Symbol", "L", {"positive": True}],
     ...                                "symbols": {"L": {"positive": True}}}})
     >>> ref.error, [p["part"] for p in ref.parts]
     ('', ['2.1'])
@@ -67,7 +71,7 @@ class Reference:
     path: str
     sha: str
     parts: list  # [schema.Part as dict]
-    answers: dict  # name -> {"srepr"/"choice", "symbols"} or {"error"}
+    answers: dict  # name -> {"kind", "tree"/"choice", "symbols"} or {"error"}
     error: str = ""
 
 
@@ -92,7 +96,7 @@ def code_cells(nb: dict) -> list:
 
 def _hash(data: bytes) -> str:
     h = hashlib.sha256(data)
-    # every module that reads and describes an answer (the answers package: kinds, wire, srepr, ...)
+    # every module that reads and describes an answer (the answers package: kinds, wire, ...)
     host = [p.read_text() for p in sorted(Path(describe.__file__).parent.glob("*.py"))]
     for s in (*SHIPPED.values(), *host, GRADE_VERSION):
         h.update(s.encode())
@@ -118,9 +122,33 @@ def read_cache(cfile: Path, secret: bytes, sha: str) -> Reference | None:
         ref = d["reference"]
         if not verify(secret, _CACHE_PURPOSE, _canonical(ref), d.get("mac")) or ref.get("sha") != sha:
             return None
-        return Reference(**ref)
-    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        ref = Reference(**ref)
+        return ref if in_format(ref) else None
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, RecursionError):
         return None
+
+
+def in_format(ref: Reference) -> bool:
+    """Whether every answer of ``ref`` is in this version's format: an error, a choice, or a wire tree that
+    :func:`kinlib.course.answers.wire.load` reads (an older cache's ``srepr`` text is not: rebuilt).
+
+    >>> in_format(Reference("n", "t", "p", "0", [], {"a": {"kind": "expr", "srepr": "Integer(1)", "symbols": {}}}))
+    False
+    """
+    if not isinstance(ref.answers, dict):
+        return False
+    for name, a in ref.answers.items():
+        if not isinstance(a, dict) or "srepr" in a:
+            return False
+        if "error" in a or "choice" in a:
+            continue
+        if not isinstance(a.get("kind"), str):
+            return False
+        try:
+            reference_value(ref, name)
+        except (wire.WireError, RecursionError):
+            return False
+    return True
 
 
 def _write_cache(cfile: Path, secret: bytes, ref: Reference) -> None:
@@ -132,7 +160,7 @@ def _write_cache(cfile: Path, secret: bytes, ref: Reference) -> None:
 
 
 def reference_answers(exported: dict, kinds: dict) -> dict:
-    """{name: {"kind", "srepr", "symbols"} | {"kind", "choice"} | {"error"}} for the reference answers ``kinds`` =
+    """{name: {"kind", "tree", "symbols"} | {"kind", "choice"} | {"error"}} for the reference answers ``kinds`` =
     {name: kind}, from what the reference kernel exported (``{"tree": ...}`` per name, as
     :func:`kinlib.course.grader.in_kernel.export.export_answer` writes it): each read by the same parser as a
     student's (:func:`kinlib.course.answers.wire.load`) and normalised here (:func:`~kinlib.course.answers.describe.dump_reference`).
@@ -188,10 +216,10 @@ def _run_solution(path: Path, nb: dict, kinds: dict, timeout: float) -> tuple[di
     if missing and not err:
         err = "; ".join(missing)[:1000]
     for n, a in ans.items():  # the key must read back as data now, not fail later at grading time
-        if "srepr" in a and not err:
+        if "tree" in a and not err:
             try:
-                parse_srepr(a["srepr"])
-            except ValueError as exc:
+                wire.load(a["tree"], max_nodes=10 * wire.MAX_NODES)
+            except (wire.WireError, RecursionError) as exc:
                 err = f"{n}: {exc}"
     return ans, err
 
@@ -312,11 +340,33 @@ def _fast_expr(obj):
     return tmpl, values
 
 
+def reference_value(ref: Reference, name: str):
+    """The reference answer ``name`` as a SymPy value (or a dict of them): its wire tree read back by
+    :func:`kinlib.course.answers.wire.load`, the parser that reads a student's answer (never ``eval``).
+
+    >>> reference_value(Reference("n", "t", "p", "0", [], {"L": {"kind": "expr", "tree": ["Symbol", "L", {}]}}), "L")
+    L
+    """
+    import sympy as sp
+
+    value = wire.load(ref.answers[name]["tree"], max_nodes=10 * wire.MAX_NODES)
+    stack = [value]  # SymPy values, in dicts (keyed by name or symbol) and lists: no plain data the key never holds
+    while stack:
+        v = stack.pop()
+        if isinstance(v, dict):
+            stack += [k for k in v if not isinstance(k, str)] + list(v.values())
+        elif isinstance(v, (list, tuple)):
+            stack += list(v)
+        elif not isinstance(v, (sp.Basic, sp.MatrixBase)):
+            raise wire.WireError(f"a reference answer holds a {type(v).__name__}, not SymPy values")
+    return value
+
+
 def reference_description(ref: Reference, name: str, kind: str, points: list, seed: int) -> dict:
     """The reference answer ``name`` described like a student's, at ``points`` (the same code path as a
     student's, :func:`kinlib.course.answers.describe.describe`; the parsed tree and its lambdified form are cached per process).
 
-    >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "srepr": "Pow(Symbol('x'), Integer(2))",
+    >>> ref = Reference("n", "t", "p", "0" * 64, [], {"x2": {"kind": "expr", "tree": ["Pow", ["Symbol", "x", {}], ["Integer", "2"]],
     ...                                                      "symbols": {"x": {}}}})
     >>> reference_description(ref, "x2", "expr", [{"x": 3.0}], 0)["values"]
     [[[9.0, 0.0]]]
@@ -324,9 +374,9 @@ def reference_description(ref: Reference, name: str, kind: str, points: list, se
     a = ref.answers[name]
     if "choice" in a:
         return a["choice"]
-    key = (name, a["srepr"])  # by the text itself: a different text is never served from this cache
+    key = (name, _canonical({"t": a["tree"]}))  # by the tree itself: a different tree is never served from here
     if key not in _PARSED:
-        obj = parse_srepr(a["srepr"])
+        obj = reference_value(ref, name)
         fast = (
             _fast_expr(obj)
             if kind in ("expr", "subspace") and obj is not None and to_sympy(obj)[0] in ("matrix", "scalar")

@@ -185,6 +185,9 @@ def _feedback_cells(res: dict) -> list[str]:
         ]
     if res.get("output_bytes", 0) > 1_000_000:
         lines.append(f"- your notebook printed {res['output_bytes'] / 1e6:.1f} MB of output (not kept)")
+    if res.get("output_dropped", 0):
+        n = res["output_dropped"]
+        lines.append(f"- {n} output message(s) of your notebook were over the grader's size cap and were not read")
     return lines
 
 

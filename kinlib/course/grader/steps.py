@@ -81,6 +81,11 @@ class Grading:
 
 
 def _execute(g: Grading) -> None:
+    try:  # the answers' result files first: a submission that fills its disk cannot take their space
+        g.run.reserve(1 + sum(len(p["answers"]) for p in g.parts))
+    except OSError as exc:  # the disk was full before any cell ran: the grader's problem, never the student's
+        g.fatal = g.out["infrastructure"] = f"infrastructure: no space for the answers' files ({exc.strerror})"
+        return
     try:
         g.run.execute()
     except KernelStartError as exc:

@@ -33,10 +33,12 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
+import zmq
 from jupyter_client import BlockingKernelClient
 from jupyter_client.connect import write_connection_file
 
 from ...schema import cell_source, is_plain_selfcheck
+from .limits import launch_prelude
 from .reap import kill_group
 from .sandbox import font_cache
 
@@ -60,8 +62,15 @@ IN_KERNEL_MODULES = ("guard", "export")
 SHIPPED = {name: (IN_KERNEL_DIR / f"{name}.py").read_text() for name in IN_KERNEL_MODULES}
 MAX_RESTARTS = 2  # kernel restarts per notebook (past cells that kill it)
 MAX_RESULT_BYTES = 5 * 2**20  # the largest JSON result read back from the kernel
+RESERVED_BYTES = 2**20  # disk reserved per result file before any cell runs (NotebookRun.reserve)
 START_ATTEMPTS = 3  # tries to start a kernel before it is an infrastructure failure
 MAX_FILES = 1024  # open files per kernel process (RLIMIT_NOFILE) without an enclosure's limits
+# What the grader reads from a kernel is bounded whatever the kernel sends (an IOPub flood: print or display of
+# hundreds of MB): ZeroMQ refuses a message over MAX_MESSAGE_BYTES before the grader holds it (it drops the
+# connection, which ZeroMQ makes again; the drop is counted and flagged on the cell), and queues at most
+# MAX_QUEUED messages per channel, so a client holds at most about MAX_QUEUED x MAX_MESSAGE_BYTES per channel.
+MAX_MESSAGE_BYTES = 16 * 2**20
+MAX_QUEUED = 8
 
 
 class KernelStartError(RuntimeError):
@@ -72,23 +81,7 @@ class KernelStartError(RuntimeError):
     """
 
 
-_LAUNCH = (
-    "import resource, sys\n"
-    "def _lim(r, v):\n"
-    "    try:\n"
-    "        resource.setrlimit(r, (v, v))\n"
-    "    except (ValueError, OSError):\n"
-    "        pass\n"
-    "_lim(resource.RLIMIT_AS, {mem})\n"
-    "_lim(resource.RLIMIT_FSIZE, {fsize})\n"
-    "_lim(resource.RLIMIT_CORE, 0)\n"
-    "_lim(resource.RLIMIT_NOFILE, {nofile})\n"
-    "if {nproc}:\n"
-    "    _lim(resource.RLIMIT_NPROC, {nproc})\n"
-    "sys.path[:] = [p for p in sys.path if p not in ('', '.')]\n"
-    "from ipykernel import kernelapp as app\n"
-    "app.launch_new_instance()\n"
-)
+_KERNEL_MAIN = "from ipykernel import kernelapp as app\napp.launch_new_instance()\n"  # after limits.launch_prelude
 
 
 def _cpu_seconds(pid) -> float:
@@ -106,7 +99,7 @@ class CellResult:
     """What happened when one cell ran: status ok | error | timeout | died | skipped.
 
     >>> CellResult(0, "ok")
-    CellResult(index=0, status='ok', ename='', evalue='', seconds=0.0, output_bytes=0, note='')
+    CellResult(index=0, status='ok', ename='', evalue='', seconds=0.0, output_bytes=0, note='', dropped=0)
     >>> CellResult(4, "timeout", note="stopped after the 60 s limit for one cell").summary()
     'stopped after the 60 s limit for one cell'
     """
@@ -118,6 +111,7 @@ class CellResult:
     seconds: float = 0.0
     output_bytes: int = 0
     note: str = ""
+    dropped: int = 0  # output messages refused as over the size cap (ZeroMQ dropped the connection)
 
     def summary(self) -> str:
         """One line for a person: "ran", "raised E: v", or the note.
@@ -169,6 +163,7 @@ class Kernel:
     record: list | None = None  # sandbox.sandbox_record: [pid namespace, init PID, its start time]
     start_failures: int = 0
     cpu_seconds: float = 0.0  # CPU time the kernel process (and what it waited for) used, read when it is killed
+    monitor: object | None = None  # ZeroMQ events of the IOPub socket (a connection dropped: a message over the cap)
 
     def start(self) -> None:
         """Launch the kernel and wait until it answers, retrying (:data:`START_ATTEMPTS` tries); raise
@@ -192,7 +187,7 @@ class Kernel:
             rl = self.enclosure.rlimits()
             mem, fsize, nproc = int(rl["as"]), int(rl["fsize"]), int(rl.get("nproc", 0))
             nofile = int(rl.get("nofile", MAX_FILES))
-        code = _LAUNCH.format(mem=mem, fsize=fsize, nproc=nproc, nofile=nofile)
+        code = launch_prelude(mem, fsize, nofile, nproc) + _KERNEL_MAIN
         argv = [sys.executable, "-P", "-B", "-c", code, "-f", connection_file, "--HistoryManager.enabled=False"]
         return argv + ["--IPKernelApp.log_level=ERROR", "--Application.log_level=ERROR"]
 
@@ -263,9 +258,10 @@ class Kernel:
             self.record = sandbox_record(self.info)
             if self.record is None:
                 raise KernelStartError(f"the sandbox did not start (bwrap exit status {self.proc.poll()})")
-        self.kc = BlockingKernelClient(connection_file=fn)
+        self.kc = BlockingKernelClient(connection_file=fn, context=capped_context())
         self.kc.load_connection_file()
         self.kc.start_channels(hb=False)
+        self.monitor = self.kc.iopub_channel.socket.get_monitor_socket(_DROPPED_EVENTS)
 
     def _wait_ready(self, deadline: float) -> None:
         """kernel_info until it is answered and IOPub delivers; alive means ``proc.poll()`` is None."""
@@ -303,10 +299,14 @@ class Kernel:
         waiting until no process of it is left)."""
         if self.kc is not None:
             try:
+                if self.monitor is not None:
+                    self.kc.iopub_channel.socket.disable_monitor()
+                    self.monitor.close(0)
                 self.kc.stop_channels()
+                self.kc.context.destroy(linger=0)
             except Exception:  # noqa: BLE001
                 pass
-            self.kc = None
+            self.kc, self.monitor = None, None
         if self.proc is not None:
             if self.proc.poll() is None:
                 self.cpu_seconds += _cpu_seconds(self._kernel_pid())
@@ -411,12 +411,56 @@ class Kernel:
                 break
             if not idle:
                 idle = self._take_output(msg_id, res, 0.1 if replied else 0.05)
+                self._reconnect_if_dropped(res)
             if not replied and self._take_reply(msg_id, res, 0.1 if idle else 0):
                 replied, replied_at = True, time.monotonic()
         if res.status == "timeout" and interrupted_at is not None and self.alive():
             res.ename = "TimeoutError"
+        self._reconnect_if_dropped(res)
+        if res.dropped and not res.note:
+            res.note = f"output over {MAX_MESSAGE_BYTES // 2**20} MB in one message was not read (dropped)"
         res.seconds = time.monotonic() - t0
         return res
+
+    def _reconnect_if_dropped(self, res) -> None:
+        """When ZeroMQ dropped the IOPub connection (a message over :data:`MAX_MESSAGE_BYTES`), count it on
+        ``res`` and connect a fresh IOPub socket (the dropped one is not made again)."""
+        n = 0
+        while self.monitor is not None and self.monitor.poll(0):
+            try:
+                self.monitor.recv_multipart(zmq.NOBLOCK)
+            except zmq.ZMQError:
+                break
+            n += 1
+        if not n or self.kc is None:
+            return
+        res.dropped += n
+        channel = self.kc.iopub_channel
+        old = channel.socket
+        old.disable_monitor()
+        self.monitor.close(0)
+        channel.socket = self.kc.connect_iopub()
+        self.monitor = channel.socket.get_monitor_socket(_DROPPED_EVENTS)
+        old.close(0)
+
+
+def capped_context():
+    """A ZeroMQ context whose sockets refuse a message over :data:`MAX_MESSAGE_BYTES` and queue at most
+    :data:`MAX_QUEUED` messages (the grader's kernel clients; defaults of every socket made from it).
+
+    >>> ctx = capped_context()
+    >>> ctx.socket(zmq.SUB).getsockopt(zmq.MAXMSGSIZE) == MAX_MESSAGE_BYTES
+    True
+    >>> ctx.term()
+    """
+    ctx = zmq.Context()
+    ctx.setsockopt(zmq.MAXMSGSIZE, MAX_MESSAGE_BYTES)
+    ctx.setsockopt(zmq.RCVHWM, MAX_QUEUED)
+    ctx.setsockopt(zmq.LINGER, 0)
+    return ctx
+
+
+_DROPPED_EVENTS = zmq.EVENT_DISCONNECTED
 
 
 def _message_of(get, msg_id: str, wait: float):
@@ -519,6 +563,7 @@ class NotebookRun:
         self.start_failures = 0
         self.cpu_seconds = 0.0  # of every kernel this run started (read as each is stopped)
         self.nonce = "_kinlib_grade_" + os.urandom(8).hex()
+        self.reserved: list = []  # result files allocated before any cell ran (reserve), used by call in order
         self.kernel = None
         self.results: dict = {}
         self.restarts = 0
@@ -586,12 +631,43 @@ class NotebookRun:
                 if j not in skip:
                     del self.results[j]
 
+    def reserve(self, n: int) -> None:
+        """Allocate ``n`` result files of :data:`RESERVED_BYTES` in ``tmp`` now, before any cell runs: a
+        submission that fills its disk (``tmp`` may be on its own tmpfs, or one it shares) cannot take the space
+        its answers are written to (the kernel writes them in place, :func:`~..in_kernel.export.export_answer`).
+        Raises OSError (ENOSPC: the disk was full before the submission ran) when it cannot.
+
+        >>> import tempfile
+        >>> run = NotebookRun([], cwd=".", tmp=tempfile.mkdtemp(), cell_timeout=5, total_timeout=30)
+        >>> run.reserve(2); [os.path.getsize(p) for p in run.reserved]
+        [1048576, 1048576]
+        """
+        for _ in range(n):
+            path = os.path.join(self.tmp, "r-" + os.urandom(8).hex() + ".json")
+            fd = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW, 0o600)
+            try:
+                os.posix_fallocate(fd, 0, RESERVED_BYTES)
+                os.fchmod(fd, 0o666)  # the kernel (maybe the student's user) writes it in place
+            finally:
+                os.close(fd)
+            self.reserved.append(path)
+
     def call(self, expr: str, timeout: float) -> tuple[dict | None, str]:
         """Run ``export.<expr with PATH>`` in the kernel (:mod:`kinlib.course.grader.in_kernel.export`); return
-        (JSON result, error text). ``expr`` names only answers: never a point, seed or reference."""
+        (JSON result, error text). ``expr`` names only answers: never a point, seed or reference. PATH is the
+        next file :meth:`reserve` allocated (else a new one), removed once read."""
         if self.kernel is None or not self.kernel.alive():
             return None, "the kernel was not running"
-        path = os.path.join(self.tmp, "r-" + os.urandom(8).hex() + ".json")
+        path = self.reserved.pop(0) if self.reserved else os.path.join(self.tmp, "r-" + os.urandom(8).hex() + ".json")
+        try:
+            return self._call(expr, path, timeout)
+        finally:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
+
+    def _call(self, expr: str, path: str, timeout: float) -> tuple[dict | None, str]:
         r = self.kernel.run(f"{self._m()}.{expr.replace('PATH', repr(path))}", timeout=timeout, silent=True)
         if r.status != "ok":
             return None, r.summary()

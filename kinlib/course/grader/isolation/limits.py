@@ -36,9 +36,39 @@ from pathlib import Path
 
 from .reap import kill_until_gone
 
-__all__ = ["Limits", "Enclosure", "parse_size", "cgroup_support", "kill_cgroup", "release"]
+__all__ = ["Limits", "Enclosure", "parse_size", "cgroup_support", "kill_cgroup", "release", "launch_prelude"]
 
 MS_NOSUID, MS_NODEV, MNT_DETACH = 2, 4, 2
+
+
+def launch_prelude(mem: int, fsize: int, nofile: int, nproc: int = 0, path_first: str | None = None) -> str:
+    """The first lines of ``python -c`` for a process the grader starts on student data (a kernel, a judge):
+    its own rlimits (address space, file size, no core, open files, processes when ``nproc``), then ``sys.path``
+    without the working directory (``path_first`` in front when given). What follows is the process's own code.
+
+    >>> code = launch_prelude(2**30, 0, 64, path_first="/src")
+    >>> "RLIMIT_AS, 1073741824" in code and "RLIMIT_NPROC" not in code and "['/src']" in code
+    True
+    """
+    lines = [
+        "import resource, sys",
+        "def _lim(r, v):",
+        "    try:",
+        "        resource.setrlimit(r, (v, v))",
+        "    except (ValueError, OSError):",
+        "        pass",
+        f"_lim(resource.RLIMIT_AS, {int(mem)})",
+        f"_lim(resource.RLIMIT_FSIZE, {int(fsize)})",
+        "_lim(resource.RLIMIT_CORE, 0)",
+        f"_lim(resource.RLIMIT_NOFILE, {int(nofile)})",
+    ]
+    if nproc:
+        lines.append(f"_lim(resource.RLIMIT_NPROC, {int(nproc)})")
+    first = f"[{path_first!r}] + " if path_first else ""
+    lines.append(f"sys.path[:] = {first}[p for p in sys.path if p not in ('', '.')]")
+    return "\n".join(lines) + "\n"
+
+
 _CG2 = Path("/sys/fs/cgroup")
 _SUPPORT: dict = {}
 
