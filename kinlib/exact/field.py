@@ -63,7 +63,7 @@ class NotExact(ValueError):
     >>> ExactField([sp.sin(sp.sqrt(2))])   # an angle √2: no exact zero test (a ValueError)
     Traceback (most recent call last):
     ...
-    kinlib.exactfield.NotExact: the angle sqrt(2) is not a rational number plus a rational multiple of π
+    kinlib.exact.field.NotExact: the angle sqrt(2) is not a rational number plus a rational multiple of π
     """
 
 

@@ -539,7 +539,7 @@ def budget_seconds(time_budget: Any, name: str = "time_budget") -> float | None:
     except (TypeError, ValueError):
         value = None
     if value is None or not value >= 0:
-        from ._backend import describe
+        from .._backend import describe
 
         raise ValueError(f"{name} must be a number of seconds ≥ 0 (or None: no limit), got {describe(time_budget)}")
     return None if value == float("inf") else value

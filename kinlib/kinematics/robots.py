@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ._backend import describe, exact_number
+from .._backend import describe, exact_number
 from .chains import SerialChain
 
 __all__ = [
@@ -272,7 +272,7 @@ def _rational_cos_sin(a: sp.Rational) -> tuple[sp.Rational, sp.Rational]:
     """(cos â, sin â) = ((1 − t²)/(1 + t²), 2t/(1 + t²)) for the rational t of smallest denominator
     (a continued-fraction convergent of tan(a/2), computed with 50 digits) with |â − a| ≤ URDF_ANGLE_TOL
     (modulo 2π): an exact rational point on the unit circle at the typed angle, to 1e-18 rad."""
-    from .exactfield import mp_context
+    from ..exact.field import mp_context
 
     mpmath = mp_context()  # this thread's own mpmath context: never the global precision
 

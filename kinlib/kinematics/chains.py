@@ -13,7 +13,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from ._backend import (
+from .._backend import (
     as_matrix,
     as_screw_list,
     as_thetas,
@@ -23,12 +23,12 @@ from ._backend import (
     is_symbolic,
     joint_symbols,
 )
-from .codegen import CompiledMatrix
+from ..fast.codegen import CompiledMatrix
+from ..fast.tape import Tape
 from .jacobians import jacobian_body as _jacobian_body
 from .jacobians import jacobian_space as _jacobian_space
 from .poe import checked_screw_list, fk_body, fk_space
 from .rigid import adjoint, check_se3, cross, skew, trans_inv
-from .tape import Tape
 
 __all__ = ["fk_space", "fk_body", "SerialChain"]
 

@@ -44,8 +44,8 @@ from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.precedence import precedence
 from sympy.printing.pycode import PythonCodePrinter
 
+from .._backend import describe
 from . import native
-from ._backend import describe
 from .native import ArithmeticRules
 
 __all__ = ["CompiledMatrix", "javascript_function"]
