@@ -2,6 +2,6 @@
 (``singularities``) and by numerical search (``singular_search``), manipulability and the one "near a
 singularity" rule (``manipulability``, ``nearsingular``), velocity kinematics and statics (``velocity``).
 
-Built on ``kinlib.kinematics`` and the exact engine (``kinlib.exact``); the pictures (``kinlib.plotting``,
+Builds on ``kinlib.kinematics`` and the exact engine (``kinlib.exact``); the pictures (``kinlib.plotting``,
 ``kinlib.widgets``) and the course (``kinlib.course``) build on it.
 """

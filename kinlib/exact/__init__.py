@@ -6,7 +6,7 @@ at a configuration (``linalg``: ``rank_at``, ``column_space``, ``left_null_space
 60-digit fallback (``fallback``), simplification for display (``display``) and time budgets that never touch
 the process they limit (``budget``).
 
-Imports only ``kinlib._backend``; ``kinlib.kinematics`` and ``kinlib.analysis`` build on it. This package
+Builds on ``kinlib._backend`` only; ``kinlib.kinematics`` and ``kinlib.analysis`` build on it. This package
 re-exports ``linalg``'s names: ``kinlib.exact`` was that module before the core was laid out by job (issue 32).
 
 >>> from kinlib.exact import rank_at

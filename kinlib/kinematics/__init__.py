@@ -2,6 +2,6 @@
 twists (``screws``), the product of exponentials (``poe``), the space, body and geometric Jacobians
 (``jacobians``), serial chains (``chains``) and the course's robots, URDF joints included (``robots``).
 
-Built on the exact engine (``kinlib.exact``) and the generated code (``kinlib.fast``); ``kinlib.analysis``
+Builds on the exact engine (``kinlib.exact``) and the generated code (``kinlib.fast``); ``kinlib.analysis``
 builds on it.
 """
