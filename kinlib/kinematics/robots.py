@@ -22,6 +22,7 @@ __all__ = [
     "planar_rpp",
     "ur5",
     "puma560",
+    "stanford",
     "length",
     "from_urdf_joints",
 ]
@@ -260,6 +261,35 @@ def puma560(a2=None, d3=None, a3=None, d4=None) -> SerialChain:
         joint_points=sp.Matrix.hstack(*pts),
         description="PUMA 560 (Corke's standard DH parameters)",
     )
+
+
+def stanford(H=None, D=None) -> SerialChain:
+    """A Stanford-type arm (RRPRRR): a base joint about z_s, a shoulder about x at height ``H``, a slide along
+    y_s, and a wrist of three axes (y, x, y) through the shoulder point (0, 0, H), the slide retracted at θ = 0;
+    the tool at (0, D, H). Defaults H = 1, D = 1/2, exact: the arm of kinlib's exact-rank tests and benchmark.
+
+    At θ5 = 0 (and π) the axes of joints 4 and 6 line up, and J_s's columns 4 and 6 are equal: a wrist
+    singularity.
+
+    >>> import sympy as sp
+    >>> r = stanford()
+    >>> r.joint_types
+    'RRPRRR'
+    >>> J = r.jacobian_space([1, 2, sp.Rational(1, 3), 4, 0, 6])
+    >>> J[:, 3] == J[:, 5]
+    True
+    """
+    H = sp.Integer(1) if H is None else length(H, "H")
+    D = sp.Rational(1, 2) if D is None else length(D, "D")
+    S = _cols(
+        [0, 0, 1, 0, 0, 0],
+        [1, 0, 0, 0, H, 0],
+        [0, 0, 0, 0, 1, 0],
+        [0, 1, 0, -H, 0, 0],
+        [1, 0, 0, 0, H, 0],
+        [0, 1, 0, -H, 0, 0],
+    )
+    return SerialChain(_T([0, D, H]), S, name="stanford", description="Stanford-type RRPRRR arm")
 
 
 # --- issue 11, item 6: a student's own arm from URDF joint placements --------------------------------
