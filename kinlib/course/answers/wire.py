@@ -386,7 +386,7 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
             raise WireError("a fraction with denominator 0")
         return sp.Rational(p, q)
     if op == "Float" and len(args) == 2:
-        return _float(args, text, small)
+        return _sympy_float(args, text, small)
     if op == "Symbol" and len(args) == 2:
         return sp.Symbol(_name(args[0]), **_assumptions(args[1]))
     if op == "Dummy" and len(args) == 3:
@@ -402,7 +402,7 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
         except (TypeError, ValueError):
             raise WireError("UndefinedFunction could not be rebuilt") from None
     if op == "Matrix" and len(args) >= 2:
-        return _matrix(args, build, small)
+        return _sympy_matrix(args, build, small)
     if op in SINGLETONS and not args:
         return getattr(sp.S, _SINGLETON_ATTR.get(op, op))
     cls = classes.get(op)
@@ -422,7 +422,7 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
     return _check_number(made) if isinstance(made, sp.Number) else made
 
 
-def _float(args, text, small):
+def _sympy_float(args, text, small):
     """A Float from its digits (mpmath's number syntax, checked character by character; never eval) and precision."""
     import sympy as sp
 
@@ -436,7 +436,7 @@ def _float(args, text, small):
     return _check_number(made)
 
 
-def _matrix(args, build, small):
+def _sympy_matrix(args, build, small):
     """A Matrix from its shape and at most MAX_ENTRIES entries, each a SymPy value."""
     import sympy as sp
 
