@@ -828,16 +828,6 @@ def urdf_section(args, targets: Targets) -> list[str]:
     return lines
 
 
-_STANFORD = [
-    [0, 0, 1, 0, 0, 0],
-    [1, 0, 0, 0, 1, 0],
-    [0, 0, 0, 0, 1, 0],
-    [0, 1, 0, -1, 0, 0],
-    [1, 0, 0, 0, 1, 0],
-    [0, 1, 0, -1, 0, 0],
-]
-
-
 def exact_section(args, targets: Targets) -> list[str]:
     """Exact rank, column space and left null space at configurations of 6-joint arms (kinlib.exact)."""
     from kinlib.exact import column_space, left_null_space, rank_at
@@ -849,9 +839,7 @@ def exact_section(args, targets: Targets) -> list[str]:
         "(or, beyond the exact budget, 60-digit numerics, flagged).",
         "",
     ]
-    M = sp.eye(4)
-    M[:3, 3] = sp.Matrix([0, sp.Rational(1, 2), 1])
-    stanford = kinlib.SerialChain(M, _STANFORD, name="stanford")
+    stanford = robots.stanford()
     R = sp.Rational
     cases = [
         ("Stanford RRPRRR", stanford, "J_s", (1, 2, 3, 4, 5, 6)),

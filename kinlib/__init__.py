@@ -15,11 +15,36 @@ all the measures). Plotting and widgets live in ``kinlib.plotting`` and ``kinlib
 [2.0, 1.0]
 """
 
-from . import manipulability, robots, taskspace
-from .chains import SerialChain, fk_body, fk_space
-from .display import is_identically_zero, simplify_for_display
-from .exact import ConditionalResultWarning, NumericFallbackWarning, Rank
-from .jacobians import (
+import importlib
+import sys
+
+from .analysis import manipulability, taskspace
+from .analysis.manipulability import condition_number, isotropy, twist_speed_form, velocity_ellipsoid
+from .analysis.singular_search import SingularPoints, find_singularities
+from .analysis.singularities import (
+    IncompleteResultWarning,
+    SingularSet,
+    column_space,
+    evaluate_at,
+    left_null_space,
+    rank_at,
+    singular_configurations,
+    task_rows,
+)
+from .analysis.velocity import (
+    PinvReport,
+    SingularityWarning,
+    damped_least_squares,
+    force_ellipsoid,
+    inverse_velocity,
+    joint_torques,
+    pseudoinverse,
+)
+from .exact.display import is_identically_zero, simplify_for_display
+from .exact.linalg import ConditionalResultWarning, NumericFallbackWarning, Rank
+from .kinematics import robots
+from .kinematics.chains import SerialChain, fk_body, fk_space
+from .kinematics.jacobians import (
     angular_first,
     body_to_geometric,
     body_to_space,
@@ -33,29 +58,58 @@ from .jacobians import (
     space_to_body,
     space_to_geometric,
 )
-from .manipulability import condition_number, isotropy, twist_speed_form, velocity_ellipsoid
-from .rigid import adjoint, check_se3, check_so3, exp3, log3, rp_to_trans, skew, trans_inv, trans_to_rp, unskew
-from .screws import bracket, exp6, log6, screw_axis, screw_prismatic, screw_revolute, unbracket
-from .singular_search import SingularPoints, find_singularities
-from .singularities import (
-    IncompleteResultWarning,
-    SingularSet,
-    column_space,
-    evaluate_at,
-    left_null_space,
-    rank_at,
-    singular_configurations,
-    task_rows,
+from .kinematics.rigid import (
+    adjoint,
+    check_se3,
+    check_so3,
+    exp3,
+    log3,
+    rp_to_trans,
+    skew,
+    trans_inv,
+    trans_to_rp,
+    unskew,
 )
-from .velocity import (
-    PinvReport,
-    SingularityWarning,
-    damped_least_squares,
-    force_ellipsoid,
-    inverse_velocity,
-    joint_torques,
-    pseudoinverse,
-)
+from .kinematics.screws import bracket, exp6, log6, screw_axis, screw_prismatic, screw_revolute, unbracket
+
+#: Where each module of the flat layout (before issue 32 laid the core out by job) lives now. The old paths
+#: stay importable and are the same module objects (``kinlib.poe is kinlib.kinematics.poe``), so
+#: ``import kinlib.poe``, ``from kinlib.native import ...`` and monkeypatching through either name work.
+#: ``kinlib.exact`` is now the engine's package; it re-exports what the module ``kinlib.exact`` exported.
+MOVED = {
+    "rigid": "kinematics.rigid",
+    "screws": "kinematics.screws",
+    "poe": "kinematics.poe",
+    "jacobians": "kinematics.jacobians",
+    "chains": "kinematics.chains",
+    "robots": "kinematics.robots",
+    "taskspace": "analysis.taskspace",
+    "singularities": "analysis.singularities",
+    "singular_search": "analysis.singular_search",
+    "nearsingular": "analysis.nearsingular",
+    "manipulability": "analysis.manipulability",
+    "velocity": "analysis.velocity",
+    "exact_rank": "exact.rank",
+    "exactfield": "exact.field",
+    "trigpoly": "exact.trigpoly",
+    "trigsign": "exact.trigsign",
+    "fallback": "exact.fallback",
+    "display": "exact.display",
+    "budget": "exact.budget",
+    "tape": "fast.tape",
+    "codegen": "fast.codegen",
+    "native": "fast.native",
+}
+
+
+def _alias_old_paths() -> None:
+    for old, new in MOVED.items():
+        module = importlib.import_module(f"{__name__}.{new}")
+        sys.modules.setdefault(f"{__name__}.{old}", module)
+        globals().setdefault(old, module)
+
+
+_alias_old_paths()
 
 __version__ = "0.1.0"
 

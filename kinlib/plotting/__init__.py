@@ -60,8 +60,8 @@ functions), :mod:`~kinlib.plotting.plots` (bar charts, directions, manipulabilit
 
 from __future__ import annotations
 
-from ..manipulability import manipulability_values
-from ..taskspace import ROW_LABELS, ROW_NAMES, ROW_TEX, is_planar, task_row_indices
+from ..analysis.manipulability import manipulability_values
+from ..analysis.taskspace import ROW_LABELS, ROW_NAMES, ROW_TEX, is_planar, task_row_indices
 from .artists import ChainArtist, EllipseArtist, JointVelocitiesArtist, VelocityArtist
 from .common import FRAME_COLORS, JOINT_COLORS, default_ranges
 from .cost import CostPlot, plot_singularity_cost

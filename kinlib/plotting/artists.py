@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..manipulability import velocity_ellipsoid
+from ..analysis.manipulability import velocity_ellipsoid
 from .common import FRAME_COLORS, JOINT_COLORS, as_configuration, is_3d, theta_tex
 from .primitives import Arrows, add_line, add_segments, add_text, move_text, perpendicular, set_line, set_segments
 from .view import (

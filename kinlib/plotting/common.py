@@ -17,7 +17,7 @@ import numpy as np
 import sympy as sp
 
 from .._backend import describe
-from ..chains import SerialChain
+from ..kinematics.chains import SerialChain
 
 __all__ = [
     "JOINT_COLORS",

@@ -25,8 +25,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .._backend import describe
-from ..taskspace import default_task_rows, rows_label, task_row_indices, task_rows
-from ..velocity import SingularityWarning, damped_least_squares, inverse_velocity
+from ..analysis.taskspace import default_task_rows, rows_label, task_row_indices, task_rows
+from ..analysis.velocity import SingularityWarning, damped_least_squares, inverse_velocity
 from .common import as_configuration, checked_numeric
 
 __all__ = ["CostPlot", "plot_singularity_cost"]

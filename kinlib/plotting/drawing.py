@@ -17,7 +17,7 @@ import numpy as np
 import sympy as sp
 
 from .._backend import describe
-from ..taskspace import default_task_rows, is_planar, rows_label, task_row_indices
+from ..analysis.taskspace import default_task_rows, is_planar, rows_label, task_row_indices
 from .artists import ChainArtist, EllipseArtist, JointVelocitiesArtist, VelocityArtist, ellipse_outline
 from .common import (
     JOINT_COLORS,

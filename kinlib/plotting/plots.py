@@ -23,8 +23,8 @@ import numpy as np
 import sympy as sp
 
 from .._backend import describe
-from ..manipulability import manipulability_values, measure_label, strongest_joints
-from ..taskspace import default_task_rows, rows_label, task_row_indices, task_rows
+from ..analysis.manipulability import manipulability_values, measure_label, strongest_joints
+from ..analysis.taskspace import default_task_rows, rows_label, task_row_indices, task_rows
 from .common import JOINT_COLORS, as_configuration, checked_numeric, default_ranges, is_3d, theta_tex
 from .primitives import Arrows, add_text
 from .view import include, pi_ticks

@@ -27,9 +27,9 @@ import io
 import numpy as np
 
 from .._backend import describe
-from ..manipulability import manipulability_values, measure_label
+from ..analysis.manipulability import manipulability_values, measure_label
+from ..analysis.taskspace import rows_label, task_rows
 from ..plotting.common import checked_numeric
-from ..taskspace import rows_label, task_rows
 from .explorer import Explorer
 
 __all__ = ["animate_singularity", "SingularityAnimation"]

@@ -58,11 +58,17 @@ import numpy as np
 import sympy as sp
 
 from .._backend import describe
-from ..codegen import CompiledMatrix
-from ..manipulability import NEAR_SINGULAR, SINGULAR_RTOL, peak_manipulability, singular_values, singularity_state
+from ..analysis.manipulability import (
+    NEAR_SINGULAR,
+    SINGULAR_RTOL,
+    peak_manipulability,
+    singular_values,
+    singularity_state,
+)
+from ..analysis.singularities import singular_configurations
+from ..analysis.taskspace import default_task_rows, is_planar, task_row_indices, task_rows
+from ..fast.codegen import CompiledMatrix
 from ..plotting.common import as_configuration, checked_numeric, default_ranges, reach
-from ..singularities import singular_configurations
-from ..taskspace import default_task_rows, is_planar, task_row_indices, task_rows
 from .frontend import script, square_view
 
 __all__ = ["explorer", "Explorer", "classify_families", "without_answers", "FRONT_END"]

@@ -28,9 +28,9 @@ from collections.abc import Mapping
 import numpy as np
 
 from .._backend import describe
-from ..manipulability import NEAR_SINGULAR, SINGULAR_RTOL, strongest_joints
+from ..analysis.manipulability import NEAR_SINGULAR, SINGULAR_RTOL, strongest_joints
+from ..analysis.taskspace import ROW_LABELS, ROW_TEX, is_planar, task_row_indices
 from ..plotting.common import JOINT_COLORS, as_configuration, checked_numeric, reach, theta_tex
-from ..taskspace import ROW_LABELS, ROW_TEX, is_planar, task_row_indices
 from .frontend import script, square_view
 
 __all__ = ["config_picker", "ConfigPicker"]

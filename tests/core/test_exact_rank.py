@@ -278,25 +278,10 @@ def test_far_apart_angles_on_a_6_joint_arm_are_exact_at_the_elbow():
     assert r2 == 6 and r2.exact
 
 
-STANFORD = sp.Matrix(
-    [
-        [0, 0, 1, 0, 0, 0],
-        [1, 0, 0, 0, 1, 0],
-        [0, 0, 0, 0, 1, 0],
-        [0, 1, 0, -1, 0, 0],
-        [1, 0, 0, 0, 1, 0],
-        [0, 1, 0, -1, 0, 0],
-    ]
-).T
-
-
 @pytest.mark.parametrize("q", [(1, 2, 3, 4, 5, 6), (1, 2, R(1, 3), 4, 0, 6), (2, -1, 3, 1, pi / 2, 10)])
 def test_six_joint_arms_at_integer_angles(q):
     """The Stanford-like RRPRRR arm (was > 4 minutes) and the UR5 (elbow stretched), against the oracle."""
-    M = sp.eye(4)
-    M[:3, 3] = sp.Matrix([0, R(1, 2), 1])
-    st_arm = SerialChain(M, STANFORD, name="stanford")
-    for chain in (st_arm, robots.ur5()):
+    for chain in (robots.stanford(), robots.ur5()):
         Js = chain.jacobian_space()
         want = O.rank(O.space_jacobian(chain.screws, q))
         assert rank_at(Js, q, chain.thetas) == want

@@ -19,7 +19,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import exact_oracle as O
-from kinlib import SerialChain, robots
+from kinlib import robots
 from kinlib.exact import NumericFallbackWarning, Rank, column_space, exact_is_zero, left_null_space, rank_at
 from kinlib.exactfield import decide_zero
 from kinlib.singularities import K, singular_configurations
@@ -50,24 +50,9 @@ def mixed_pose(draw):
 multiple_of_pi = st.integers(-2, 2).map(lambda k: k * pi)
 
 
-def _stanford():
-    """The Stanford arm RRPRRR (the screws of tests/core/test_exact_rank.py's STANFORD; tool at (0, 1/2, 1))."""
-    S = [
-        [0, 0, 1, 0, 0, 0],
-        [1, 0, 0, 0, 1, 0],
-        [0, 0, 0, 0, 1, 0],
-        [0, 1, 0, -1, 0, 0],
-        [1, 0, 0, 0, 1, 0],
-        [0, 1, 0, -1, 0, 0],
-    ]
-    M = sp.eye(4)
-    M[:3, 3] = sp.Matrix([0, R(1, 2), 1])
-    return SerialChain(M, sp.Matrix(S).T, name="stanford")
-
-
 def _arms():
     return {
-        "stanford": _stanford(),
+        "stanford": robots.stanford(),
         "ur5": robots.ur5(),
         "puma560": robots.puma560(),
         "puma_no_offsets": robots.puma560(R(2, 5), 0, 0, R(2, 5)),

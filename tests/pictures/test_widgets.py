@@ -37,6 +37,7 @@ ROBOTS = {
     "spatial_rppr": (lambda: robots.spatial_rppr(1, sp.Rational(3, 5)), {"rows": "all"}),
     "ur5": (lambda: robots.ur5(), {}),
     "puma560": (lambda: robots.puma560(), {}),
+    "stanford": (lambda: robots.stanford(), {}),
 }
 
 

@@ -38,7 +38,7 @@ def agg(monkeypatch):
 
 
 def test_modules_found():
-    assert "kinlib" in MODULES and "kinlib.rigid" in MODULES and len(MODULES) > 10, MODULES
+    assert "kinlib" in MODULES and "kinlib.kinematics.rigid" in MODULES and len(MODULES) > 10, MODULES
 
 
 @pytest.mark.parametrize("name", MODULES)

@@ -1,14 +1,22 @@
-"""The package's structure: layers, no import cycles, no reaching into other modules' private names,
-small modules, a light math core, and docstring examples.
+"""The package's structure: layers, no import cycles, no reaching into other modules' private names, a light
+math core, simple functions, and docstring examples.
 
-kinlib has three layers:
+kinlib is laid out by job (issue 32), in layers that import one way (a layer imports only itself and the
+layers listed under it in ``ALLOWED``):
 
-- the **core** (every module not listed below): NumPy and SymPy (and mpmath) only;
-- the **picture** layer: ``kinlib.plotting`` (matplotlib) and ``kinlib.widgets*`` (ipywidgets), on the core;
+- the **core** (NumPy, SymPy and mpmath only), bottom up:
+  ``kinlib._backend`` (input conversion and checks, used by every folder);
+  the engine, ``kinlib.exact`` (exact decisions, 60-digit fallback, time budgets) and ``kinlib.fast``
+  (generated and compiled code), which do not import each other;
+  ``kinlib.kinematics`` (the textbook's rigid motions, screws, product of exponentials, Jacobians, chains, robots);
+  ``kinlib.analysis`` (task rows, singularities, manipulability, velocity);
+  ``kinlib`` itself (``__init__``: the user's names, re-exported from the folders);
+- the **picture** layer: ``kinlib.plotting`` (matplotlib) and ``kinlib.widgets`` (ipywidgets), on the core;
 - the **course** layer: ``kinlib.course`` (handouts, self-checks, grading; Jupyter), on both.
 
-A layer imports only from the layers below it. Everything here is read from the source with ``ast`` (no
-kinlib module is imported in this process), except the two tests that import kinlib in a subprocess.
+A module's size is not capped: a function's complexity is (ruff's C901, mccabe, in pyproject.toml). Everything
+here is read from the source with ``ast`` (no kinlib module is imported in this process), except the tests that
+import kinlib in a subprocess and the test of the old module paths.
 """
 
 from __future__ import annotations
@@ -30,12 +38,6 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 PKG = "kinlib"
 PKG_DIR = ROOT / PKG
-# A soft size cap that catches a module growing into two jobs; issue 32 (layout by job) is to replace it with
-# cohesion rules. 750 since its first fixes (a hostile-number check in chains, a constant-J branch in
-# manipulability, the students' build in handouts and lite) put four modules a few lines over 700.
-MAX_LINES = 750
-#: modules allowed over the cap for now, each with its way back under it
-OVER_THE_CAP: dict[str, int] = {}
 HEAVY = ("matplotlib", "ipywidgets", "nbformat", "nbclient", "nbconvert", "jupyter_client", "IPython")
 CORE_DEPS = ("numpy", "sympy", "mpmath")  # pyproject.toml's `dependencies`
 
@@ -63,25 +65,37 @@ def _discover() -> dict[str, Path]:
 MODULES = _discover()
 
 
+#: the core's folders, each a layer of its own (kinlib/*.py holds only __init__ and _backend)
+CORE_FOLDERS = ("exact", "fast", "kinematics", "analysis")
+CORE_LAYERS = {"base", *CORE_FOLDERS, "api"}
+
+
 def layer(module: str) -> str:
-    """core, plotting, widgets or course."""
+    """base (kinlib._backend), exact, fast, kinematics, analysis, api (kinlib itself), plotting, widgets or course."""
     parts = module.split(".")
     top = parts[1] if len(parts) > 1 else ""
-    if top == "course":
-        return "course"
-    if top == "plotting":
-        return "plotting"
+    if not top:
+        return "api"
+    if top in ("course", "plotting", *CORE_FOLDERS):
+        return top
     if top.startswith("widgets"):
         return "widgets"
-    return "core"
+    return "base"
 
 
-# which layers each layer may import (itself included)
+# which layers each layer may import (itself included): the engine under the textbook's kinematics, analysis
+# over both, the user's names (kinlib) over the whole core, pictures over the core, the course over all
+_ENGINE = {"base", "exact", "fast"}
 ALLOWED = {
-    "core": {"core"},
-    "plotting": {"core", "plotting", "widgets"},
-    "widgets": {"core", "plotting", "widgets"},
-    "course": {"core", "plotting", "widgets", "course"},
+    "base": {"base"},
+    "exact": {"base", "exact"},
+    "fast": {"base", "fast"},
+    "kinematics": _ENGINE | {"kinematics"},
+    "analysis": _ENGINE | {"kinematics", "analysis"},
+    "api": CORE_LAYERS,
+    "plotting": CORE_LAYERS | {"plotting", "widgets"},
+    "widgets": CORE_LAYERS | {"plotting", "widgets"},
+    "course": CORE_LAYERS | {"plotting", "widgets", "course"},
 }
 
 
@@ -341,7 +355,7 @@ def _edge_at(src: str, dst: str) -> str:
 
 
 def test_modules_found():
-    assert PKG in MODULES and f"{PKG}.rigid" in MODULES, sorted(MODULES)
+    assert PKG in MODULES and f"{PKG}.kinematics.rigid" in MODULES, sorted(MODULES)
 
 
 def test_no_import_cycles():
@@ -374,9 +388,50 @@ def test_layers():
         }
     )
     assert not bad, (
-        "layer violations (core < plotting/widgets < course; a layer imports only from the "
-        "layers below it):\n  " + "\n  ".join(bad)
+        "layer violations (_backend < exact, fast < kinematics < analysis < kinlib < plotting/widgets < course; "
+        "a layer imports only from itself and the layers below it, see ALLOWED):\n  " + "\n  ".join(bad)
     )
+
+
+def test_core_is_laid_out_by_job():
+    """kinlib/*.py is only the package and _backend: every other core module lives in the folder of its job,
+    and each folder says in its docstring what it holds and what it builds on."""
+    flat = sorted(m for m in MODULES if layer(m) == "base" and m != f"{PKG}._backend")
+    assert not flat, f"core modules outside the folders {CORE_FOLDERS} (put each in the folder of its job): {flat}"
+    for folder in CORE_FOLDERS:
+        init = MODULES[f"{PKG}.{folder}"]
+        assert "builds on" in (ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))) or "").lower(), (
+            f"{_rel(init)}'s docstring says what {folder} holds and which layers it builds on"
+        )
+
+
+def test_old_module_paths_are_the_new_modules():
+    """Every module of the flat layout (kinlib.poe, kinlib.native, ...) still imports, as the same module object
+    as its new home (so monkeypatching either name patches the real module); kinlib.exact, now the engine's
+    package, still has the old module's names."""
+    import importlib
+
+    import kinlib
+
+    assert set(kinlib.MOVED) | {"exact"} == set(OLD_MODULES)
+    for old, new in kinlib.MOVED.items():
+        real = importlib.import_module(f"{PKG}.{new}")
+        assert importlib.import_module(f"{PKG}.{old}") is real and getattr(kinlib, old) is real, old
+        assert set(getattr(real, "__all__", ())) <= set(dir(real)), old
+    import kinlib.exact
+    import kinlib.exact.linalg
+
+    for name in kinlib.exact.linalg.__all__:
+        assert getattr(kinlib.exact, name) is getattr(kinlib.exact.linalg, name), name
+    for name in kinlib.__all__:
+        assert hasattr(kinlib, name), name
+
+
+#: the core's modules before the layout by job (issue 32): each must still import
+OLD_MODULES = (
+    "rigid screws poe jacobians chains robots taskspace singularities singular_search nearsingular manipulability "
+    "velocity exact exact_rank exactfield trigpoly trigsign fallback display budget tape codegen native"
+).split()
 
 
 #: kinlib.course laid out by where its code runs: each folder a package whose docstring says where
@@ -434,18 +489,10 @@ def test_core_needs_only_numpy_and_sympy():
         {
             f"{_rel(MODULES[m])}:{line}: {top}"
             for m, top, line in _scan().external
-            if layer(m) == "core" and top not in allowed
+            if layer(m) in CORE_LAYERS and top not in allowed
         }
     )
     assert not bad, "core modules import packages beyond numpy, sympy and mpmath:\n  " + "\n  ".join(bad)
-
-
-def test_modules_are_small():
-    big = {m: len(p.read_text(encoding="utf-8").splitlines()) for m, p in MODULES.items()}
-    big = {m: n for m, n in big.items() if n > OVER_THE_CAP.get(m, MAX_LINES)}
-    assert not big, f"modules over {MAX_LINES} lines (split them):\n  " + "\n  ".join(
-        f"{_rel(MODULES[m])}: {n}" for m, n in sorted(big.items(), key=lambda kv: -kv[1])
-    )
 
 
 #: the grader path (the trusted host and what decides an answer): no function longer than this, its docstring aside

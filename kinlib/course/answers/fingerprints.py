@@ -154,7 +154,7 @@ def evaluate(x, k: int):
 
 
 def _evaluate_mpmath(x, pt: dict):
-    from kinlib.exactfield import mp_context
+    from kinlib.exact.field import mp_context
 
     mpmath = mp_context()  # this thread's own mpmath context: the global precision is never changed
     syms = sorted(pt, key=lambda s: s.name)

@@ -79,7 +79,7 @@ def _never_zero(M, what: str):
     """(True, None) when det M ≠ 0 for every real value of M's non-positive symbols (its joint values) is
     proved by :func:`kinlib.singularities.singular_configurations` (no condition, complete); else
     (False, message). For a non-square M (m < n) the rank test is det(M Mᵀ) (Cauchy–Binet)."""
-    from kinlib.singularities import singular_configurations
+    from kinlib.analysis.singularities import singular_configurations
 
     variables = sorted((s for s in M.free_symbols if not s.is_positive), key=lambda s: s.name)
     if len(variables) > M.cols:
@@ -127,7 +127,7 @@ def _matrix(tree, name: str):
 def _robot_task_jacobian(S, name: str):
     """The task rows (ω_z, v_x, v_y) of the space Jacobian of the planar robot with screw axes S (6×n), or a
     message (str) saying why the robot cannot be judged: not planar, not valid screws, too many joints."""
-    from kinlib.jacobians import jacobian_space
+    from kinlib.kinematics.jacobians import jacobian_space
 
     if S.cols > MAX_ROBOT_JOINTS:
         return f"{name}: a robot of {S.cols} joints is more than this check decides (at most {MAX_ROBOT_JOINTS})"

@@ -395,14 +395,7 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
             raise WireError("a fraction with denominator 0")
         return sp.Rational(p, q)
     if op == "Float" and len(args) == 2:
-        digits = text(args[0], 1300)
-        if not digits or not all(c in "0123456789.eE+-infa" for c in digits):
-            raise WireError("malformed Float")
-        try:  # mpmath's number syntax (never eval); malformed digits are a ValueError
-            made = sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
-        except (ValueError, TypeError):
-            raise WireError("malformed Float") from None
-        return _check_number(made)
+        return _sympy_float(args, text, small)
     if op == "Symbol" and len(args) == 2:
         return sp.Symbol(_name(args[0]), **_assumptions(args[1]))
     if op == "Dummy" and len(args) == 3:
@@ -418,13 +411,7 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
         except (TypeError, ValueError):
             raise WireError("UndefinedFunction could not be rebuilt") from None
     if op == "Matrix" and len(args) >= 2:
-        r, c = small(args[0], MAX_ENTRIES), small(args[1], MAX_ENTRIES)
-        if r * c != len(args) - 2 or r * c > MAX_ENTRIES:
-            raise WireError("malformed matrix (shape and entries disagree, or too many entries)")
-        entries = [build(a) for a in args[2:]]
-        if not all(isinstance(e, sp.Basic) for e in entries):
-            raise WireError("a Matrix's entries are SymPy values")
-        return sp.Matrix(r, c, entries)
+        return _sympy_matrix(args, build, small)
     if op in SINGLETONS and not args:
         return getattr(sp.S, _SINGLETON_ATTR.get(op, op))
     cls = classes.get(op)
@@ -442,6 +429,33 @@ def _sympy(op, args, build, text, integer, small, classes, dummies):
     except (TypeError, ValueError, AttributeError, NotImplementedError, IndexError, KeyError, ArithmeticError) as exc:
         raise WireError(f"{op} could not be rebuilt ({type(exc).__name__})") from None
     return _check_number(made) if isinstance(made, sp.Number) else made
+
+
+def _sympy_float(args, text, small):
+    """A Float from its digits (mpmath's number syntax, checked character by character; never eval) and precision."""
+    import sympy as sp
+
+    digits = text(args[0], 1300)
+    if not digits or not all(c in "0123456789.eE+-infa" for c in digits):
+        raise WireError("malformed Float")
+    try:  # mpmath's number syntax (never eval); malformed digits are a ValueError
+        made = sp.Float(digits, precision=small(args[1], MAX_PREC) or 53)
+    except (ValueError, TypeError):
+        raise WireError("malformed Float") from None
+    return _check_number(made)
+
+
+def _sympy_matrix(args, build, small):
+    """A Matrix from its shape and at most MAX_ENTRIES entries, each a SymPy value."""
+    import sympy as sp
+
+    r, c = small(args[0], MAX_ENTRIES), small(args[1], MAX_ENTRIES)
+    if r * c != len(args) - 2 or r * c > MAX_ENTRIES:
+        raise WireError("malformed matrix (shape and entries disagree, or too many entries)")
+    entries = [build(a) for a in args[2:]]
+    if not all(isinstance(e, sp.Basic) for e in entries):
+        raise WireError("a Matrix's entries are SymPy values")
+    return sp.Matrix(r, c, entries)
 
 
 def _check_number(x):

@@ -76,56 +76,15 @@ def restore(snap):
     >>> restore(snap), math.sqrt is real
     (['math.sqrt'], True)
     """
-    import types
-
-    def top_of(module_name: str) -> str:
-        return str(module_name).split(".")[0]
-
     fixed = []
     for name, m in snap["sysmods"].items():
         if sys.modules.get(name) is not m:
             sys.modules[name] = m
             fixed.append(f"sys.modules[{name!r}]")
     for name, (m, saved) in snap["mods"].items():
-        cur = m.__dict__
-        for k in list(cur):
-            if (
-                k not in saved
-                and _fn(cur[k])
-                and not isinstance(cur[k], types.ModuleType)
-                and not k.startswith("__")
-                and k not in _NOT_RESTORED
-            ):
-                if not _library_made(cur[k], top_of(name)):
-                    fixed.append(f"{name}.{k} (added)")
-                del cur[k]
-        for k, v in saved.items():
-            new = cur.get(k, _MISSING)
-            if new is not v and _fn(v) and not k.startswith("__") and k not in _NOT_RESTORED:
-                if not _library_made(new, top_of(name)):
-                    fixed.append(f"{name}.{k}")
-                cur[k] = v
+        _restore_module(name, m.__dict__, saved, fixed)
     for cls, saved in snap["classes"].values():
-        where = f"{cls.__module__}.{cls.__qualname__}"
-        top = top_of(cls.__module__)
-        for k in list(cls.__dict__):
-            if k not in saved and _fn(cls.__dict__[k]) and not _display_only(k):
-                try:
-                    new = cls.__dict__[k]
-                    delattr(cls, k)
-                    if not _library_made(new, top):
-                        fixed.append(f"{where}.{k} (added)")
-                except (AttributeError, TypeError):
-                    pass
-        for k, v in saved.items():
-            new = cls.__dict__.get(k, _MISSING)
-            if new is not v and _fn(v) and not _display_only(k):
-                try:
-                    setattr(cls, k, v)
-                    if not _library_made(new, top):
-                        fixed.append(f"{where}.{k}")
-                except (AttributeError, TypeError):
-                    pass
+        _restore_class(cls, saved, fixed)
     try:
         from sympy.core.cache import clear_cache
 
@@ -133,3 +92,54 @@ def restore(snap):
     except Exception:
         pass
     return fixed
+
+
+def _top_of(module_name: str) -> str:
+    return str(module_name).split(".")[0]
+
+
+def _restore_module(name: str, cur: dict, saved: dict, fixed: list) -> None:
+    """Put back the module ``name``'s functions/classes as snapshotted (``cur``: its __dict__), dropping added ones."""
+    import types
+
+    for k in list(cur):
+        if (
+            k not in saved
+            and _fn(cur[k])
+            and not isinstance(cur[k], types.ModuleType)
+            and not k.startswith("__")
+            and k not in _NOT_RESTORED
+        ):
+            if not _library_made(cur[k], _top_of(name)):
+                fixed.append(f"{name}.{k} (added)")
+            del cur[k]
+    for k, v in saved.items():
+        new = cur.get(k, _MISSING)
+        if new is not v and _fn(v) and not k.startswith("__") and k not in _NOT_RESTORED:
+            if not _library_made(new, _top_of(name)):
+                fixed.append(f"{name}.{k}")
+            cur[k] = v
+
+
+def _restore_class(cls, saved: dict, fixed: list) -> None:
+    """Put back the class's methods as snapshotted, dropping added ones (display hooks aside)."""
+    where = f"{cls.__module__}.{cls.__qualname__}"
+    top = _top_of(cls.__module__)
+    for k in list(cls.__dict__):
+        if k not in saved and _fn(cls.__dict__[k]) and not _display_only(k):
+            try:
+                new = cls.__dict__[k]
+                delattr(cls, k)
+                if not _library_made(new, top):
+                    fixed.append(f"{where}.{k} (added)")
+            except (AttributeError, TypeError):
+                pass
+    for k, v in saved.items():
+        new = cls.__dict__.get(k, _MISSING)
+        if new is not v and _fn(v) and not _display_only(k):
+            try:
+                setattr(cls, k, v)
+                if not _library_made(new, top):
+                    fixed.append(f"{where}.{k}")
+            except (AttributeError, TypeError):
+                pass

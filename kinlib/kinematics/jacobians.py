@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_vector, describe, is_symbolic, nested_shape
+from .._backend import as_matrix, as_vector, describe, is_symbolic, nested_shape
 from .poe import checked_screw_list, fk_space
 from .rigid import check_se3, check_so3, cross, rodrigues_coefficients, skew
 from .screws import exp6_unchecked

@@ -31,8 +31,8 @@ import numpy as np
 import sympy as sp
 from sympy.simplify.fu import TR10i
 
-from ._backend import check_real_finite, describe
-from .exactfield import decide_zero
+from .._backend import check_real_finite, describe
+from .field import decide_zero
 from .trigpoly import NotTrigPolynomial, TrigRing, single_angle_form
 
 __all__ = ["simplify_for_display", "is_identically_zero", "readable", "readable_fold", "readable_ratio"]

@@ -63,7 +63,7 @@ class NotExact(ValueError):
     >>> ExactField([sp.sin(sp.sqrt(2))])   # an angle √2: no exact zero test (a ValueError)
     Traceback (most recent call last):
     ...
-    kinlib.exactfield.NotExact: the angle sqrt(2) is not a rational number plus a rational multiple of π
+    kinlib.exact.field.NotExact: the angle sqrt(2) is not a rational number plus a rational multiple of π
     """
 
 
@@ -102,6 +102,40 @@ def _field_constant(K, c: sp.Expr):
     same few constants (cos and sin of the configuration's multiples of π, √2, …) recur in every field built
     for a notebook. Both K and c are immutable, so the cache cannot change an answer."""
     return K.convert(c) if c.is_Rational else K.from_sympy(c)
+
+
+def _is_algebraic_constant(c) -> bool:
+    """Whether the number c is built from rationals, rational powers and sin/cos of rational multiples of π."""
+    for f in c.atoms(sp.Function):
+        if not (isinstance(f, (sp.sin, sp.cos)) and (f.args[0] / sp.pi).is_Rational):
+            return False
+    bare = c.xreplace({f: sp.Dummy() for f in c.atoms(sp.sin, sp.cos)})
+    return not bare.has(sp.pi, sp.E) and all(
+        not p.is_Pow or p.exp.is_Rational for p in sp.preorder_traversal(bare) if isinstance(p, sp.Basic)
+    )
+
+
+def _scan_constants(x, repl: dict, g, consts: set, extra: set) -> None:
+    """Collect the constants of the entry part x: algebraic ones into ``consts``, π and e into ``extra`` (only
+    when there is no trig angle, ``g`` = 0); anything else raises NotExact. ``repl``: the sines and cosines of
+    the angles, which are the field's generator, not constants."""
+    if x.is_Rational or x in repl or x.is_Symbol:
+        return
+    if x is sp.pi or x is sp.E:
+        if g != 0:
+            raise NotExact(f"the constant {x} appears next to the transcendental sin/cos of {g}")
+        extra.add(x)
+    elif x.is_Add or x.is_Mul:
+        for arg in x.args:
+            _scan_constants(arg, repl, g, consts, extra)
+    elif x.is_Pow and x.exp.is_Integer:
+        _scan_constants(x.base, repl, g, consts, extra)
+    elif x.is_number and _is_algebraic_constant(x):
+        consts.add(x)
+    else:
+        raise NotExact(
+            f"the entry part {x} is not a rational function of sines and cosines, algebraic numbers and parameters"
+        )
 
 
 class ExactField:
@@ -149,38 +183,8 @@ class ExactField:
         repl = {f: sp.Dummy() for f in trig}
 
         extra = set()
-
-        def algebraic(c) -> bool:
-            for f in c.atoms(sp.Function):
-                if not (isinstance(f, (sp.sin, sp.cos)) and (f.args[0] / sp.pi).is_Rational):
-                    return False
-            bare = c.xreplace({f: sp.Dummy() for f in c.atoms(sp.sin, sp.cos)})
-            return not bare.has(sp.pi, sp.E) and all(
-                not p.is_Pow or p.exp.is_Rational for p in sp.preorder_traversal(bare) if isinstance(p, sp.Basic)
-            )
-
-        def scan(x):
-            if x.is_Rational or x in repl or x.is_Symbol:
-                return
-            if x is sp.pi or x is sp.E:
-                if g != 0:
-                    raise NotExact(f"the constant {x} appears next to the transcendental sin/cos of {g}")
-                extra.add(x)
-            elif x.is_Add or x.is_Mul:
-                for arg in x.args:
-                    scan(arg)
-            elif x.is_Pow and x.exp.is_Integer:
-                scan(x.base)
-            elif x.is_number and algebraic(x):
-                consts.add(x)
-            else:
-                raise NotExact(
-                    f"the entry part {x} is not a rational function of sines and cosines, algebraic "
-                    "numbers and parameters"
-                )
-
         for e in exprs:
-            scan(e)
+            _scan_constants(e, repl, g, consts, extra)
         self.extra = sorted(extra, key=str)  # π, e: generators (transcendental; no trig angle then)
         algebraic_consts = sorted((c for c in consts if not c.is_Rational), key=sp.default_sort_key)
         self._known: dict = {}

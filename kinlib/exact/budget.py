@@ -387,6 +387,33 @@ def _end(pid: int) -> None:
 
 def _forked(seconds: float, what: str, fn, args, kwargs, progress):
     r, w = os.pipe()
+    pid = _fork_child(r, w, seconds, what, fn, args, kwargs, progress)
+    os.close(w)
+    try:
+        os.setpgid(pid, pid)  # (also done by the child: whichever runs first)
+    except OSError:
+        pass
+    pidfd = _open_pidfd(pid)
+    try:
+        os.set_blocking(r, False)
+        frames, status, usage, stalled = _watch(pid, r, pidfd, seconds)
+    except BaseException:  # the caller was interrupted (KeyboardInterrupt ...): the work goes with it
+        _end(pid)
+        try:
+            os.waitpid(pid, 0)
+        except ChildProcessError:
+            pass
+        raise
+    finally:
+        os.close(r)
+        if pidfd is not None:
+            os.close(pidfd)
+    _charge(usage.ru_utime + usage.ru_stime)
+    return _outcome(frames, status, stalled, what, seconds, progress)
+
+
+def _fork_child(r: int, w: int, seconds: float, what: str, fn, args, kwargs, progress) -> int:
+    """Fork a child that does the work and writes its frames to w: the child's pid (in the parent only)."""
     try:
         pid = os.fork()
     except OSError:  # no process to be had (a process limit): cooperative checks only, as in Pyodide
@@ -401,63 +428,65 @@ def _forked(seconds: float, what: str, fn, args, kwargs, progress):
             status = 70
         finally:
             os._exit(status)
-    os.close(w)
-    try:
-        os.setpgid(pid, pid)  # (also done by the child: whichever runs first)
-    except OSError:
-        pass
-    pidfd = None
+    return pid
+
+
+def _open_pidfd(pid: int) -> int | None:
+    """A file descriptor that becomes readable when the child ends (Linux ≥ 5.3), or None."""
     if hasattr(os, "pidfd_open"):
         try:
-            pidfd = os.pidfd_open(pid)
+            return os.pidfd_open(pid)
         except OSError:
-            pidfd = None
-    buf, frames, status, stalled = bytearray(), [], None, False
-    try:
-        os.set_blocking(r, False)
-        started = last_change = time.monotonic()
-        last_cpu = None
-        while True:
-            ready, _, _ = select.select(
-                [r] if pidfd is None else [r, pidfd], [], [], 0.5 if pidfd is not None else 0.02
-            )
-            if r in ready:
-                _drain(r, buf, frames)
-                if frames and frames[-1][0] in ("ok", "err"):
-                    _, status, usage = os.wait4(pid, 0)
-                    break
-            if pidfd is None or pidfd in ready:  # (without a pidfd: asked at every turn, 20 ms apart at most)
-                done, st, ru = os.wait4(pid, os.WNOHANG)
-                if done:
-                    status, usage = st, ru
-                    _drain(r, buf, frames)
-                    break
-            cpu = _proc_cpu(pid)
-            now = time.monotonic()
-            if cpu is None:  # no /proc here: a generous wall-clock ceiling instead
-                stuck = now - started > 20 * seconds + STALL
-            else:
-                if cpu != last_cpu:
-                    last_cpu, last_change = cpu, now
-                stuck = now - last_change > STALL
-            if stuck:
-                stalled = True
-                _end(pid)
+            return None
+    return None
+
+
+def _watch(pid: int, r: int, pidfd: int | None, seconds: float):
+    """Read the child's frames until it answers or ends, ending it when it is stuck:
+    (frames, wait status, resource usage, whether it was ended as stuck)."""
+    buf, frames = bytearray(), []
+    stuck = _StuckWatch(pid, seconds)
+    while True:
+        ready, _, _ = select.select([r] if pidfd is None else [r, pidfd], [], [], 0.5 if pidfd is not None else 0.02)
+        if r in ready:
+            _drain(r, buf, frames)
+            if frames and frames[-1][0] in ("ok", "err"):
                 _, status, usage = os.wait4(pid, 0)
+                return frames, status, usage, False
+        if pidfd is None or pidfd in ready:  # (without a pidfd: asked at every turn, 20 ms apart at most)
+            done, status, usage = os.wait4(pid, os.WNOHANG)
+            if done:
                 _drain(r, buf, frames)
-                break
-    except BaseException:  # the caller was interrupted (KeyboardInterrupt ...): the work goes with it
-        _end(pid)
-        try:
-            os.waitpid(pid, 0)
-        except ChildProcessError:
-            pass
-        raise
-    finally:
-        os.close(r)
-        if pidfd is not None:
-            os.close(pidfd)
-    _charge(usage.ru_utime + usage.ru_stime)
+                return frames, status, usage, False
+        if stuck():
+            _end(pid)
+            _, status, usage = os.wait4(pid, 0)
+            _drain(r, buf, frames)
+            return frames, status, usage, True
+
+
+class _StuckWatch:
+    """Called once a turn: whether the child has made no CPU progress for STALL seconds (without /proc: a
+    generous wall-clock ceiling, 20 × its budget + STALL)."""
+
+    def __init__(self, pid: int, seconds: float):
+        self.pid, self.seconds = pid, seconds
+        self.started = self.last_change = time.monotonic()
+        self.last_cpu = None
+
+    def __call__(self) -> bool:
+        cpu = _proc_cpu(self.pid)
+        now = time.monotonic()
+        if cpu is None:  # no /proc here: a generous wall-clock ceiling instead
+            return now - self.started > 20 * self.seconds + STALL
+        if cpu != self.last_cpu:
+            self.last_cpu, self.last_change = cpu, now
+        return now - self.last_change > STALL
+
+
+def _outcome(frames: list, status: int, stalled: bool, what: str, seconds: float, progress):
+    """The child's answer (its progress reports passed on first), its exception, OutOfTime, or a RuntimeError
+    saying how it ended without an answer."""
     for frame in frames:
         if frame[0] == "progress" and progress is not None:
             progress(frame[1])
@@ -539,7 +568,7 @@ def budget_seconds(time_budget: Any, name: str = "time_budget") -> float | None:
     except (TypeError, ValueError):
         value = None
     if value is None or not value >= 0:
-        from ._backend import describe
+        from .._backend import describe
 
         raise ValueError(f"{name} must be a number of seconds ≥ 0 (or None: no limit), got {describe(time_budget)}")
     return None if value == float("inf") else value

@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from ._backend import describe, numeric_jacobian
+from .._backend import describe, numeric_jacobian
 from .taskspace import task_rows
 
 __all__ = ["NEAR_SINGULAR", "SINGULAR_RTOL", "singularity_state", "near_singular", "peak_manipulability"]

@@ -13,7 +13,7 @@ import numpy as np
 import sympy as sp
 from sympy.core.function import AppliedUndef
 
-from ._backend import (
+from .._backend import (
     as_matrix,
     as_scalar,
     as_vector,
@@ -23,7 +23,7 @@ from ._backend import (
     is_symbolic,
     real_array,
 )
-from .exactfield import decide_zero
+from ..exact.field import decide_zero
 
 __all__ = [
     "skew",
@@ -383,7 +383,7 @@ def _log3_numeric(A: np.ndarray):
 
 def _log3_exact(R: sp.Matrix):
     """(ω̂, θ, exactly_zero) for an exact SymPy rotation matrix; see :func:`log3`."""
-    from .display import is_identically_zero, simplify_for_display
+    from ..exact.display import is_identically_zero, simplify_for_display
 
     for e in R:
         check_real_finite(e, "R")

@@ -15,7 +15,7 @@ import warnings
 
 import sympy as sp
 
-from .exactfield import FALLBACK_DIGITS, mp_context, mp_matrix
+from .field import FALLBACK_DIGITS, mp_context, mp_matrix
 
 __all__ = ["FALLBACK_ZERO_DIGITS", "NumericFallbackWarning", "fallback_rank", "fallback_rref", "fallback_warning"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import sympy as sp
 
-from ._backend import describe, exact_number
+from .._backend import describe, exact_number
 from .chains import SerialChain
 
 __all__ = [
@@ -22,6 +22,7 @@ __all__ = [
     "planar_rpp",
     "ur5",
     "puma560",
+    "stanford",
     "length",
     "from_urdf_joints",
 ]
@@ -262,6 +263,35 @@ def puma560(a2=None, d3=None, a3=None, d4=None) -> SerialChain:
     )
 
 
+def stanford(H=None, D=None) -> SerialChain:
+    """A Stanford-type arm (RRPRRR): a base joint about z_s, a shoulder about x at height ``H``, a slide along
+    y_s, and a wrist of three axes (y, x, y) through the shoulder point (0, 0, H), the slide retracted at θ = 0;
+    the tool at (0, D, H). Defaults H = 1, D = 1/2, exact: the arm of kinlib's exact-rank tests and benchmark.
+
+    At θ5 = 0 (and π) the axes of joints 4 and 6 line up, and J_s's columns 4 and 6 are equal: a wrist
+    singularity.
+
+    >>> import sympy as sp
+    >>> r = stanford()
+    >>> r.joint_types
+    'RRPRRR'
+    >>> J = r.jacobian_space([1, 2, sp.Rational(1, 3), 4, 0, 6])
+    >>> J[:, 3] == J[:, 5]
+    True
+    """
+    H = sp.Integer(1) if H is None else length(H, "H")
+    D = sp.Rational(1, 2) if D is None else length(D, "D")
+    S = _cols(
+        [0, 0, 1, 0, 0, 0],
+        [1, 0, 0, 0, H, 0],
+        [0, 0, 0, 0, 1, 0],
+        [0, 1, 0, -H, 0, 0],
+        [1, 0, 0, 0, H, 0],
+        [0, 1, 0, -H, 0, 0],
+    )
+    return SerialChain(_T([0, D, H]), S, name="stanford", description="Stanford-type RRPRRR arm")
+
+
 # --- issue 11, item 6: a student's own arm from URDF joint placements --------------------------------
 _URDF_KINDS = {"revolute": "R", "continuous": "R", "prismatic": "P", "fixed": None}
 #: largest difference between a typed rpy angle and the angle of its exact rational rotation (radians)
@@ -272,7 +302,7 @@ def _rational_cos_sin(a: sp.Rational) -> tuple[sp.Rational, sp.Rational]:
     """(cos â, sin â) = ((1 − t²)/(1 + t²), 2t/(1 + t²)) for the rational t of smallest denominator
     (a continued-fraction convergent of tan(a/2), computed with 50 digits) with |â − a| ≤ URDF_ANGLE_TOL
     (modulo 2π): an exact rational point on the unit circle at the typed angle, to 1e-18 rad."""
-    from .exactfield import mp_context
+    from ..exact.field import mp_context
 
     mpmath = mp_context()  # this thread's own mpmath context: never the global precision
 

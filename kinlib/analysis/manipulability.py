@@ -22,14 +22,14 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ._backend import as_vector, describe, exact_jacobian, is_symbolic, nested_shape, numeric_jacobian, numeric_vectors
-from .budget import ExactTimeoutError, OutOfTime, budget_seconds, report, run
-from .exact import TIME_BUDGET, NumericFallbackWarning, exact_det
-from .exactfield import FALLBACK_DIGITS, decide_zero, mp_context, mp_matrix
+from .._backend import as_vector, describe, exact_jacobian, is_symbolic, nested_shape, numeric_jacobian, numeric_vectors
+from ..exact.budget import ExactTimeoutError, OutOfTime, budget_seconds, report, run
+from ..exact.field import FALLBACK_DIGITS, decide_zero, mp_context, mp_matrix
+from ..exact.linalg import TIME_BUDGET, NumericFallbackWarning, exact_det
+from ..exact.trigpoly import TrigRing, angles_in
 from .nearsingular import NEAR_SINGULAR, SINGULAR_RTOL, near_singular, peak_manipulability, singularity_state
 from .singularities import trig_simplify
 from .taskspace import task_row_indices, task_rows
-from .trigpoly import TrigRing, angles_in
 
 __all__ = [
     "manipulability",
@@ -165,7 +165,7 @@ def _kappa_parts(J: Any, what: str):
     if k > 2 and not M.free_symbols:
         # a constant J with sines of numbers (sin 1, …): singular exactly when det G = 0 (decided exactly); else the
         # eigenvalues are roots of a cubic or worse with transcendental coefficients: κ from a 60-digit SVD, flagged
-        from .fallback import fallback_rank, fallback_warning
+        from ..exact.fallback import fallback_rank, fallback_warning
 
         Gc = M * M.T if M.rows <= M.cols else M.T * M
         if decide_zero(exact_det(Gc)):

@@ -19,7 +19,7 @@ import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
 from .display import readable_fold, readable_ratio
-from .exactfield import FALLBACK_DIGITS, ExactField, NotExact, PointLift, decide_zero, mp_context, mp_matrix, mp_value
+from .field import FALLBACK_DIGITS, ExactField, NotExact, PointLift, decide_zero, mp_context, mp_matrix, mp_value
 from .trigpoly import NotTrigPolynomial, TrigRing
 
 __all__ = ["EXACT_BUDGET", "MAX_MINORS", "RankAnalysis", "ring_det", "canonical_rows", "rank_conditions"]

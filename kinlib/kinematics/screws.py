@@ -9,9 +9,9 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_scalar, as_vector, check_real_finite, describe, exact_number, is_symbolic
-from .display import is_identically_zero
-from .exactfield import decide_zero
+from .._backend import as_matrix, as_scalar, as_vector, check_real_finite, describe, exact_number, is_symbolic
+from ..exact.display import is_identically_zero
+from ..exact.field import decide_zero
 from .rigid import check_se3, check_unit_vector, cross, log3, rodrigues_coefficients, skew, skew_vector
 
 __all__ = [
@@ -251,7 +251,7 @@ def log6(T, form: str = "matrix"):
     >>> log6(sp.Matrix([[1, 0, 0, 3], [0, 1, 0, 4], [0, 0, 1, 0], [0, 0, 0, 1]]), form="screw_angle")[1]
     5
     """
-    from ._backend import real_array
+    from .._backend import real_array
     from .rigid import log3
 
     if not isinstance(form, str) or form not in _LOG6_FORMS:

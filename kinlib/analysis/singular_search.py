@@ -20,7 +20,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ._backend import describe
+from .._backend import describe
 from .taskspace import task_rows
 
 __all__ = ["find_singularities", "SingularPoints"]
@@ -91,7 +91,7 @@ def find_singularities(
     >>> bool(np.all(sigma < 1e-6)) and bool(np.allclose(np.sin(q[:, 1]) * np.sin(q[:, 2]), 0, atol=1e-5))
     True
     """
-    from .chains import SerialChain
+    from ..kinematics.chains import SerialChain
 
     if not isinstance(chain, SerialChain):
         raise TypeError(f"chain must be a kinlib SerialChain, got {describe(chain)}")

@@ -44,12 +44,12 @@ import numpy as np
 import sympy as sp
 from sympy.polys.matrices import DomainMatrix
 
-from ._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
+from .._backend import as_matrix, describe, exact_number, is_symbolic, joint_symbols, real_array
 from .budget import ExactTimeoutError, OutOfTime, budget_seconds, run
 from .display import readable
-from .exact_rank import RankAnalysis, canonical_rows, rank_conditions
-from .exactfield import FALLBACK_DIGITS, MAX_MULTIPLE, NotExact, decide_zero, exact_is_zero
 from .fallback import NumericFallbackWarning, fallback_rank, fallback_rref, fallback_warning
+from .field import FALLBACK_DIGITS, MAX_MULTIPLE, NotExact, decide_zero, exact_is_zero
+from .rank import RankAnalysis, canonical_rows, rank_conditions
 
 __all__ = [
     "Rank",

@@ -36,7 +36,7 @@ class NotTrigPolynomial(ValueError):
     >>> TrigRing([sp.sqrt(L) * sp.sin(t)])   # exact mode: √L is not a polynomial generator
     Traceback (most recent call last):
         ...
-    kinlib.trigpoly.NotTrigPolynomial: sqrt(L)
+    kinlib.exact.trigpoly.NotTrigPolynomial: sqrt(L)
     """
 
 

@@ -29,7 +29,7 @@ from typing import Any, NamedTuple
 import numpy as np
 import sympy as sp
 
-from ._backend import (
+from .._backend import (
     as_vector,
     check_real_finite,
     exact_jacobian,
@@ -39,10 +39,10 @@ from ._backend import (
     numeric_vectors,
     within_float_range,
 )
-from .budget import ExactTimeoutError, OutOfTime, budget_seconds, run
-from .display import readable, readable_ratio
-from .exact import TIME_BUDGET
-from .exactfield import decide_zero
+from ..exact.budget import ExactTimeoutError, OutOfTime, budget_seconds, run
+from ..exact.display import readable, readable_ratio
+from ..exact.field import decide_zero
+from ..exact.linalg import TIME_BUDGET
 from .manipulability import velocity_ellipsoid
 from .taskspace import task_rows
 
@@ -187,7 +187,7 @@ def _exact_pinv(M: sp.Matrix, name: str = "J"):
         )
     m, n = M.shape
     try:
-        from .exactfield import ExactField, NotExact
+        from ..exact.field import ExactField, NotExact
     except ImportError:  # pragma: no cover - the exact field is part of kinlib
         ExactField, NotExact = None, ValueError
     if ExactField is not None:
@@ -447,7 +447,7 @@ def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
     (one linear solve), else the matrix Jᵀ(J Jᵀ + λ²I)⁻¹; None when the field does not apply."""
     const_v = not v.free_symbols
     try:
-        from .exactfield import ExactField
+        from ..exact.field import ExactField
 
         fld = ExactField(list(M) + [lam] + (list(v) if const_v else []))
         A = fld.field_matrix(M)

@@ -44,8 +44,8 @@ from sympy.printing.jscode import JavascriptCodePrinter
 from sympy.printing.precedence import precedence
 from sympy.printing.pycode import PythonCodePrinter
 
+from .._backend import describe
 from . import native
-from ._backend import describe
 from .native import ArithmeticRules
 
 __all__ = ["CompiledMatrix", "javascript_function"]
@@ -289,129 +289,16 @@ class _BatchEmitter:
     def _emit(self, e, dest: str, allow_neg: bool = False) -> bool:
         """Emit code leaving e in dest (or -e, returning True, when allow_neg); returns whether negated."""
         scratch: list[str] = []
-        neg = False
         if e.is_Mul:
-            coeff, factors = e.as_coeff_mul()
-            flat, divs = [], []
-            for f in factors:
-                if f.is_Pow and f.exp.is_Integer and 2 <= int(f.exp) <= 4:
-                    flat += [f.base] * int(f.exp)
-                elif f.is_Pow and f.exp.is_Integer and int(f.exp) == -1:
-                    divs.append(f.base)
-                else:
-                    flat.append(f)
-            neg = bool(coeff < 0)
-            c = abs(coeff)
-            if not flat:
-                flat, c = [sp.Float(float(c))], sp.S.One
-            ops = []
-            for f in flat:
-                txt, fneg = (self._num(f), False) if f.is_Number else self._operand(f, scratch)
-                ops.append(txt)
-                neg ^= fneg
-            if len(ops) == 1:
-                if c != 1:
-                    if neg and not allow_neg:
-                        c, neg = -c, False
-                    self.lines.append(f"_mul({ops[0]}, {self._num(c)}, out={dest})")
-                    c = sp.S.One
-                elif divs:
-                    self.lines.append(f"_div({ops[0]}, 1.0, out={dest})")
-                elif neg and not allow_neg:
-                    self.lines.append(f"_neg({ops[0]}, out={dest})")
-                    neg = False
-                else:
-                    self.lines.append(f"{dest}[...] = {ops[0]}")
-            else:
-                self.lines.append(f"_mul({ops[0]}, {ops[1]}, out={dest})")
-                for o in ops[2:]:
-                    self.lines.append(f"_mul({dest}, {o}, out={dest})")
-            if c != 1:
-                if neg and not allow_neg:
-                    c, neg = -c, False
-                self.lines.append(f"_mul({dest}, {self._num(c)}, out={dest})")
-            for d in divs:
-                txt, dneg = self._operand(d, scratch)
-                self.lines.append(f"_div({dest}, {txt}, out={dest})")
-                neg ^= dneg
+            neg = self._emit_mul(e, dest, allow_neg, scratch)
         elif e.is_Add:
-            const = sp.S.Zero
-            terms = []
-            for t in e.args:
-                if t.is_Number:
-                    const += t
-                else:
-                    terms.append(t)
-            # a computed positive term goes straight into dest; the rest are names or scratch rows
-            first = None
-            for t in terms:
-                if t not in self.name and not t.could_extract_minus_sign():
-                    first = t
-                    break
-            acc_neg = None  # None: dest not started
-            if first is not None:
-                acc_neg = self._emit(first, dest, allow_neg=True)
-                terms.remove(first)
-            pending = None  # a first term not yet combined: (text, negated)
-            for t in terms:
-                if t in self.name:
-                    txt, tneg = self.name[t], t in self.negated
-                else:
-                    txt, tneg = self._operand(t, scratch)
-                if acc_neg is None and pending is None:
-                    pending = (txt, tneg)
-                    continue
-                if pending is not None:
-                    (a, aneg), pending = pending, None
-                    if aneg == tneg:
-                        self.lines.append(f"_add({a}, {txt}, out={dest})")
-                        acc_neg = aneg
-                    elif tneg:
-                        self.lines.append(f"_sub({a}, {txt}, out={dest})")
-                        acc_neg = False
-                    else:
-                        self.lines.append(f"_sub({txt}, {a}, out={dest})")
-                        acc_neg = False
-                elif acc_neg == tneg:
-                    self.lines.append(f"_add({dest}, {txt}, out={dest})")
-                elif not acc_neg:
-                    self.lines.append(f"_sub({dest}, {txt}, out={dest})")
-                else:
-                    self.lines.append(f"_sub({txt}, {dest}, out={dest})")
-                    acc_neg = False
-            if pending is not None:  # a single term (and maybe a constant)
-                a, acc_neg = pending
-                if const != 0:
-                    self._add_constant(a, acc_neg, float(const), dest)
-                    acc_neg, const = False, sp.S.Zero
-                elif acc_neg and not allow_neg:
-                    self.lines.append(f"_neg({a}, out={dest})")
-                    acc_neg = False
-                else:
-                    self.lines.append(f"{dest}[...] = {a}")
-            if const != 0:  # when acc_neg, dest holds −(sum): the value is k − dest
-                self._add_constant(dest, acc_neg, float(const), dest)
-                acc_neg = False
-            neg = bool(acc_neg)
+            neg = self._emit_add(e, dest, allow_neg, scratch)
         elif isinstance(e, sp.Function) and e.func in _UFUNC_OF and len(e.args) == 1:
-            arg, aneg = self._operand(e.args[0], scratch)
-            if aneg:  # rare: fix the sign of the argument first
-                self.lines.append(f"_neg({arg}, out={dest})")
-                arg = dest
-            self.lines.append(f"{_UFUNC_OF[e.func]}({arg}, out={dest})")
+            neg = self._emit_ufunc(e, dest, scratch)
         elif e in self.name:
-            if e in self.negated and not allow_neg:
-                self.lines.append(f"_neg({self.name[e]}, out={dest})")
-            else:
-                self.lines.append(f"{dest}[...] = {self.name[e]}")
-                neg = e in self.negated
+            neg = self._emit_name(e, dest, allow_neg)
         else:  # anything else: the NumPy expression as printed, assigned into dest
-            txt = self.pr.doprint(
-                e.xreplace(
-                    {s: (-1 if s in self.negated else 1) * sp.Symbol(n) for s, n in self.name.items() if s.is_Symbol}
-                )
-            )
-            self.lines.append(f"{dest}[...] = {txt}")
+            neg = self._emit_printed(e, dest)
         for b in scratch:
             self._release(b)
         if neg and not allow_neg:
@@ -419,9 +306,187 @@ class _BatchEmitter:
             neg = False
         return neg
 
+    @staticmethod
+    def _mul_factors(e):
+        """(coefficient, factors, divisors) of a product: small integer powers written out as repeated factors,
+        x**-1 as a divisor."""
+        coeff, factors = e.as_coeff_mul()
+        flat, divs = [], []
+        for f in factors:
+            if f.is_Pow and f.exp.is_Integer and 2 <= int(f.exp) <= 4:
+                flat += [f.base] * int(f.exp)
+            elif f.is_Pow and f.exp.is_Integer and int(f.exp) == -1:
+                divs.append(f.base)
+            else:
+                flat.append(f)
+        return coeff, flat, divs
+
+    def _emit_mul(self, e, dest: str, allow_neg: bool, scratch: list) -> bool:
+        """dest = a product: its factors multiplied in order, then the coefficient, then the divisors."""
+        coeff, flat, divs = self._mul_factors(e)
+        neg = bool(coeff < 0)
+        c = abs(coeff)
+        if not flat:
+            flat, c = [sp.Float(float(c))], sp.S.One
+        ops = []
+        for f in flat:
+            txt, fneg = (self._num(f), False) if f.is_Number else self._operand(f, scratch)
+            ops.append(txt)
+            neg ^= fneg
+        if len(ops) == 1:
+            c, neg = self._mul_single(ops[0], c, neg, bool(divs), dest, allow_neg)
+        else:
+            self.lines.append(f"_mul({ops[0]}, {ops[1]}, out={dest})")
+            for o in ops[2:]:
+                self.lines.append(f"_mul({dest}, {o}, out={dest})")
+        if c != 1:
+            if neg and not allow_neg:
+                c, neg = -c, False
+            self.lines.append(f"_mul({dest}, {self._num(c)}, out={dest})")
+        for d in divs:
+            txt, dneg = self._operand(d, scratch)
+            self.lines.append(f"_div({dest}, {txt}, out={dest})")
+            neg ^= dneg
+        return neg
+
+    def _mul_single(self, op: str, c, neg: bool, divs: bool, dest: str, allow_neg: bool):
+        """dest = one factor (times c when c ≠ 1, folding a sign into c): the (c, neg) still to apply."""
+        if c != 1:
+            if neg and not allow_neg:
+                c, neg = -c, False
+            self.lines.append(f"_mul({op}, {self._num(c)}, out={dest})")
+            return sp.S.One, neg
+        if divs:
+            self.lines.append(f"_div({op}, 1.0, out={dest})")
+        elif neg and not allow_neg:
+            self.lines.append(f"_neg({op}, out={dest})")
+            neg = False
+        else:
+            self.lines.append(f"{dest}[...] = {op}")
+        return c, neg
+
+    def _emit_add(self, e, dest: str, allow_neg: bool, scratch: list) -> bool:
+        """dest = a sum: a computed positive term straight into dest, the names and scratch rows added to it
+        with the signs folded into _add/_sub, the constant last."""
+        const = sp.S.Zero
+        terms = []
+        for t in e.args:
+            if t.is_Number:
+                const += t
+            else:
+                terms.append(t)
+        # a computed positive term goes straight into dest; the rest are names or scratch rows
+        first = next((t for t in terms if t not in self.name and not t.could_extract_minus_sign()), None)
+        acc_neg = None  # None: dest not started
+        if first is not None:
+            acc_neg = self._emit(first, dest, allow_neg=True)
+            terms.remove(first)
+        pending = None  # a first term not yet combined: (text, negated)
+        for t in terms:
+            if t in self.name:
+                txt, tneg = self.name[t], t in self.negated
+            else:
+                txt, tneg = self._operand(t, scratch)
+            if acc_neg is None and pending is None:
+                pending = (txt, tneg)
+            elif pending is not None:
+                acc_neg, pending = self._add_pair(pending, txt, tneg, dest), None
+            else:
+                acc_neg = self._add_to(dest, acc_neg, txt, tneg)
+        if pending is not None:  # a single term (and maybe a constant)
+            acc_neg, const = self._add_single(pending, const, dest, allow_neg)
+        if const != 0:  # when acc_neg, dest holds −(sum): the value is k − dest
+            self._add_constant(dest, acc_neg, float(const), dest)
+            acc_neg = False
+        return bool(acc_neg)
+
+    def _add_pair(self, first: tuple, txt: str, tneg: bool, dest: str) -> bool:
+        """dest = the first two terms (each a name or row, maybe holding minus its value): whether dest is negated."""
+        a, aneg = first
+        if aneg == tneg:
+            self.lines.append(f"_add({a}, {txt}, out={dest})")
+            return aneg
+        if tneg:
+            self.lines.append(f"_sub({a}, {txt}, out={dest})")
+        else:
+            self.lines.append(f"_sub({txt}, {a}, out={dest})")
+        return False
+
+    def _add_to(self, dest: str, acc_neg: bool, txt: str, tneg: bool) -> bool:
+        """dest += one more term (dest and the term each maybe negated): whether dest is negated."""
+        if acc_neg == tneg:
+            self.lines.append(f"_add({dest}, {txt}, out={dest})")
+        elif not acc_neg:
+            self.lines.append(f"_sub({dest}, {txt}, out={dest})")
+        else:
+            self.lines.append(f"_sub({txt}, {dest}, out={dest})")
+            acc_neg = False
+        return acc_neg
+
+    def _add_single(self, term: tuple, const, dest: str, allow_neg: bool):
+        """dest = a sum's only term (plus its constant when there is one): (negated, the constant still to add)."""
+        a, acc_neg = term
+        if const != 0:
+            self._add_constant(a, acc_neg, float(const), dest)
+            return False, sp.S.Zero
+        if acc_neg and not allow_neg:
+            self.lines.append(f"_neg({a}, out={dest})")
+            acc_neg = False
+        else:
+            self.lines.append(f"{dest}[...] = {a}")
+        return acc_neg, const
+
+    def _emit_ufunc(self, e, dest: str, scratch: list) -> bool:
+        """dest = f(argument) for a function NumPy has as a ufunc (sin, cos, sqrt, …)."""
+        arg, aneg = self._operand(e.args[0], scratch)
+        if aneg:  # rare: fix the sign of the argument first
+            self.lines.append(f"_neg({arg}, out={dest})")
+            arg = dest
+        self.lines.append(f"{_UFUNC_OF[e.func]}({arg}, out={dest})")
+        return False
+
+    def _emit_name(self, e, dest: str, allow_neg: bool) -> bool:
+        """dest = a temporary or joint that already has a name."""
+        if e in self.negated and not allow_neg:
+            self.lines.append(f"_neg({self.name[e]}, out={dest})")
+            return False
+        self.lines.append(f"{dest}[...] = {self.name[e]}")
+        return e in self.negated
+
+    def _emit_printed(self, e, dest: str) -> bool:
+        """dest = the NumPy expression as SymPy's printer writes it, the named symbols by their names."""
+        names = {s: (-1 if s in self.negated else 1) * sp.Symbol(n) for s, n in self.name.items() if s.is_Symbol}
+        self.lines.append(f"{dest}[...] = {self.pr.doprint(e.xreplace(names))}")
+        return False
+
     def emit_block(self, repl, outputs) -> list[str]:
         """Lines computing the cse temporaries ``repl`` and writing each (slot, expr) of ``outputs``."""
-        # each output right after the last temporary it needs: temporaries die early, fewer rows live
+        stmts, last = self._schedule(repl, outputs)
+        for sym in set().union(*(e.free_symbols for _, e, _ in stmts)):
+            if str(sym).startswith("_q"):
+                self.name[sym] = str(sym)
+        for j, (s, e, slot) in enumerate(stmts):
+            if s in self.trig:  # with its partner (sin a with cos a), at the first use of either
+                if s not in self.name:
+                    self._emit_trig(s)
+                self._release_dead(e, j, last)
+                continue
+            e = _collect(e)
+            if s is None:
+                self._emit_output(e, slot)
+            elif last.get(s, -1) < 0:
+                continue  # unused temporary
+            else:
+                buf = self._emit_temporary(s, e)
+            self._release_dead(e, j, last)
+            if s is not None:
+                self._buf_of[s] = buf
+        return self.lines
+
+    @staticmethod
+    def _schedule(repl, outputs):
+        """The statements in order, (temporary or None, expr, output slot or None), each output right after the
+        last temporary it needs (temporaries die early, fewer rows live); and each symbol's last statement."""
         where = {s: j for j, (s, _) in enumerate(repl)}
         after: dict[int, list] = {}
         for slot, e in outputs:
@@ -433,49 +498,39 @@ class _BatchEmitter:
         for j, (_, e, _) in enumerate(stmts):
             for sym in e.free_symbols:
                 last[sym] = j
-        for sym in set().union(*(e.free_symbols for _, e, _ in stmts)):
-            if str(sym).startswith("_q"):
-                self.name[sym] = str(sym)
-        for j, (s, e, slot) in enumerate(stmts):
-            if s in self.trig:  # with its partner (sin a with cos a), at the first use of either
-                if s not in self.name:
-                    self._emit_trig(s)
-                self._release_dead(e, j, last)
-                continue
-            e = _collect(e)
-            start = len(self.lines)
-            if s is not None:
-                if last.get(s, -1) < 0:
-                    continue  # unused temporary
-                buf = self._alloc()
-                if self._emit(e, buf, allow_neg=True):  # the row holds -s: users fold the sign in
-                    self.negated.add(s)
-                self.name[s] = str(s)
-                # bind the name where the row is first written; later calls use the name
-                pat = re.compile(rf"\b{buf}\b")
-                k = next((i for i in range(start, len(self.lines)) if pat.search(self.lines[i])), None)
-                if k is not None and self.lines[k].endswith(f"out={buf})") and pat.subn("", self.lines[k])[1] == 1:
-                    self.lines[k] = f"{s} = {self.lines[k]}"
-                    self.lines[k + 1 :] = [pat.sub(str(s), ln) for ln in self.lines[k + 1 :]]
-                else:
-                    self.lines[start:] = [pat.sub(str(s), ln) for ln in self.lines[start:]]
-                    self.lines.insert(start, f"{s} = {buf}")
+        return stmts, last
+
+    def _emit_temporary(self, s, e) -> str:
+        """Compute the temporary s = e into a fresh row, named s where the row is first written: the row."""
+        start = len(self.lines)
+        buf = self._alloc()
+        if self._emit(e, buf, allow_neg=True):  # the row holds -s: users fold the sign in
+            self.negated.add(s)
+        self.name[s] = str(s)
+        # bind the name where the row is first written; later calls use the name
+        pat = re.compile(rf"\b{buf}\b")
+        k = next((i for i in range(start, len(self.lines)) if pat.search(self.lines[i])), None)
+        if k is not None and self.lines[k].endswith(f"out={buf})") and pat.subn("", self.lines[k])[1] == 1:
+            self.lines[k] = f"{s} = {self.lines[k]}"
+            self.lines[k + 1 :] = [pat.sub(str(s), ln) for ln in self.lines[k + 1 :]]
+        else:
+            self.lines[start:] = [pat.sub(str(s), ln) for ln in self.lines[start:]]
+            self.lines.insert(start, f"{s} = {buf}")
+        return buf
+
+    def _emit_output(self, e, slot: str) -> None:
+        """Write e into the output view ``slot``."""
+        if e.is_Symbol and e in self.name and e in self.negated:
+            self.lines.append(f"_neg({self.name[e]}, out={slot})")
+        elif e.is_Symbol and e in self.name:
+            self.lines.append(f"{slot} = {self.name[e]}")
+        else:
+            n0 = len(self.lines)
+            self._emit(e, "_o")
+            if len(self.lines) - n0 == 1:
+                self.lines[-1] = re.sub(r"\b_o\b", slot, self.lines[-1])
             else:
-                if e.is_Symbol and e in self.name and e in self.negated:
-                    self.lines.append(f"_neg({self.name[e]}, out={slot})")
-                elif e.is_Symbol and e in self.name:
-                    self.lines.append(f"{slot} = {self.name[e]}")
-                else:
-                    n0 = len(self.lines)
-                    self._emit(e, "_o")
-                    if len(self.lines) - n0 == 1:
-                        self.lines[-1] = re.sub(r"\b_o\b", slot, self.lines[-1])
-                    else:
-                        self.lines.insert(n0, f"_o = {slot}")
-            self._release_dead(e, j, last)
-            if s is not None:
-                self._buf_of[s] = buf
-        return self.lines
+                self.lines.insert(n0, f"_o = {slot}")
 
     def _release_dead(self, e, j: int, last: dict) -> None:
         """Free the rows of the temporaries in e whose last use is statement j."""

@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ._backend import as_jacobian, describe, is_symbolic
+from .._backend import as_jacobian, describe, is_symbolic
 
 __all__ = [
     "ROW_NAMES",

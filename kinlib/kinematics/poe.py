@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import sympy as sp
 
-from ._backend import as_matrix, as_screw_list, as_thetas, is_symbolic
+from .._backend import as_matrix, as_screw_list, as_thetas, is_symbolic
 from .rigid import check_se3
 from .screws import exp6_unchecked, screw_kind
 

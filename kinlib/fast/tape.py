@@ -14,7 +14,7 @@ from collections.abc import Sequence
 
 import sympy as sp
 
-from ._backend import describe
+from .._backend import describe
 from .codegen import CompiledMatrix
 
 __all__ = ["Tape", "TapeValue"]

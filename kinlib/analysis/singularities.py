@@ -36,12 +36,12 @@ from typing import Any
 import numpy as np
 import sympy as sp
 
-from ._backend import as_jacobian, describe, exact_number, is_symbolic, joint_symbols
-from .budget import OutOfTime, budget_seconds, clock, report, run
-from .exact import column_space, evaluate_at, left_null_space, rank_at
+from .._backend import as_jacobian, describe, exact_number, is_symbolic, joint_symbols
+from ..exact.budget import OutOfTime, budget_seconds, clock, report, run
+from ..exact.linalg import column_space, evaluate_at, left_null_space, rank_at
+from ..exact.trigpoly import NotTrigPolynomial, TrigRing, angles_in
+from ..exact.trigsign import generator_kinds, proves_nonzero
 from .taskspace import ROW_NAMES, task_rows
-from .trigpoly import NotTrigPolynomial, TrigRing, angles_in
-from .trigsign import generator_kinds, proves_nonzero
 
 __all__ = [
     "ROW_NAMES",

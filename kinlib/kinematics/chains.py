@@ -13,7 +13,7 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 import sympy as sp
 
-from ._backend import (
+from .._backend import (
     as_matrix,
     as_screw_list,
     as_thetas,
@@ -23,12 +23,12 @@ from ._backend import (
     is_symbolic,
     joint_symbols,
 )
-from .codegen import CompiledMatrix
+from ..fast.codegen import CompiledMatrix
+from ..fast.tape import Tape
 from .jacobians import jacobian_body as _jacobian_body
 from .jacobians import jacobian_space as _jacobian_space
 from .poe import checked_screw_list, fk_body, fk_space
 from .rigid import adjoint, check_se3, cross, skew, trans_inv
-from .tape import Tape
 
 __all__ = ["fk_space", "fk_body", "SerialChain"]
 
@@ -564,27 +564,43 @@ def _poe_rows(chain, what: str, num, joint):
     """Rows of T, J_s, J_b, the geometric J or the skeleton of ``chain`` by the recursions of
     :meth:`SerialChain._numeric_form`, in the arithmetic given by ``num`` (an exact constant into it)
     and ``joint(i)`` → (sin θ_i, cos θ_i, θ_i)."""
-    n, kinds = chain.n, chain.joint_types
-    M = chain.M
-    pM = [num(M[i, 3]) for i in range(3)]
     if what == "jb":
-        B = _body_screw_columns(M, chain.screws)
-        cols, Q, u = [None] * n, _I3, [0, 0, 0]
-        for i in reversed(range(n)):
-            b, nu = [num(x) for x in B[i][:3]], [num(x) for x in B[i][3:]]
-            cols[i] = _mtv(Q, b) + _mtv(Q, _vadd(nu, _vcross(b, u)))
-            rot, tr = _exp_apply(_exp_constants(B[i], kinds[i], num), *joint(i))
-            Q, u = _mm(rot, Q), _vadd(_mv(rot, u), tr)
-        return [[cols[j][r] for j in range(n)] for r in range(6)]
-    C = [_exp_constants(chain.screws[:, i], kinds[i], num) for i in range(n)]
-    E = [_exp_apply(C[i], *joint(i)) for i in range(n)]
+        return _body_jacobian_rows(chain, num, joint)
+    C = [_exp_constants(chain.screws[:, i], chain.joint_types[i], num) for i in range(chain.n)]
+    E = [_exp_apply(C[i], *joint(i)) for i in range(chain.n)]
     if what == "skeleton":
-        cols, R, p = [[0, 0, 0]], _I3, [0, 0, 0]
-        for i in range(n):
-            cols.append(_vadd(_mv(R, [num(x) for x in chain.joint_points[:, i]]), p))
-            p, R = _vadd(_mv(R, E[i][1]), p), _mm(R, E[i][0])
-        cols.append(_vadd(_mv(R, pM), p))
-        return [[col[r] for col in cols] for r in range(3)]
+        return _skeleton_rows(chain, num, E)
+    return _space_rows(chain, what, num, joint, C, E)
+
+
+def _body_jacobian_rows(chain, num, joint):
+    """J_b's rows, from the tool back: column i is Ad of the exponentials after joint i applied to B_i."""
+    n, kinds = chain.n, chain.joint_types
+    B = _body_screw_columns(chain.M, chain.screws)
+    cols, Q, u = [None] * n, _I3, [0, 0, 0]
+    for i in reversed(range(n)):
+        b, nu = [num(x) for x in B[i][:3]], [num(x) for x in B[i][3:]]
+        cols[i] = _mtv(Q, b) + _mtv(Q, _vadd(nu, _vcross(b, u)))
+        rot, tr = _exp_apply(_exp_constants(B[i], kinds[i], num), *joint(i))
+        Q, u = _mm(rot, Q), _vadd(_mv(rot, u), tr)
+    return [[cols[j][r] for j in range(n)] for r in range(6)]
+
+
+def _skeleton_rows(chain, num, E):
+    """The skeleton's rows (x, y, z of the base, each joint's point and the tool), from the exponentials E."""
+    pM = [num(chain.M[i, 3]) for i in range(3)]
+    cols, R, p = [[0, 0, 0]], _I3, [0, 0, 0]
+    for i in range(chain.n):
+        cols.append(_vadd(_mv(R, [num(x) for x in chain.joint_points[:, i]]), p))
+        p, R = _vadd(_mv(R, E[i][1]), p), _mm(R, E[i][0])
+    cols.append(_vadd(_mv(R, pM), p))
+    return [[col[r] for col in cols] for r in range(3)]
+
+
+def _space_rows(chain, what: str, num, joint, C, E):
+    """Rows of T ("fk"), J_s ("js") or the geometric J ("jg") from the exponentials' constants C and values E."""
+    n, M = chain.n, chain.M
+    pM = [num(M[i, 3]) for i in range(3)]
     R = [_I3]  # R[i] = rot(E_1)⋯rot(E_i)
     for i in range(n if what == "fk" else n - 1):
         R.append(_mm(R[-1], E[i][0]))
