@@ -559,7 +559,8 @@ def force_ellipsoid(J: Any, rows: Any = None, *, time_budget=TIME_BUDGET):
                 if not s.free_symbols:
                     raise
                 zero = False  # not identically zero: 1/s is exact wherever s ≠ 0
-            out.append(sp.oo if zero else (1 / s if s.has(sp.CRootOf) or s.is_Float else sp.radsimp(1 / s)))
+            plain = s.has(sp.CRootOf) or s.is_Float or sp.count_ops(s) > 60  # (radsimp of a long root: minutes)
+            out.append(sp.oo if zero else (1 / s if plain else sp.radsimp(1 / s)))
         return out, U
     A = numeric_jacobian(J)
     if rows is None and A.shape[-2] == 6:
