@@ -497,7 +497,7 @@ def _back(fld, X) -> sp.Matrix:
 
 def _terms(x) -> int:
     """Terms of a field element's numerator and denominator (polynomials in t and the parameters)."""
-    return sum(len(getattr(p, "terms", lambda: [p])()) for p in (x.numer, x.denom))
+    return sum(len(p.terms()) if hasattr(p, "terms") else 1 for p in (x.numer, x.denom))
 
 
 # ----------------------------------------------------------------------------------------------
