@@ -489,7 +489,9 @@ def _back(fld, X) -> sp.Matrix:
         num, den = fld.to_ratio(x)
         if _terms(x) <= READABLE_TERMS:  # (no sines: algebraic numbers, radsimp'd without a trig ring's field
             # isomorphisms, 16 s → under a second for the planar 2R at (π/8, π/3))
-            return readable_ratio(num, den) if num.has(sp.sin, sp.cos) or den.has(sp.sin, sp.cos) else readable(num / den)
+            return (
+                readable_ratio(num, den) if num.has(sp.sin, sp.cos) or den.has(sp.sin, sp.cos) else readable(num / den)
+            )
         return num if den == 1 else num / den
 
     return sp.Matrix(rows, cols, [entry(L[i][j]) for i in range(rows) for j in range(cols)])
