@@ -270,10 +270,11 @@ def _mp_svd(M):
 _PUMA0 = robots.puma560(R(2, 5), 0, 0, R(2, 5))
 
 
-@settings(max_examples=4, **SETTINGS)
+@settings(max_examples=3, **SETTINGS)
 @given(
     st.sampled_from(["ur5_elbow", "ur5_wrist", "puma0_elbow"]),
-    st.lists(st.tuples(st.integers(1, 12), st.integers(5, 17)), min_size=5, max_size=5),
+    # denominators whose sines SymPy keeps as sin(kπ/q) (π/5, π/12 ... become radicals: not this path, see below)
+    st.lists(st.tuples(st.integers(1, 12), st.sampled_from([7, 9, 11, 13])), min_size=5, max_size=5),
 )
 def test_velocity_ellipsoid_at_singular_poses(family, frac):
     """Random rational·π angles on UR5/PUMA singular families: semi-axes right to 40 digits against a 60-digit
