@@ -879,6 +879,10 @@ def singular_poses_section(args, targets: Targets) -> list[str]:
     import warnings
 
     from kinlib.exact import NumericFallbackWarning, column_space, left_null_space, rank_at
+    from kinlib.manipulability import velocity_ellipsoid
+
+    def ellipsoid(J, q, thetas):  # the default rows ("linear"), J at the pose; exact when its rank is ≤ 1
+        return velocity_ellipsoid(J.subs(dict(zip(thetas, q))))
 
     R, pi = sp.Rational, sp.pi
     h = [3 * pi / 11, 2 * pi / 7, 5 * pi / 13, 3 * pi / 11, 2 * pi / 7, R(1, 3)]
@@ -895,7 +899,7 @@ def singular_poses_section(args, targets: Targets) -> list[str]:
     lines = [
         "## Exact analysis at singular poses (issue 32)",
         "",
-        "`rank_at`, `column_space`, `left_null_space` of the space Jacobian at elbow, wrist and shoulder "
+        "`rank_at`, `column_space`, `left_null_space`, `velocity_ellipsoid` (linear rows) of the space Jacobian at elbow, wrist and shoulder "
         "singularities with mixed rational·π angles (2π/7, 3π/11, 5π/13, 1/3: their number field has degree in the "
         "hundreds). CPU seconds per call (`time.thread_time`, SymPy's cache cleared before each pose) and whether "
         "the answer is exact. Before issue 32 each call spent its whole 60 s budget, then answered in 60-digit "
@@ -907,7 +911,7 @@ def singular_poses_section(args, targets: Targets) -> list[str]:
         J = chain.jacobian_space()
         sp.core.cache.clear_cache()
         cells, worst, exact = [], 0.0, True
-        for fn in (rank_at, column_space, left_null_space):
+        for fn in (rank_at, column_space, left_null_space, ellipsoid):
             with warnings.catch_warnings(record=True) as caught:
                 warnings.simplefilter("always")
                 t0 = CLOCK()
@@ -915,6 +919,11 @@ def singular_poses_section(args, targets: Targets) -> list[str]:
                 dt = CLOCK() - t0
             if fn is rank_at:
                 ok, r = bool(out.exact), out
+            elif fn is ellipsoid:  # exact, or the stated-precision answer with its warning (both are right)
+                fell = any(issubclass(w.category, NumericFallbackWarning) for w in caught)
+                cells.append(f"{fmt_t(dt)} ({'60 digits, warned' if fell else 'exact'})")
+                worst = max(worst, dt)
+                continue
             else:
                 ok = not any(e.has(sp.Float) for e in out)
             ok = ok and not any(issubclass(w.category, NumericFallbackWarning) for w in caught)
@@ -923,7 +932,8 @@ def singular_poses_section(args, targets: Targets) -> list[str]:
             cells.append(f"{fmt_t(dt)} ({'exact' if ok else 'NOT exact'})")
         status = targets.upper(f"singular pose, {label}", worst if exact else None, T_SINGULAR_POSE)
         rows.append([f"{label}: rank {int(r)}", *cells, f"≤ {fmt_t(T_SINGULAR_POSE)} each, exact", status])
-    return lines + table(["pose", "rank_at", "column_space", "left_null_space", "target", "status"], rows)
+    header = ["pose", "rank_at", "column_space", "left_null_space", "velocity_ellipsoid", "target", "status"]
+    return lines + table(header, rows)
 
 
 _SINGULAR7_SCRIPT = r"""

@@ -24,7 +24,7 @@ import sympy as sp
 
 from .._backend import as_vector, describe, exact_jacobian, is_symbolic, nested_shape, numeric_jacobian, numeric_vectors
 from ..exact.budget import ExactTimeoutError, OutOfTime, budget_seconds, report, run
-from ..exact.field import FALLBACK_DIGITS, decide_zero, mp_context, mp_matrix
+from ..exact.field import FALLBACK_DIGITS, decide_zero, mp_context, mp_matrix, mp_value
 from ..exact.linalg import TIME_BUDGET, NumericFallbackWarning, exact_det
 from ..exact.trigpoly import TrigRing, angles_in
 from .nearsingular import NEAR_SINGULAR, SINGULAR_RTOL, near_singular, peak_manipulability, singularity_state
@@ -375,7 +375,72 @@ def velocity_ellipsoid(J: Any, rows: Any = None, hold: Any = None, *, time_budge
         U, s, _ = np.linalg.svd(A, full_matrices=False)
         return s, U
     M = exact_jacobian(J)
+    if _at_a_pose(M):
+        got = _pose_axes(M, seconds)
+        if got is not None:
+            return got
     return budgeted_axes(lambda: M * M.T, min(M.rows, M.cols), seconds, "velocity_ellipsoid", M.free_symbols)
+
+
+def _at_a_pose(M: sp.Matrix) -> bool:
+    """M is an evaluated J of three or more rows, none of them zero, with sines and cosines that did not evaluate
+    (angles such as 2π/7, 1/3): the Gram matrix's eigenvalues are then roots of a polynomial whose coefficients
+    lie in a number field of high degree, where SymPy's generic eigen-decomposition spent the whole budget."""
+    return (
+        not M.free_symbols
+        and M.rows >= 3
+        and M.has(sp.sin, sp.cos)
+        and all(any(e != 0 for e in M.row(i)) for i in range(M.rows))
+    )
+
+
+def _pose_rank_axes(M: sp.Matrix):
+    """In the budget's process: ("exact", lengths, U) when the rank r of M (proved by
+    :class:`~kinlib.exact_rank.RankAnalysis`, the structure at singular poses) is 0 or 1, else ("rank", r).
+    Rank 1: J Jᵀ = ‖·‖² c cᵀ for a pivot column c, so σ₁ = √(tr J Jᵀ) along c/‖c‖; the other axes have length 0
+    along an orthonormal basis of the left null space of M."""
+    from ..exact.linalg import _left_null_space_exact
+    from ..exact.rank import RankAnalysis
+
+    r = RankAnalysis(M).rank
+    if r > 1:
+        return ("rank", r)
+    m, k = M.rows, min(M.rows, M.cols)
+    if r == 0:
+        return ("exact", [sp.S.Zero] * k, sp.eye(m)[:, :k])
+    c = next(M.col(j) for j in range(M.cols) if any(decide_zero(e) is False for e in M.col(j)))
+    lam = sum((e**2 for e in M), sp.S.Zero)
+    u = c / sp.sqrt(sum((e**2 for e in c), sp.S.Zero))
+    N, why = _left_null_space_exact(M, m)
+    if N is None:
+        return ("rank", r)
+    zeros = sp.GramSchmidt([N.col(j) for j in range(N.cols)], orthonormal=True)[: k - 1]
+    return ("exact", [sp.sqrt(lam)] + [sp.S.Zero] * (k - 1), sp.Matrix.hstack(u, *zeros))
+
+
+def _pose_axes(M: sp.Matrix, seconds):
+    """velocity_ellipsoid at an evaluated pose (:func:`_at_a_pose`): exact for rank ≤ 1 (:func:`_pose_rank_axes`);
+    otherwise the eigen-decomposition of J Jᵀ in 60-digit numerics with a NumericFallbackWarning, its zero axes
+    (rank proved exactly) exactly 0. None when the rank itself is out of reach (then the generic path)."""
+    try:
+        got = run(seconds, "velocity_ellipsoid", _pose_rank_axes, M)
+    except (OutOfTime, ValueError):
+        return None
+    if got[0] == "exact":
+        return got[1], got[2]
+    r, k = got[1], min(M.rows, M.cols)
+    lengths, U = _numeric_axes(M * M.T, k)
+    if sum(1 for x in lengths if x != 0) != r:  # a nonzero axis below the 60-digit resolution: look closer
+        lengths, U = _numeric_axes(M * M.T, k, digits=4 * FALLBACK_DIGITS)
+    lengths = [x if i < r else sp.S.Zero for i, x in enumerate(lengths)]
+    warnings.warn(
+        f"velocity_ellipsoid: J has rank {r} here (proved exactly), so {k - r} semi-axes are exactly 0; the "
+        f"{r} nonzero ones are roots of a degree-{r} polynomial with coefficients in a number field of high degree "
+        f"(no closed form in reach): computed with {FALLBACK_DIGITS}-digit numerics",
+        NumericFallbackWarning,
+        stacklevel=3,
+    )
+    return lengths, U
 
 
 class _NoClosedForm(Exception):
@@ -413,16 +478,22 @@ def budgeted_axes(gram, k: int, seconds, what: str, symbols=()):
     return _numeric_axes(G, k)
 
 
-def _numeric_axes(G: sp.Matrix, k: int):
-    """(lengths, directions) of the k largest eigenvalues of the symmetric constant G, as 60-digit Floats."""
+def _numeric_axes(G: sp.Matrix, k: int, digits: int = FALLBACK_DIGITS):
+    """(lengths, directions) of the k largest eigenvalues of the symmetric constant G, as 60-digit Floats
+    (``digits``: the working precision, more for tiny eigenvalues)."""
     mpmath = mp_context()  # this thread's own context: never the global precision
-    X = mp_matrix(G)
-    with mpmath.workdps(FALLBACK_DIGITS + 20):
+    if digits > FALLBACK_DIGITS:
+        memo: dict = {}
+        with mpmath.workdps(digits + 40):
+            X = mpmath.matrix([[mp_value(G[i, j], memo, mpmath) for j in range(G.cols)] for i in range(G.rows)])
+    else:
+        X = mp_matrix(G)
+    with mpmath.workdps(digits + 20):
         X = (X + X.T) / 2
         E, Q = mpmath.eigsy(X)
         order = sorted(range(len(E)), key=lambda i: -E[i])[:k]
         top = max((abs(e) for e in E), default=mpmath.mpf(0))
-        tol = top * mpmath.mpf(10) ** -40
+        tol = top * mpmath.mpf(10) ** -(digits - 20)
 
         def fl(x):
             return sp.Float(mpmath.nstr(x, FALLBACK_DIGITS), FALLBACK_DIGITS) if abs(x) > tol else sp.S.Zero

@@ -469,19 +469,37 @@ def _field_dls(M: sp.Matrix, lam: sp.Expr, v: sp.Matrix):
     return _back(fld, X)
 
 
+#: an entry of an exact result is folded for reading (:func:`~kinlib.display.readable_ratio`: trig identities,
+#: common factors) only while its numerator and denominator in t = tan(g/2) have at most this many terms together;
+#: larger ones come back as one fraction of polynomials in sin g, cos g, exactly equal, unfolded (folding a UR5's
+#: J⁺ at integer angles was 93 % of its 21.7 s; issue 32)
+READABLE_TERMS = 24
+
+
 def _back(fld, X) -> sp.Matrix:
-    """A matrix over the exact field written back readably in the configuration's sines and cosines."""
+    """A matrix over the exact field written back in the configuration's sines and cosines (small entries folded
+    readably, large ones as a fraction of polynomials: :data:`READABLE_TERMS`)."""
     rows, cols = X.shape
     L = X.to_list()
-    return sp.Matrix(
-        rows,
-        cols,
-        [
-            readable_ratio(*fld.to_ratio(fld.F(L[i][j]))) if L[i][j] else sp.S.Zero
-            for i in range(rows)
-            for j in range(cols)
-        ],
-    )
+
+    def entry(x):
+        if not x:
+            return sp.S.Zero
+        x = fld.F(x)
+        num, den = fld.to_ratio(x)
+        if _terms(x) <= READABLE_TERMS:  # (no sines: algebraic numbers, radsimp'd without a trig ring's field
+            # isomorphisms, 16 s → under a second for the planar 2R at (π/8, π/3))
+            return (
+                readable_ratio(num, den) if num.has(sp.sin, sp.cos) or den.has(sp.sin, sp.cos) else readable(num / den)
+            )
+        return num if den == 1 else num / den
+
+    return sp.Matrix(rows, cols, [entry(L[i][j]) for i in range(rows) for j in range(cols)])
+
+
+def _terms(x) -> int:
+    """Terms of a field element's numerator and denominator (polynomials in t and the parameters)."""
+    return sum(len(p.terms()) if hasattr(p, "terms") else 1 for p in (x.numer, x.denom))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -543,7 +561,8 @@ def force_ellipsoid(J: Any, rows: Any = None, *, time_budget=TIME_BUDGET):
                 if not s.free_symbols:
                     raise
                 zero = False  # not identically zero: 1/s is exact wherever s ≠ 0
-            out.append(sp.oo if zero else (1 / s if s.has(sp.CRootOf) or s.is_Float else sp.radsimp(1 / s)))
+            plain = s.has(sp.CRootOf) or s.is_Float or sp.count_ops(s) > 60  # (radsimp of a long root: minutes)
+            out.append(sp.oo if zero else (1 / s if plain else sp.radsimp(1 / s)))
         return out, U
     A = numeric_jacobian(J)
     if rows is None and A.shape[-2] == 6:

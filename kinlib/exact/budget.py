@@ -222,16 +222,20 @@ def check() -> None:
 
 
 def remaining() -> float:
-    """Seconds left in the innermost budget of this thread (inf without one).
+    """Seconds left in the innermost budget of this thread (inf without one). In a budget's child, also at most what
+    its CPU timer has left: the timer counts the CPU its own budgeted children used, the thread clock does not (a
+    run started after another inside a budget gets only what is left; issue 32: sequential nested runs could use up
+    to twice the outer budget).
 
     >>> with within(30, "a rank proof"):
     ...     0 < remaining() <= 30
     True
     """
     stack = getattr(_local, "stack", None)
-    if not stack:
-        return float("inf")
-    return max(0.0, min(b.deadline for b in stack) - clock())
+    left = max(0.0, min(b.deadline for b in stack) - clock()) if stack else float("inf")
+    if _child:  # a budget's child: its timer also counts the CPU its own budgeted children used (_charge)
+        left = min(left, signal.getitimer(signal.ITIMER_PROF)[0])
+    return left
 
 
 def report(item: Any) -> None:

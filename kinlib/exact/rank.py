@@ -384,12 +384,16 @@ def _has_division(e: sp.Expr) -> bool:
 
 def _hadamard_small(d, X, rows, cols, digits: int) -> bool:
     """Whether |d| (a minor X[rows, cols] computed at ``digits`` digits) is below the certification line
-    10^(70 − digits) · Π ‖column‖ (Hadamard's bound on the minor): "not certified nonzero"."""
+    10^(70 − digits) · Π max(‖column‖, s) (Hadamard's bound on the minor; s = the largest entry of X):
+    "not certified nonzero". The floor s: an entry's error is absolute, on the scale of the matrix, so a column
+    that is 0 exactly but computed as 10⁻¹⁰² must not make its own noise look certified (a PUMA's linear rows at
+    its elbow singularity, rank 1, were given rank 3; issue 32)."""
     mpmath = mp_context()
 
+    s = max((abs(X[i, j]) for i in range(X.rows) for j in range(X.cols)), default=mpmath.mpf(0))
     h = mpmath.mpf(1)
     for j in cols:
-        h *= mpmath.sqrt(mpmath.fsum(abs(X[i, j]) ** 2 for i in rows))
+        h *= max(mpmath.sqrt(mpmath.fsum(abs(X[i, j]) ** 2 for i in rows)), s)
     return not abs(d) > h * mpmath.mpf(10) ** (70 - digits)
 
 
