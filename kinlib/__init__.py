@@ -20,12 +20,13 @@ import sys
 
 from .analysis import manipulability, taskspace
 from .analysis.manipulability import condition_number, isotropy, twist_speed_form, velocity_ellipsoid
-from .analysis.singular_search import SingularPoints, find_singularities
 from .analysis.singularities import (
     IncompleteResultWarning,
+    SingularPoints,
     SingularSet,
     column_space,
     evaluate_at,
+    find_singularities,
     left_null_space,
     rank_at,
     singular_configurations,
@@ -85,8 +86,8 @@ MOVED = {
     "robots": "kinematics.robots",
     "taskspace": "analysis.taskspace",
     "singularities": "analysis.singularities",
-    "singular_search": "analysis.singular_search",
-    "nearsingular": "analysis.nearsingular",
+    "singular_search": "analysis.singularities",
+    "nearsingular": "analysis.manipulability",
     "manipulability": "analysis.manipulability",
     "velocity": "analysis.velocity",
     "exact_rank": "exact.rank",

@@ -69,7 +69,7 @@ def test_no_second_near_threshold_in_kinlib_or_the_notebooks():
         for k, line in _code_lines(text)
         if re.match(r"\s*NEAR_SINGULAR\s*=", line)
     ]
-    assert len(defs) == 1 and defs[0].startswith("kinlib/analysis/nearsingular.py:"), defs
+    assert len(defs) == 1 and defs[0].startswith("kinlib/analysis/manipulability.py:"), defs
 
 
 def test_the_scanner_catches_second_rules():
