@@ -901,7 +901,8 @@ def singular_poses_section(args, targets: Targets) -> list[str]:
         "",
         "`rank_at`, `column_space`, `left_null_space`, `velocity_ellipsoid` (linear rows) of the space Jacobian at elbow, wrist and shoulder "
         "singularities with mixed rational·π angles (2π/7, 3π/11, 5π/13, 1/3: their number field has degree in the "
-        "hundreds). CPU seconds per call (`time.thread_time`, SymPy's cache cleared before each pose) and whether "
+        "hundreds). CPU seconds per call (`CLOCK`: this thread's and its ended children's, so a budgeted call's forked "
+        "child is counted; SymPy's cache cleared before each pose) and whether "
         "the answer is exact. Before issue 32 each call spent its whole 60 s budget, then answered in 60-digit "
         "numerics.",
         "",
