@@ -491,7 +491,7 @@ def _pose_rank_axes(M: sp.Matrix):
     :class:`~kinlib.exact_rank.RankAnalysis`, the structure at singular poses) is 0 or 1, else ("rank", r).
     Rank 1: J Jᵀ = ‖·‖² c cᵀ for a pivot column c, so σ₁ = √(tr J Jᵀ) along c/‖c‖; the other axes have length 0
     along an orthonormal basis of the left null space of M."""
-    from ..exact.linalg import _left_null_space_exact
+    from ..exact.linalg import left_null_space_exact
     from ..exact.rank import RankAnalysis
 
     r = RankAnalysis(M).rank
@@ -503,7 +503,7 @@ def _pose_rank_axes(M: sp.Matrix):
     c = next(M.col(j) for j in range(M.cols) if any(decide_zero(e) is False for e in M.col(j)))
     lam = sum((e**2 for e in M), sp.S.Zero)
     u = c / sp.sqrt(sum((e**2 for e in c), sp.S.Zero))
-    N, why = _left_null_space_exact(M, m)
+    N, why = left_null_space_exact(M, m)
     if N is None:
         return ("rank", r)
     zeros = sp.GramSchmidt([N.col(j) for j in range(N.cols)], orthonormal=True)[: k - 1]

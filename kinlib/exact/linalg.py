@@ -59,6 +59,7 @@ __all__ = [
     "rank_at",
     "column_space",
     "left_null_space",
+    "left_null_space_exact",
     "exact_is_zero",
     "exact_det",
     "MAX_MULTIPLE",
@@ -334,8 +335,16 @@ def _column_space_exact(A: sp.Matrix):
     return out, ""
 
 
-def _left_null_space_exact(A: sp.Matrix, m: int):
-    """(canonical basis of null A as columns, "") proved exactly, or (None, why not)."""
+def left_null_space_exact(A: sp.Matrix, m: int):
+    """The left null space of the ``m``-row matrix ``A`` (the rows of a Jacobian already evaluated at a pose), with
+    no time budget of its own (the caller runs it inside one, :func:`kinlib.exact.budget.run`): (canonical basis of
+    null Aᵀ as columns, "") proved exactly, or (None, why not). :func:`left_null_space` is the user's function.
+
+    >>> left_null_space_exact(sp.Matrix([[1, 2], [2, 4]]), 2)  # rows 2 = 2 × row 1: y = (1, -1/2) has yᵀA = 0
+    (Matrix([
+    [   1],
+    [-1/2]]), '')
+    """
     an, why = _analyse(A, "left_null_space")
     if an is None:
         return None, why
@@ -476,7 +485,7 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
     A = M.T  # null(Mᵀ) = null(A)
     m = A.cols
     try:
-        out, why = run(seconds, "left_null_space", _left_null_space_exact, A, m)
+        out, why = run(seconds, "left_null_space", left_null_space_exact, A, m)
         if out is not None:
             return out
     except OutOfTime:

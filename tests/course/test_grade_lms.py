@@ -446,7 +446,14 @@ def _check_after(r, mark):
 def _check_compiled(site: Path):
     """setup.sh byte-compiled what a kernel imports (the kernels run with -B, as a user who cannot write the venv:
     a module without its .pyc would be compiled again in each), the bundle's kinlib too; the test suites left out."""
-    for mod in ("sympy/core/basic", "sympy/matrices/dense", "numpy/linalg/_linalg", "kinlib/poe", "kinlib/jacobians"):
+    for mod in (
+        "sympy/core/basic",
+        "sympy/matrices/dense",
+        "numpy/linalg/_linalg",
+        "kinlib/kinematics/poe",
+        "kinlib/kinematics/jacobians",
+        "kinlib/exact/budget",
+    ):
         folder, name = (site / mod).parent, (site / mod).name
         assert (folder / f"{name}.py").is_file() and list((folder / "__pycache__").glob(f"{name}.*.pyc")), mod
     assert (site / "sympy" / "core" / "tests").is_dir() and not list(
