@@ -551,7 +551,7 @@ def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
     assert 0 <= d["score"] <= sum(t["max_score"] for t in d["tests"]) and d["score"] == 0, d
     assert all(0 <= t["score"] <= t["max_score"] for t in d["tests"]), d["tests"]
     shown = r.stdout + r.stderr + json.dumps(d)
-    assert (six["dir"] / "secret").read_bytes().strip().decode() not in shown
+    assert six["kw"]["secret"].read_bytes().strip().decode() not in shown
     for ref in json.loads(z.read("references.json")).values():
         for a in ref["answers"].values():
             if "tree" in a:
