@@ -406,15 +406,21 @@ def rank_at(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = None,
     M, numeric = _evaluated(J, subs, thetas)
     if numeric:
         return rank_at(_as_float(M))
-    try:
-        got, why = run(seconds, "rank_at", _rank_exact, M)
-        if got is not None:
-            return got
-    except OutOfTime:
-        why = _late(seconds)
+    got, why = _exact_or_why(seconds, "rank_at", _rank_exact, M)
+    if got is not None:
+        return got
     r, _ = fallback_rank(_numbers_only(M, "rank_at", why, seconds))
     fallback_warning("rank_at", why)
     return Rank(r, exact=False, note=f"{FALLBACK_DIGITS}-digit SVD ({why})")
+
+
+def _exact_or_why(seconds, what: str, work, *args):
+    """``work(*args)`` (which returns (answer or None, why not)) run within ``seconds`` of CPU in a killable child
+    (:func:`kinlib.exact.budget.run`): its (answer, why), or (None, why) past the budget, for the caller's fallback."""
+    try:
+        return run(seconds, what, work, *args)
+    except OutOfTime:
+        return None, _late(seconds)
 
 
 def _warn_conditions(what: str, unless: tuple):
@@ -450,12 +456,9 @@ def column_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None = 
     if numeric:
         return column_space(_as_float(M))
     A = M.T
-    try:
-        out, why = run(seconds, "column_space", _column_space_exact, A)
-        if out is not None:
-            return out
-    except OutOfTime:
-        why = _late(seconds)
+    out, why = _exact_or_why(seconds, "column_space", _column_space_exact, A)
+    if out is not None:
+        return out
     A = _numbers_only(A, "column_space", why, seconds)
     fallback_warning("column_space", why)
     return fallback_rref(A).T
@@ -484,12 +487,9 @@ def left_null_space(J: Any, subs: Any = None, thetas: Sequence[sp.Symbol] | None
         return left_null_space(_as_float(M))
     A = M.T  # null(Mᵀ) = null(A)
     m = A.cols
-    try:
-        out, why = run(seconds, "left_null_space", left_null_space_exact, A, m)
-        if out is not None:
-            return out
-    except OutOfTime:
-        why = _late(seconds)
+    out, why = _exact_or_why(seconds, "left_null_space", left_null_space_exact, A, m)
+    if out is not None:
+        return out
     A = _numbers_only(A, "left_null_space", why, seconds)
     fallback_warning("left_null_space", why)
     return _null_from_rref(fallback_rref(A), m, fallback=True)
