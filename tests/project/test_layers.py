@@ -444,6 +444,7 @@ COURSE_PACKAGES = {
     "kinlib.course.grader.in_kernel": "sent as text into the untrusted student kernel",
     "kinlib.course.grader.isolation": "the student kernel and its sandbox",
     "kinlib.course.lms": "the LMS bundles",
+    "kinlib.course.variants": "the instructor's machine and the grader: per-student variants, proved and keyed",
 }
 #: the code kinlib.course.grader.isolation.kernel sends as source text into a student kernel
 SHIPPED_TO_KERNEL = {
