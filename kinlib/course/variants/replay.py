@@ -94,9 +94,9 @@ class Run:
 class _Cell:
     loads: set | None  # every name read anywhere (None: does not parse, assumed to read everything)
     free: set  # read before bound
-    bound: set  # bound at top level (minus imports)
-    imported: set
+    bound: set  # bound at top level (imports too)
     mutated: set  # x of x[...] = / x.a = / del x[...]
+    statements: list  # [(loads, bound | mutated, bound)] of each top-level statement but imports
     widget: bool
     check: bool
 
@@ -113,31 +113,51 @@ def _python(src: str) -> str:
     return TransformerManager().transform_cell(src)
 
 
-def _analyse(cell) -> _Cell:
-    src = _source(cell)
-    free, bound = cell_names(src)
-    try:
-        tree = ast.parse(_python(src))
-    except SyntaxError:
-        return _Cell(None, set(), set(), set(), set(), False, CHECK in cell_tags(cell))
-    loads, imported, mutated = set(), set(), set()
+def _mutated(tree) -> set:
+    out = set()
     for n in ast.walk(tree):
-        if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load):
-            loads.add(n.id)
-        elif isinstance(n, (ast.Import, ast.ImportFrom)):
-            imported |= {(a.asname or a.name).split(".")[0] for a in n.names if a.name != "*"}
-        elif isinstance(n, (ast.Subscript, ast.Attribute)) and isinstance(n.ctx, (ast.Store, ast.Del)):
+        if isinstance(n, (ast.Subscript, ast.Attribute)) and isinstance(n.ctx, (ast.Store, ast.Del)):
             base = n.value
             while isinstance(base, (ast.Subscript, ast.Attribute)):
                 base = base.value
             if isinstance(base, ast.Name):
-                mutated.add(base.id)
-    # a name bound only by an import is the same object each time: rebinding it changes nothing
-    assigned = {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and not isinstance(n.ctx, ast.Load)}
-    defined = {n.name for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef))}
-    imported -= assigned | defined
+                out.add(base.id)
+    return out
+
+
+def _loads(tree) -> set:
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name) and isinstance(n.ctx, ast.Load)}
+
+
+def _analyse(cell) -> _Cell:
+    src = _source(cell)
+    check = CHECK in cell_tags(cell)
+    try:
+        tree = ast.parse(_python(src))
+    except SyntaxError:
+        return _Cell(None, set(), set(), set(), [], False, check)
+    free, bound = cell_names(src)
+    statements = []
+    for stmt in tree.body:  # what each statement reads and writes: a name is tainted only by what computes it
+        if not isinstance(stmt, (ast.Import, ast.ImportFrom)):  # an import binds the same object each time
+            names = cell_names(ast.unparse(stmt))[1]
+            statements.append((_loads(stmt), names | _mutated(stmt), names))
+    loads = _loads(tree)
     widget = bool(loads & _WIDGET_NAMES) or any(WIDGET_VIEW in o.get("data", {}) for o in cell.get("outputs", []))
-    return _Cell(loads, free, bound - imported, imported, mutated, widget, CHECK in cell_tags(cell))
+    return _Cell(loads, free, bound, _mutated(tree), statements, widget, check)
+
+
+def _taint(c: _Cell, tainted: set, everything: bool = False) -> set:
+    """The names cell ``c`` writes from a tainted name (statement by statement, in order); every name it writes
+    when ``everything``."""
+    local, out = set(tainted), set()
+    for loads, writes, names in c.statements:
+        if everything or loads & local:
+            local |= writes
+            out |= writes
+        else:  # rebound from untainted names: this cell reads its own value from here on
+            local -= names
+    return out
 
 
 @dataclass
@@ -187,19 +207,19 @@ def plan(nb) -> Plan:
     cells = nb["cells"]
     code = [i for i, c in enumerate(cells) if c.get("cell_type") == "code" and _source(c).strip()]
     info = {i: _analyse(cells[i]) for i in code}
-    tainted = set(info[v].bound) | info[v].mutated
+    tainted = _taint(info[v], set(), everything=True)  # the names it assigns (not its imports)
     dependent, skipped = [], {}
     for i in code:
         if i <= v:
             continue
         c = info[i]
-        if c.loads is not None and not (c.loads & tainted):
+        if c.loads is not None and not (c.free & tainted):  # reads no tainted name before binding it
             continue
         if c.check:
             skipped[i] = "check"
             continue
         dependent.append(i)
-        tainted |= c.bound | c.mutated
+        tainted |= _taint(c, tainted)
     for w in reversed(list(dependent)):  # a widget no later re-run cell reads is not re-run
         if info[w].widget and not any(
             info[c].loads is None or info[c].loads & info[w].bound for c in dependent if c > w
