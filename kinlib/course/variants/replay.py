@@ -52,9 +52,9 @@ import nbformat
 from ..grader.isolation.kernel import setup_code
 from ..grader.refdata import reference_answers
 from ..publish.aids import show_students_version
-from ..publish.analysis import cell_names
+from ..publish.analysis import answer_dependents, cell_names
 from ..publish.execute import notebook_client
-from ..schema import CHECK, answer_groups, cell_reveals, cell_tags, parse_parts, stash_points
+from ..schema import CHECK, SOLUTION, answer_groups, cell_reveals, cell_tags, parse_parts, stash_points
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
 from .spec import Spec, assignment_source, variant_cell_index
 
@@ -220,12 +220,21 @@ def plan(nb) -> Plan:
             continue
         dependent.append(i)
         tainted |= _taint(c, tainted)
-    for w in reversed(list(dependent)):  # a widget no later re-run cell reads is not re-run
-        if info[w].widget and not any(
-            info[c].loads is None or info[c].loads & info[w].bound for c in dependent if c > w
+    # a widget, or a cell no student's page shows (a worked step, a picture of the answers), that no later re-run
+    # cell reads and that binds no answer is not re-run: its output is the instructor's only
+    answers = {n for p in parse_parts(nb) for n in p.kinds}
+    hidden = set(answer_dependents(nbformat.reads(json.dumps(nb), as_version=4))) | {
+        i for i in code if {SOLUTION, CHECK} & set(cell_tags(cells[i]))
+    }
+    for w in reversed(list(dependent)):
+        why = "widget" if info[w].widget else "not shown" if w in hidden else None
+        if (
+            why
+            and not (info[w].bound & answers)
+            and not any(info[c].loads is None or info[c].loads & info[w].bound for c in dependent if c > w)
         ):
             dependent.remove(w)
-            skipped[w] = "widget"
+            skipped[w] = why
     rerun = {v, *dependent}
 
     # the names read again: by re-run cells, when a part ends (stash), the fingerprints, the export at the end
