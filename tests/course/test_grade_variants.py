@@ -1,0 +1,238 @@
+"""``kinlib grade --variants KEY`` (issue 33, item 4): each submission judged against its student's own variant.
+
+A small solution notebook whose numbers vary (``k``: its variant cell) and a key built by hand (the lead's
+:mod:`kinlib.course.variants.key` format: each variant's reference answers computed here by SymPy, independently of
+the grader, and dumped as the reference kernel would, :func:`kinlib.course.answers.describe.dump_reference`). The
+student id is the submission's folder (``--id-pattern``), never the notebook: one submission plants another
+student's variant in its metadata and its variant cell, and is graded as its folder says.
+
+One batch (a kernel per submission, two at a time) is graded once; the tests read its rows and feedback.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import pytest
+import sympy as sp
+
+from kinlib.course.answers.describe import dump_reference
+from kinlib.course.cli import main
+from kinlib.course.grader import grade
+from kinlib.course.grader.judging import OTHER_VARIANT
+from kinlib.course.grader.secret import load_secret
+from kinlib.course.variants.key import Key, NotebookKey, Variant, write_key
+
+NID = "91_variant_fixture"
+FLAG = "this looks like another variant's answer"
+KINDS = {"r": "expr", "s": "expr"}
+SPEC = {"params": {"k": {"type": "number", "choices": ["2", "3", "5", "7"]}}, "original": {"k": "2"}, "parts": ["1.1"]}
+# each student's variant (k), as the key says; dan is not on the roster
+STUDENTS = {"ada": 3, "bob": 5, "cyd": 7, "eve": 5}
+
+
+def _md(src, tags=()):
+    return {"cell_type": "markdown", "metadata": {"tags": list(tags)}, "source": src}
+
+
+def _code(src, meta=None, tags=()):
+    md = {"tags": list(tags)} | ({"kinlib": meta} if meta else {})
+    return {"cell_type": "code", "metadata": md, "source": src, "outputs": [], "execution_count": None}
+
+
+def variant_cell(k: int) -> str:
+    return f"# The numbers of this problem set: the course's build writes each student's own here.\nfrom sympy import pi, Rational\nk = {k}\n"
+
+
+def notebook(k: int = 2, r: str = "r = k * x**2 + 1", s: str = "s = sp.Matrix([[x, k], [0, k * x]])", values=None):
+    """The solution notebook (k = 2, the original), or a student's workbook (their k, their answers)."""
+    meta = {"notebook": NID, "title": "Variants fixture", "sections": ["1.1"]}
+    if values is not None:
+        meta["variants"] = copy.deepcopy(SPEC) | {"original": values}  # the student controls this: never read
+    else:
+        meta["variants"] = copy.deepcopy(SPEC)
+    return {
+        "nbformat": 4,
+        "nbformat_minor": 5,
+        "metadata": {
+            "kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"},
+            "kinlib": meta,
+        },
+        "cells": [
+            _md("# Variants fixture"),
+            _code(variant_cell(k), {"variant": True}),
+            _code("import sympy as sp\nx = sp.Symbol('x', real=True)"),
+            _md("**1.1 (5 points).** Find r(x) = k x² + 1.", ["question"]),
+            _code(r, {"answers": ["r"], "part": "1.1"}, ["solution"]),
+            _md("**1.2 (5 points).** Find the matrix S(x).", ["question"]),
+            _code(s, {"answers": ["s"], "part": "1.2"}, ["solution"]),
+        ],
+    }
+
+
+def answers_for(k: int) -> dict:
+    """The reference answers of variant k, computed here (not by the grader)."""
+    x = sp.Symbol("x", real=True)
+    return dump_reference({"r": k * x**2 + 1, "s": sp.Matrix([[x, k], [0, k * x]])}, KINDS)
+
+
+def make_key(secret: bytes, path: Path) -> Path:
+    variants = {f"v{k}": Variant({"k": str(k)}, answers_for(k), {}) for k in sorted(set(STUDENTS.values()))}
+    nk = NotebookKey(NID, "0" * 64, SPEC, SPEC["original"], variants, {s: f"v{k}" for s, k in STUDENTS.items()})
+    roster = [{"id": s, "name": "", "email": ""} for s in STUDENTS]
+    return write_key(path, Key({NID: nk}, roster), secret)
+
+
+@pytest.fixture(scope="module")
+def graded(tmp_path_factory, grader_reference_cache):
+    secret = load_secret(None)  # the run's secret (conftest): the key is signed with the grader's secret
+    base = tmp_path_factory.mktemp("variants")
+    nbs = base / "notebooks"
+    nbs.mkdir()
+    (nbs / f"{NID}.ipynb").write_text(json.dumps(notebook()))
+    key = make_key(secret, base / "key" / "variants-key.json")
+    subs = base / "subs"
+    bob_planted = notebook(3, r="r = 5 * x**2 + 1", s="s = sp.Matrix([[x, 5], [0, 5 * x]])", values={"k": "3"})
+    files = {
+        "ada": notebook(3),  # ada's own, right
+        "bob": bob_planted,  # right for bob (k=5), with ada's k in its variant cell and metadata
+        "cyd": notebook(3),  # ada's right workbook handed in as cyd's (cyd has k=7)
+        "dan": notebook(5),  # not on the roster
+        "eve": notebook(5, r="r = None  # your answer", s="s = None  # your answer"),  # untouched
+        "fay": notebook(2),  # the original's numbers (the solution pages'): fay is not on the roster either
+    }
+    for sid, nb in files.items():
+        (subs / sid).mkdir(parents=True)
+        (subs / sid / "ps.ipynb").write_text(json.dumps(nb))
+    out = base / "grades"
+    summary = grade.grade_batch(
+        [subs],
+        out,
+        jobs=2,
+        timeout=240,
+        cell_timeout=60,
+        notebooks=nbs,
+        cache=grader_reference_cache,
+        log=None,
+        id_pattern=r"(?P<id>[^/]+)/",
+        variants=key,
+    )
+    rows = {}
+    for res in summary["results"]:
+        rows[res["student_id"]] = {r["part"]: r for r in res["rows"]}
+    return {
+        "summary": summary,
+        "rows": rows,
+        "out": out,
+        "key": key,
+        "subs": subs,
+        "nbs": nbs,
+        "cache": grader_reference_cache,
+    }
+
+
+def _points(graded, sid):
+    return sum(r["points"] for r in graded["rows"][sid].values())
+
+
+def test_each_students_own_workbook_gets_full_marks(graded):
+    for sid in ("ada", "bob"):
+        rows = graded["rows"][sid]
+        assert {p: r["status"] for p, r in rows.items()} == {"1.1": "pass", "1.2": "pass"}, rows
+        assert _points(graded, sid) == 10
+        assert FLAG not in json.dumps(rows)
+
+
+def test_another_students_workbook_scores_zero_and_is_flagged(graded):
+    rows = graded["rows"]["cyd"]
+    assert _points(graded, "cyd") == 0
+    for part in ("1.1", "1.2"):
+        assert rows[part]["status"] == "fail"
+        assert FLAG in rows[part]["message"], rows[part]
+        assert "3" not in rows[part]["message"] and "7" not in rows[part]["message"]  # no variant's number, no id
+    fb = Path(
+        graded["summary"]["results"][[r["student_id"] for r in graded["summary"]["results"]].index("cyd")]["feedback"]
+    )
+    assert FLAG in fb.read_text()
+    assert OTHER_VARIANT == FLAG
+
+
+def test_nobody_off_the_roster_is_graded_against_the_original(graded):
+    """fay is not on the roster and hands in the original's numbers: not graded (never against the original key)."""
+    rows = graded["rows"]["fay"]
+    assert _points(graded, "fay") == 0
+    assert all("not on the roster" in r["message"] and r["status"] == "error" for r in rows.values()), rows
+
+
+def test_student_not_on_roster_is_not_graded_with_a_reason(graded):
+    rows = graded["rows"]["dan"]
+    assert set(rows) == {"1.1", "1.2"}
+    for r in rows.values():
+        assert r["status"] == "error" and r["points"] == 0
+        assert "'dan' is not on the roster of the variants key" in r["message"]
+        assert FLAG not in r["message"]
+    assert not graded["summary"]["infrastructure_errors"]
+
+
+def test_untouched_workbook_scores_zero_without_the_flag(graded):
+    rows = graded["rows"]["eve"]
+    assert _points(graded, "eve") == 0
+    assert all(r["status"] == "fail" and FLAG not in r["message"] for r in rows.values()), rows
+
+
+def test_the_grade_follows_the_identity_not_the_notebook(graded):
+    """bob's workbook says k = 3 (ada's) in its variant cell and metadata; judged as bob (k = 5): full marks.
+    The same file copied under ada's folder is ada's variant's wrong answer, and another variant's right one."""
+    assert _points(graded, "bob") == 10
+    res = next(r for r in graded["summary"]["results"] if r["student_id"] == "bob")
+    assert res["variant"] == "v5"
+
+
+def test_the_original_answers_for_a_student_are_flagged(tmp_path, graded):
+    """The instructor's original numbers (k = 2, the solution pages') handed in by a student on the roster: zero,
+    flagged; graded alone, in this process (one job: the other path than the batch's workers)."""
+    subs = tmp_path / "subs"
+    (subs / "ada").mkdir(parents=True)
+    (subs / "ada" / "ps.ipynb").write_text(json.dumps(notebook(2)))
+    summary = grade.grade_batch(
+        [subs],
+        tmp_path / "out",
+        jobs=1,
+        timeout=240,
+        cell_timeout=60,
+        notebooks=graded["nbs"],
+        cache=graded["cache"],
+        log=None,
+        id_pattern=r"(?P<id>[^/]+)/",
+        variants=graded["key"],
+    )
+    rows = {r["part"]: r for r in summary["rows"]}
+    assert sum(r["points"] for r in rows.values()) == 0
+    assert all(FLAG in r["message"] for r in rows.values()), rows
+
+
+def test_a_key_that_does_not_verify_is_refused(tmp_path, graded, capsys):
+    bad = tmp_path / "key.json"
+    d = json.loads(graded["key"].read_text())
+    d["key"]["notebooks"][NID]["students"]["cyd"] = "v3"  # cyd edits the key to get ada's variant
+    bad.write_text(json.dumps(d))
+    with pytest.raises(grade.VariantsKeyRefused, match="does not verify"):
+        grade.grade_batch([graded["subs"]], tmp_path / "o", notebooks=graded["nbs"], log=None, variants=bad)
+    other = make_key(b"another secret" * 3, tmp_path / "other.json")
+    code = main(
+        [
+            "grade",
+            str(graded["subs"]),
+            "--out",
+            str(tmp_path / "o2"),
+            "--notebooks",
+            str(graded["nbs"]),
+            "--variants",
+            str(other),
+        ]
+    )
+    assert code == 2
+    assert "does not verify with the grader secret" in capsys.readouterr().err
+    assert not (tmp_path / "o2" / "grades.csv").exists()
