@@ -227,6 +227,9 @@ def variant_plan(ref: Reference, key, student: str) -> dict | None:
         why = (
             f"student {student!r} is not on the roster of the variants key: not graded (the instructor must add them "
             "and build the key again)"
+            if student
+            else "no student id for this submission: not graded against a variant (its identity names nobody on the "
+            "roster of the variants key)"
         )
         return {"student": student, "refused": why}
     others = {}
