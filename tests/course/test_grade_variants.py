@@ -11,78 +11,16 @@ One batch (a kernel per submission, two at a time) is graded once; the tests rea
 
 from __future__ import annotations
 
-import copy
 import json
 from pathlib import Path
 
 import pytest
-import sympy as sp
 
-from kinlib.course.answers.describe import dump_reference
 from kinlib.course.cli import main
 from kinlib.course.grader import grade
 from kinlib.course.grader.judging import OTHER_VARIANT
 from kinlib.course.grader.secret import load_secret
-from kinlib.course.variants.key import Key, NotebookKey, Variant, write_key
-
-NID = "91_variant_fixture"
-FLAG = "this looks like another variant's answer"
-KINDS = {"r": "expr", "s": "expr"}
-SPEC = {"params": {"k": {"type": "number", "choices": ["2", "3", "5", "7"]}}, "original": {"k": "2"}, "parts": ["1.1"]}
-# each student's variant (k), as the key says; dan is not on the roster
-STUDENTS = {"ada": 3, "bob": 5, "cyd": 7, "eve": 5}
-
-
-def _md(src, tags=()):
-    return {"cell_type": "markdown", "metadata": {"tags": list(tags)}, "source": src}
-
-
-def _code(src, meta=None, tags=()):
-    md = {"tags": list(tags)} | ({"kinlib": meta} if meta else {})
-    return {"cell_type": "code", "metadata": md, "source": src, "outputs": [], "execution_count": None}
-
-
-def variant_cell(k: int) -> str:
-    return f"# The numbers of this problem set: the course's build writes each student's own here.\nfrom sympy import pi, Rational\nk = {k}\n"
-
-
-def notebook(k: int = 2, r: str = "r = k * x**2 + 1", s: str = "s = sp.Matrix([[x, k], [0, k * x]])", values=None):
-    """The solution notebook (k = 2, the original), or a student's workbook (their k, their answers)."""
-    meta = {"notebook": NID, "title": "Variants fixture", "sections": ["1.1"]}
-    if values is not None:
-        meta["variants"] = copy.deepcopy(SPEC) | {"original": values}  # the student controls this: never read
-    else:
-        meta["variants"] = copy.deepcopy(SPEC)
-    return {
-        "nbformat": 4,
-        "nbformat_minor": 5,
-        "metadata": {
-            "kernelspec": {"name": "python3", "display_name": "Python 3", "language": "python"},
-            "kinlib": meta,
-        },
-        "cells": [
-            _md("# Variants fixture"),
-            _code(variant_cell(k), {"variant": True}),
-            _code("import sympy as sp\nx = sp.Symbol('x', real=True)"),
-            _md("**1.1 (5 points).** Find r(x) = k x² + 1.", ["question"]),
-            _code(r, {"answers": ["r"], "part": "1.1"}, ["solution"]),
-            _md("**1.2 (5 points).** Find the matrix S(x).", ["question"]),
-            _code(s, {"answers": ["s"], "part": "1.2"}, ["solution"]),
-        ],
-    }
-
-
-def answers_for(k: int) -> dict:
-    """The reference answers of variant k, computed here (not by the grader)."""
-    x = sp.Symbol("x", real=True)
-    return dump_reference({"r": k * x**2 + 1, "s": sp.Matrix([[x, k], [0, k * x]])}, KINDS)
-
-
-def make_key(secret: bytes, path: Path) -> Path:
-    variants = {f"v{k}": Variant({"k": str(k)}, answers_for(k), {}) for k in sorted(set(STUDENTS.values()))}
-    nk = NotebookKey(NID, "0" * 64, SPEC, SPEC["original"], variants, {s: f"v{k}" for s, k in STUDENTS.items()})
-    roster = [{"id": s, "name": "", "email": ""} for s in STUDENTS]
-    return write_key(path, Key({NID: nk}, roster), secret)
+from variants_fixture import FLAG, NID, make_key, notebook
 
 
 @pytest.fixture(scope="module")
@@ -236,3 +174,57 @@ def test_a_key_that_does_not_verify_is_refused(tmp_path, graded, capsys):
     assert code == 2
     assert "does not verify with the grader secret" in capsys.readouterr().err
     assert not (tmp_path / "o2" / "grades.csv").exists()
+
+
+def test_a_bundle_refuses_a_key_that_does_not_verify(tmp_path, capsys):
+    """kinlib grade gradescope|prairielearn --variants: refused before any notebook runs (exit 2)."""
+    nbs = tmp_path / "nbs"
+    nbs.mkdir()
+    (nbs / f"{NID}.ipynb").write_text(json.dumps(notebook()))
+    other = make_key(b"another secret" * 3, tmp_path / "other.json")
+    for platform, out in (("gradescope", "ag.zip"), ("prairielearn", "pl")):
+        args = ["grade", platform, "--out", str(tmp_path / out), "--notebooks", str(nbs), "--variants", str(other)]
+        assert main(args) == 2
+        assert "does not verify with the grader secret" in capsys.readouterr().err
+        assert not (tmp_path / out).exists() or not any((tmp_path / out).rglob("references.json"))
+
+
+def test_the_platforms_student_id(tmp_path):
+    """Gradescope: users[0]'s sid if on the roster, else its email; PrairieLearn (which names nobody): the
+    kinlib_student_id element value, else a submitted file's name on the roster; else none, said so."""
+    from kinlib.course.lms.bundles import platform_student
+
+    meta = tmp_path / "submission_metadata.json"
+    roster = {"S-1", "bo@x.edu", "ada"}
+    meta.write_text(json.dumps({"users": [{"email": "bo@x.edu", "id": 9, "name": "Bo", "sid": "S-1"}, {"sid": "ada"}]}))
+    assert platform_student("gradescope", tmp_path, roster)[0] == "S-1"
+    meta.write_text(json.dumps({"users": [{"email": "bo@x.edu", "id": 9, "name": "Bo", "sid": "S-9"}]}))
+    assert platform_student("gradescope", tmp_path, roster) == ("bo@x.edu", "Gradescope's submitter (email)")
+    meta.write_text(json.dumps({"users": [{"email": "zz@x.edu", "sid": "S-9"}]}))
+    assert platform_student("gradescope", tmp_path, roster)[0] == "S-9"  # not on the roster: refused later, by name
+    meta.write_text("[1, 2")
+    assert platform_student("gradescope", tmp_path, roster)[0] == ""
+    (tmp_path / "data").mkdir()
+    data = tmp_path / "data" / "data.json"
+    data.write_text(json.dumps({"params": {"k": 3}, "submitted_answers": {"kinlib_student_id": " ada "}}))
+    assert platform_student("prairielearn", tmp_path, roster, [Path("S-1.ipynb")])[0] == "ada"
+    data.write_text(json.dumps({"params": {}, "submitted_answers": {}}))
+    assert platform_student("prairielearn", tmp_path, roster, [Path("x/S-1.ipynb")])[0] == "S-1"
+    sid, why = platform_student("prairielearn", tmp_path, roster, [Path("workbook.ipynb")])
+    assert sid == "" and "no student id" in why
+
+
+def test_no_student_id_is_refused_with_a_reason():
+    import tempfile
+
+    import variants_fixture as vf
+    from kinlib.course.grader.refdata import Reference
+    from kinlib.course.variants.key import read_key
+
+    with tempfile.TemporaryDirectory() as d:
+        key = read_key(make_key(b"s" * 32, Path(d) / "k.json"), b"s" * 32)
+    ref = Reference(NID, "t", "p", "0" * 64, [], vf.answers_for(2))
+    assert "no student id" in grade.variant_plan(ref, key, "")["refused"]
+    plan = grade.variant_plan(ref, key, "ada")
+    assert plan["variant"] == "v3" and set(plan["others"]) == {"r", "s"}
+    assert len(plan["others"]["r"]) == 3  # the original (k=2) and the other variants (5, 7), not ada's own
