@@ -647,7 +647,7 @@ def _variants(platform: str, root: Path, bundle: Path, cfg: dict, subs: list):
     if vkey is None:
         raise RuntimeError(f"the bundle's {VARIANTS_KEY} does not verify with its secret: build the bundle again")
     students = {s for nk in vkey.notebooks.values() for s in nk.students}
-    student, whence = platform_student(platform, root, students, [s.path for s in subs])
+    student, whence = platform_student(platform, root, students, list(subs))
     print(f"variants: graded as student {student!r} ({whence})", flush=True)
     return vkey, student, whence
 
