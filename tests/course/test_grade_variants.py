@@ -228,3 +228,70 @@ def test_no_student_id_is_refused_with_a_reason():
     plan = grade.variant_plan(ref, key, "ada")
     assert plan["variant"] == "v3" and set(plan["others"]) == {"r", "s"}
     assert len(plan["others"]["r"]) == 3  # the original (k=2) and the other variants (5, 7), not ada's own
+
+
+@pytest.mark.slow
+def test_notebook_04_graded_against_each_students_own_key(tmp_path, grader_reference_cache):
+    """The real 04 with its declared variants, its key built by the variants build (draw, replay, proof): two
+    students with different variants each get full marks for their own solution notebook (the instructor's with
+    their numbers, spec.apply); the first's handed in as the second's: every answer that differs between their
+    variants scores zero and is flagged; the others (the same for every variant) still pass."""
+    import shutil
+
+    from kinlib.course.variants import key as K
+    from kinlib.course.variants import spec as S
+
+    src = sorted((Path(__file__).resolve().parents[2] / "notebooks").glob("04_*.ipynb"))
+    if not src or S.Spec.from_notebook(json.loads(src[0].read_text())) is None:
+        pytest.skip("notebook 04 declares no variants here")
+    nbs = tmp_path / "notebooks"
+    nbs.mkdir()
+    shutil.copy(src[0], nbs / src[0].name)
+    nb = json.loads(src[0].read_text())
+    spec = S.Spec.from_notebook(nb)
+    secret = load_secret(None)
+    roster = [K.Student(f"s{i}") for i in range(6)]
+    key = K.build_key(nbs, roster, secret, log=lambda *a: None)
+    nid = next(iter(key.notebooks))
+    nk = key.notebooks[nid]
+    by_variant = {}
+    for sid, vk in nk.students.items():
+        by_variant.setdefault(vk, sid)
+    assert len(by_variant) >= 2, "six students drew one variant"
+    (va, a), (vb, b) = sorted(by_variant.items())[:2]
+    keyfile = K.write_key(tmp_path / "key.json", key, secret)
+    subs = tmp_path / "subs"
+    files = {f"{a}/own": (a, va), f"{b}/own": (b, vb), f"{b}/copy": (a, va)}
+    for rel, (_, vk) in files.items():
+        (subs / rel).parent.mkdir(parents=True, exist_ok=True)
+        (subs / f"{rel}.ipynb").write_text(json.dumps(S.apply(nb, spec, nk.variants[vk].values)))
+    summary = grade.grade_batch(
+        [subs],
+        tmp_path / "out",
+        jobs=2,
+        timeout=600,
+        cell_timeout=300,
+        notebooks=nbs,
+        cache=grader_reference_cache,
+        log=None,
+        id_pattern=r"(?P<id>[^/]+)/",
+        variants=keyfile,
+    )
+    res = {r["relpath"][: -len(".ipynb")]: r for r in summary["results"]}
+    for rel in (f"{a}/own", f"{b}/own"):
+        auto = [r for r in res[rel]["rows"] if r.get("kind") != "manual"]
+        assert auto and all(r["status"] == "pass" for r in auto), [r for r in auto if r["status"] != "pass"]
+    differ = {
+        n
+        for n, x in nk.variants[va].answers.items()
+        if json.dumps(x, sort_keys=True) != json.dumps(nk.variants[vb].answers.get(n), sort_keys=True)
+    }
+    assert differ, "the two variants have the same answers"
+    seen = {}
+    for r in res[f"{b}/copy"]["rows"]:
+        for v in r.get("answers") or []:
+            seen[v["answer"]] = v
+    assert differ <= set(seen)
+    for n in differ:
+        assert seen[n]["status"] == "fail" and FLAG in seen[n]["message"], seen[n]
+    assert all(v["status"] == "pass" for n, v in seen.items() if n not in differ), seen
