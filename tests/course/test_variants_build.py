@@ -94,7 +94,7 @@ def test_every_kept_variant_of_4_1_has_the_original_winners_form_by_an_independe
             want = _winners(_floats(spec, values, f"theta_{k}"), row)
             assert len(want) == form, (s.id, k, want)
             got = answers[f"joint_{k}"]["choice"]["value"]
-            assert tuple(sorted(got)) if isinstance(got, list) else (got,) == want
+            assert (tuple(sorted(got)) if isinstance(got, list) else (got,)) == want, (s.id, k)
 
 
 def test_a_draw_with_a_tie_where_the_original_has_one_winner_is_rejected_and_redrawn(built):
