@@ -126,6 +126,17 @@ def build_parser() -> argparse.ArgumentParser:
         help="with --audience students: a full build of the same notebooks (e.g. build/handouts) whose current "
         "sections and PDFs are copied instead of made again (never a solution)",
     )
+    h.add_argument(
+        "--variants",
+        type=Path,
+        default=None,
+        metavar="ROSTER.csv",
+        help="each student's own numbers (the notebooks' variants, each proved well-posed): pages and workbooks per "
+        "student in OUT/students/<token>/; the signed key, report, links and answer sheets in OUT/../variants/",
+    )
+    h.add_argument(
+        "--secret", type=Path, default=None, help="with --variants: the course secret (default: kinlib grade's)"
+    )
     h.add_argument("--serve", action="store_true", help="then serve OUT on http://127.0.0.1:PORT/ (Ctrl-C stops)")
     h.add_argument("--port", type=int, default=8000, help="port for --serve (default 8000; loopback only)")
     h.set_defaults(run=_handouts, parser=h)
@@ -399,6 +410,8 @@ def _handouts(args) -> int:
             fresh=args.fresh,
             audience=args.audience,
             reuse_from=args.reuse_from,
+            variants=args.variants,
+            secret=args.secret,
             log=lambda s: print(s, flush=True),
         )
     except NotebookFailed as e:  # names the notebook and the cell, with the cell's first lines

@@ -649,6 +649,8 @@ def build(
     fresh: bool = False,
     audience: str = "all",
     reuse_from: Path | None = None,
+    variants: Path | None = None,
+    secret: Path | None = None,
     log=print,
 ) -> list:
     """The whole job; raises NotebookFailed naming the notebook and cell when one fails. Writes ``out/``:
@@ -664,6 +666,12 @@ def build(
     notebook, kinlib, pins and options (its problems page and workbook: the same bytes; never a solution), and
     each PDF of a page with the same bytes, instead of executing, verifying and printing them again
     (:func:`kinlib.course.publish.incremental.adopt_sections`).
+
+    ``variants`` (a roster CSV) gives every student their own numbers (issue 33,
+    :mod:`kinlib.course.publish.perstudent`): each student's variant of every notebook that declares variants is
+    drawn with the course secret (``secret``: a file; default kinlib grade's), proved well-posed, and written as
+    their own pages and workbooks under ``out/students/``; the signed key the grader reads, the report, the links
+    and the answer sheets go to ``out/../variants/``.
 
     Incremental (:mod:`kinlib.course.publish.incremental`): a section whose notebook, kinlib code, pins and options
     are those of the outputs already in ``out/`` is reused, not executed again (the log says "reused"); the site
@@ -727,6 +735,11 @@ def build(
         audience=audience,
         log=log,
     )
+    if variants is not None:
+        from ..grader.secret import load_secret
+        from .perstudent import build_variants
+
+        build_variants(notebooks, out, variants, load_secret(secret), entries, urls, lite=site, fresh=fresh, log=log)
     sheet = notebooks / CHEATSHEET
     if sheet.exists():
         write_cheatsheet(sheet, out / "reference" / "cheatsheet.html", urls, links=links)

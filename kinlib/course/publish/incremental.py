@@ -287,6 +287,7 @@ def build_site(out: Path, paths: list, section_keys: list, stamps: Stamps, log) 
     from .lite import build_lite  # the notebooks in the browser (JupyterLite, offline): out/lite/
 
     workbooks = sorted((out / "workbooks").glob("[0-9][0-9]_*.ipynb"))
+    workbooks += sorted((out / "variant-workbooks").glob("[0-9][0-9]_*.ipynb"))  # each student's (issue 33)
     k = key(code_key(), section_keys, [(p.name, p.read_bytes()) for p in (*workbooks, *paths)])
     if stamps.current("site", k, [out / "lite" / "jupyter-lite.json"]) is not None:
         log("  lite: reused (no workbook, solution notebook or kinlib file changed)")

@@ -518,6 +518,8 @@ def build_lite(out: Path, notebooks=Path("notebooks"), *, log=print) -> Path:
         content = tmp / "content"
         for wb in workbooks:
             _notebook_for_lite(wb, content / "workbooks" / wb.name)
+        for wb in sorted((out / "variant-workbooks").glob("[0-9][0-9]_*.ipynb")):  # each student's own numbers
+            _notebook_for_lite(wb, content / "variants" / wb.name)
         for nb in solutions:
             _notebook_for_lite(nb, content / "solutions" / nb.name)
 
