@@ -144,12 +144,17 @@ notebooks: $(STAMP)
 # Incremental: a section, the site or a PDF whose inputs did not change is reused (the log says so); the students'
 # build takes the sections and PDFs that are current in build/handouts (the same bytes; never a solution).
 # `make handouts ONLY=05` builds one section (ONLY="02 05": several); `make handouts FRESH=1` builds everything again.
+# `make handouts VARIANTS=roster.csv`: every student their own numbers (issue 33): pages and workbooks per student
+# under $(HANDOUTS_OUT)/students/<token>/, and beside it build/variants/ (the signed key for `kinlib grade
+# --variants build/variants/key.json`, report.txt, links.csv with each student's page, answers/ per student).
 AUDIENCE ?= all
 ONLY ?=
 FRESH ?=
+VARIANTS ?=
 HANDOUTS_OUT := $(if $(filter students,$(AUDIENCE)),build/handouts-students,build/handouts)
 handouts: $(STAMP) chromium
 	$(VENV)/bin/kinlib handouts notebooks --out $(HANDOUTS_OUT) --audience $(AUDIENCE) $(if $(ONLY),--only $(ONLY)) $(if $(FRESH),--fresh) \
+	    $(if $(VARIANTS),--variants $(VARIANTS)) \
 	    $(if $(filter students,$(AUDIENCE)),$(if $(wildcard build/handouts/index.html),--reuse-from build/handouts))
 
 # A local look at build/handouts (the pages, the PDFs and the in-browser notebooks, lite/) on
