@@ -90,6 +90,8 @@ def test_plan_reruns_dependents_restores_overwritten_values_and_skips_checks_and
     assert p.skipped == {5: "check", 13: "widget"}
     assert 7 not in p.rerun  # y does not depend on the numbers
     assert p.recapture == [4, 10]
+    assert p.needed == [3, 4, 10]  # the failing cell and the picture are not needed for an answer
+    assert p.answers_only == [1, 3, 4, 8, 10]
 
 
 def test_plan_needs_a_variant_cell():
@@ -147,6 +149,22 @@ def test_replay_synthetic(tmp_path):
     text = "".join(o.get("text", "") for o in first.outputs[12])
     assert text == "b is 4\n"
     assert 5 not in first.outputs and 13 not in first.outputs and 7 not in first.outputs
+
+
+def test_answers_only_gives_the_answers_of_a_full_run(tmp_path):
+    nb, spec = synthetic()
+    path = tmp_path / "01_synthetic.ipynb"
+    nbformat.write(nb, path)
+    v2, v3 = {"a": "2", "t": "1/2"}, {"a": "3", "t": "1/2"}
+    with Session(path, spec) as s:
+        lean = s.run(v2, pictures=False)
+        full = s.run(v3)
+        lean3 = s.run(v3, pictures=False)  # cell 11 (1 / 0 for a = 3) is not needed for an answer
+        full2 = s.run(v2)
+    assert lean.error == "" and lean3.error == "" and full.error.startswith("cell 11: ZeroDivisionError")
+    assert lean.answers == full2.answers and lean.fingerprints == full2.fingerprints
+    assert _value(lean3.answers["z"]) == 13
+    assert 12 in full2.outputs and 12 not in lean.outputs
 
 
 def test_replay_function_and_a_value_outside_the_spec(tmp_path):
@@ -217,6 +235,9 @@ def test_replay_05_q53(tmp_path, capsys):
         orig = s.original
         assert orig.error == "", orig.error
         runs = [s.run(v) for v in (regular, singular, other, regular)]
+        lean = [s.run(v, pictures=False) for v in (singular, regular)]
+    assert p.needed == [at + 1, at + 3]  # 5.3's rank and subspaces; the figures only draw
+    assert lean[0].answers == runs[1].answers and lean[1].answers == runs[0].answers
     for run in runs:
         assert run.error == "", run.error
         rank = _rank_by_hand(run.values["q53"])
@@ -234,5 +255,9 @@ def test_replay_05_q53(tmp_path, capsys):
     assert _value(orig.answers["rank53"]) == 2 and runs[1].answers["rank53"] == orig.answers["rank53"]
     assert runs[0].answers["can_move"] != orig.answers["can_move"]
     per = [round(r.seconds, 2) for r in runs]
+    per_lean = [round(r.seconds, 2) for r in lean]
     with capsys.disabled():
-        print(f"\n05 replay: original {t_orig:.1f} s, per variant {per} s, cells re-run {p.rerun}")
+        print(
+            f"\n05 replay: original {t_orig:.1f} s, per variant {per} s (cells {p.rerun}), "
+            f"answers only {per_lean} s (cells {p.answers_only})"
+        )
