@@ -114,6 +114,22 @@ def test_plan_of_a_cell_that_rebinds_from_untainted_names_does_not_spread():
     assert p.dependent == [2, 4]
 
 
+def test_session_arguments_are_checked_before_any_kernel(tmp_path):
+    nb, spec = synthetic()
+    path = tmp_path / "01_synthetic.ipynb"
+    nbformat.write(nb, path)
+    with pytest.raises(TypeError, match="spec"):
+        Session(path, SPEC_META)
+    with pytest.raises(ValueError, match="timeout"):
+        Session(path, spec, timeout=0)
+    with pytest.raises(FileNotFoundError, match="path"):
+        Session(tmp_path / "missing.ipynb", spec)
+    nb.cells[1].metadata = {}
+    nbformat.write(nb, path)
+    with pytest.raises(ValueError, match="no variant cell"):
+        Session(path, spec)
+
+
 def test_replay_synthetic(tmp_path):
     nb, spec = synthetic()
     path = tmp_path / "01_synthetic.ipynb"

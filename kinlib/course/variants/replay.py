@@ -357,6 +357,12 @@ class Session:
     """
 
     def __init__(self, path, spec: Spec, timeout: float = 120):
+        if not isinstance(spec, Spec):
+            raise TypeError(f"spec: expected a variants Spec, got {type(spec).__name__}")
+        if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 86400:
+            raise ValueError(f"timeout: expected seconds per cell in (0, 86400], got {timeout!r}")
+        if not Path(path).is_file():
+            raise FileNotFoundError(f"path: no notebook {path}")
         self.path = Path(path)
         self.spec = spec
         self.timeout = timeout
