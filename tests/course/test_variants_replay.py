@@ -8,7 +8,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import modern_robotics as mr
 import nbformat
+import numpy as np
 import pytest
 import sympy as sp
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
@@ -209,67 +211,56 @@ def test_a_cell_that_times_out_ends_the_kernel_and_the_next_variant_gets_a_fresh
 
 
 # ---------------------------------------------------------------------------------------------------
-# The real notebook 05 with a variant cell for 5.3's configuration (until the notebooks carry theirs)
+# The real notebook 05: 5.3's configuration comes from its variant cell (metadata.kinlib.variants)
 
-Q53 = {"type": "angle", "choices": [["1/4", "1/6"], ["-1/4", "3/4", "1/4", "-1/2"], ["1/4", "0"]]}
-
-
-def notebook_05_with_q53_variant(folder: Path):
-    nb = nbformat.read(ROOT / "notebooks" / "05_singularities_planar.ipynb", as_version=4)
-    meta = {"params": {"q53": Q53}, "original": {"q53": ["1/4", "-1/4", "1/4"]}, "parts": ["5.3"]}
-    spec = specmod.Spec.from_metadata(meta)
-    at = next(i for i, c in enumerate(nb.cells) if "q53 = [pi / 4, -pi / 4, pi / 4]\n" in c.source)
-    nb.cells[at].source = nb.cells[at].source.replace("q53 = [pi / 4, -pi / 4, pi / 4]\n", "")
-    for c in nb.cells:  # the later cells take 5.3's configuration from the variant cell, not hard-coded
-        c.source = c.source.replace("q53n = [np.pi / 4, -np.pi / 4, np.pi / 4]", "q53n = [float(t) for t in q53]")
-    cell = new_code_cell(specmod.assignment_source(spec, spec.original), metadata={"kinlib": {"variant": True}})
-    nb.cells.insert(at, cell)
-    nb.metadata["kinlib"]["variants"] = meta
-    assert specmod.mismatches(nb, spec) == []
-    path = folder / "05_singularities_planar.ipynb"
-    nbformat.write(nb, path)
-    return path, spec, at
+NB05 = ROOT / "notebooks" / "05_singularities_planar.ipynb"
 
 
-def _rank_by_hand(q):
-    """Rank of 05's task rows at q: det J = L²(sin θ2 + cos θ2) (5.1), so 2 on the singular family, else 3."""
-    t2 = sp.pi * sp.Rational(q[1])
-    return 2 if sp.simplify(sp.sin(t2) + sp.cos(t2)) == 0 else 3
+def _subspace_numeric(answer):
+    """A subspace answer's spanning columns as floats (L = 1, as 05's pictures)."""
+    m = _value(answer)
+    m = m.subs({s: 1 for s in m.free_symbols if s.name == "L"})
+    return np.array(m, dtype=float)
+
+
+def _task_svd(values):
+    """Independent oracle: NumPy's SVD of modern_robotics' space Jacobian of 05's arm (L = 1), task rows."""
+    q = [float(sp.pi * sp.Rational(t)) for t in values["q53"]]
+    # 05's planar offset 3R arm (L = 1): joints about z_s through (0, 0), (1, 0), (2, 1); S_i = [ω; −ω × q_i]
+    z = np.array([0.0, 0.0, 1.0])
+    screws = np.array([np.r_[z, -np.cross(z, q_i)] for q_i in ([0, 0, 0], [1, 0, 0], [2, 1, 0])]).T
+    return np.linalg.svd(mr.JacobianSpace(screws, q)[[2, 3, 4]])
 
 
 @pytest.mark.slow
-def test_replay_05_q53(tmp_path, capsys):
-    path, spec, at = notebook_05_with_q53_variant(tmp_path)
-    p = plan(nbformat.read(path, as_version=4))
-    assert at + 1 in p.dependent and p.restore == []
-    singular = {"q53": ["1/6", "3/4", "0"]}
-    regular = {"q53": ["1/4", "1/4", "1/4"]}
-    other = {"q53": ["1/6", "-1/2", "1/4"]}
+def test_replay_05_q53(capsys):
+    nb = nbformat.read(NB05, as_version=4)
+    spec = specmod.Spec.from_notebook(nb)
+    p = plan(nb)
+    assert p.needed and p.restore == []
+    draws = [{"q53": ["1/6", "3/4", "0"]}, {"q53": ["-2/3", "-1/4", "1/2"]}, {"q53": ["5/12", "3/4", "-5/6"]}]
     t0 = time.monotonic()
-    with Session(path, spec, timeout=300) as s:
+    with Session(NB05, spec, timeout=300) as s:
         t_orig = time.monotonic() - t0
         orig = s.original
         assert orig.error == "", orig.error
-        runs = [s.run(v) for v in (regular, singular, other, regular)]
-        lean = [s.run(v, pictures=False) for v in (singular, regular)]
-    assert p.needed == [at + 1, at + 3]  # 5.3's rank and subspaces; the figures only draw
-    assert lean[0].answers == runs[1].answers and lean[1].answers == runs[0].answers
+        runs = [s.run(v) for v in (*draws, draws[0])]
+        lean = [s.run(v, pictures=False) for v in draws[1:]]
+    assert runs[0].answers == runs[3].answers  # the first draw after the others as before them
+    assert [r.answers for r in lean] == [r.answers for r in runs[1:3]]
+    changed = set()
     for run in runs:
         assert run.error == "", run.error
-        rank = _rank_by_hand(run.values["q53"])
-        assert _value(run.answers["rank53"]) == rank
-        # the subspaces: range J has dimension rank, null Jᵀ the rest (as matrices of spanning columns)
-        assert run.answers["can_move"]["kind"] == "subspace"
-        # every answer outside 5.3 is the original's
-        for name, a in orig.answers.items():
-            if name not in ("rank53", "can_move", "cannot_move"):
-                assert run.answers[name] == a, name
-        # the figure of 5.3 (cell at + 8: the arm and its directions) re-drawn for the variant
-        pngs = [o for i, outs in run.outputs.items() for o in outs if "image/png" in o.get("data", {})]
-        assert pngs
-    assert runs[0].answers == runs[3].answers  # "regular" after "singular" and "other" as before them
-    assert _value(orig.answers["rank53"]) == 2 and runs[1].answers["rank53"] == orig.answers["rank53"]
-    assert runs[0].answers["can_move"] != orig.answers["can_move"]
+        U, sv, _ = _task_svd(run.values)
+        rank = int(np.sum(sv > 1e-9))
+        assert _value(run.answers["rank53"]) == rank == 2  # every draw keeps θ2 on the singular family
+        C, N = _subspace_numeric(run.answers["can_move"]), _subspace_numeric(run.answers["cannot_move"])
+        assert C.shape == (3, rank) and np.allclose(U[:, :rank] @ U[:, :rank].T @ C, C)
+        assert N.shape == (3, 3 - rank) and np.allclose(U[:, :rank].T @ N, 0)  # null Jᵀ ⟂ range J
+        changed |= {n for n, a in orig.answers.items() if run.answers[n] != a}
+        pngs = [o for outs in run.outputs.values() for o in outs if "image/png" in o.get("data", {})]
+        assert pngs  # 5.3's figure redrawn for the variant
+    assert changed <= {"rank53", "can_move", "cannot_move"} and "can_move" in changed
     per = [round(r.seconds, 2) for r in runs]
     per_lean = [round(r.seconds, 2) for r in lean]
     with capsys.disabled():
