@@ -189,9 +189,12 @@ def test_replay_function_and_a_value_outside_the_spec(tmp_path):
     nb, spec = synthetic()
     path = tmp_path / "01_synthetic.ipynb"
     nbformat.write(nb, path)
-    orig, runs = replay(path, spec, [{"a": "5", "t": "1/2"}])
-    assert orig.error == "" and runs[0].error == ""
-    assert _value(runs[0].answers["z"]) == 15
+    draws = [{"a": "5", "t": "1/2"}, {"a": "2", "t": "0"}, {"a": "3", "t": "1/2"}]
+    orig, runs = replay(path, spec, draws, jobs=2)  # two kernels, the draws shared out between them
+    assert orig.error == "" and runs[0].error == "" and runs[1].error == ""
+    assert [r.values for r in runs] == draws
+    assert [_value(r.answers["z"]) for r in runs[:2]] == [15, 12]
+    assert runs[2].error.startswith("cell 11: ZeroDivisionError")
     with Session(path, spec) as s, pytest.raises(ValueError, match="values.a"):
         s.run({"a": "4", "t": "0"})
 

@@ -572,13 +572,36 @@ class Session:
         self.close()
 
 
-def replay(path, spec: Spec, variants: list, timeout: float = 120) -> tuple[Run, list]:
-    """(the original's :class:`Run`, one Run per variant in ``variants``): the notebook ``path`` executed once in a
-    kernel, then per variant the cells that depend on the numbers (:class:`Session`).
+def replay(path, spec: Spec, variants: list, timeout: float = 120, jobs: int = 1) -> tuple[Run, list]:
+    """(the original's :class:`Run`, one Run per variant in ``variants``, in order): the notebook ``path`` executed
+    once in a kernel, then per variant the cells that depend on the numbers (:class:`Session`). With ``jobs`` > 1
+    the variants are shared out round-robin between that many kernels (each runs the original once first).
+
+    >>> replay("nb.ipynb", None, [], jobs=0)
+    Traceback (most recent call last):
+        ...
+    ValueError: jobs: expected a whole number of kernels >= 1, got 0
 
     It runs a Jupyter kernel (tests/course/test_variants_replay.py exercises it), hence not run here:
 
     >>> original, runs = replay(Path("notebooks/05_singularities_planar.ipynb"), spec, [values])  # doctest: +SKIP
     """
-    with Session(path, spec, timeout=timeout) as s:
-        return s.original, [s.run(v) for v in variants]
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"jobs: expected a whole number of kernels >= 1, got {jobs!r}")
+    variants = list(variants)
+    jobs = min(jobs, max(len(variants), 1))
+
+    def work(share):
+        with Session(path, spec, timeout=timeout) as s:
+            return s.original, [s.run(v) for v in share]
+
+    if jobs == 1:
+        return work(variants)
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        results = list(pool.map(work, [variants[k::jobs] for k in range(jobs)]))
+    runs: list = [None] * len(variants)
+    for k, (_orig, share) in enumerate(results):
+        runs[k::jobs] = share
+    return results[0][0], runs
