@@ -211,6 +211,15 @@ def build_parser() -> argparse.ArgumentParser:
         "(default: no limit beyond each submission's)",
     )
     g.add_argument(
+        "--variants",
+        type=Path,
+        default=None,
+        metavar="KEY.json",
+        help="per-student variants: the signed key (kinlib handouts --variants); each submission is judged against "
+        "the variant of its student id (its file/folder name, --id-pattern; never the notebook's metadata); a key "
+        "that does not verify with --secret is refused",
+    )
+    g.add_argument(
         "--fresh",
         action="store_true",
         help="forget the results kept in OUT (default: merge, so grading one student replaces only their rows)",
@@ -270,6 +279,19 @@ def build_lms_parser() -> argparse.ArgumentParser:
             action="store_true",
             help="run student code without bubblewrap inside the platform's container (every result says so)",
         )
+        b.add_argument(
+            "--variants",
+            type=Path,
+            default=None,
+            metavar="KEY.json",
+            help="per-student variants: the signed key goes into the bundle; each submission is judged against the "
+            + (
+                "variant of the platform's student id (submission_metadata.json users[0]: sid, else email)"
+                if name == "gradescope"
+                else "variant of the id in the submitted file's name (PrairieLearn tells an external grader no "
+                "student identity: see kinlib.course.lms.bundles)"
+            ),
+        )
         if name == "gradescope":
             b.add_argument("--visibility", choices=VISIBILITIES, default="visible", help="of every test")
         else:
@@ -309,6 +331,7 @@ def _lms_bundle(args) -> int:
         timeout=args.timeout,
         cell_timeout=args.cell_timeout,
         log=lambda s: print(s, flush=True),
+        variants=args.variants,
     )
     try:
         if args.platform == "gradescope":
@@ -439,6 +462,7 @@ def _grade(args) -> int:
             root=args.root,
             batch_timeout=args.batch_timeout,
             limits=Limits(memory_bytes=args.memory, processes=args.processes, disk_bytes=args.disk),
+            variants=args.variants,
         )
     except (SandboxUnavailable, ValueError) as exc:  # no sandbox here, or an unsafe/unreadable secret file
         print(f"{PROG} grade: {_one_line(exc)}", file=sys.stderr)

@@ -557,10 +557,57 @@ def test_gradescope_bundle_set_up_by_its_own_setup_sh(tmp_path, six):
             if "tree" in a:
                 value = str(wire.load(a["tree"], max_nodes=10 * wire.MAX_NODES))
                 assert len(value) < 8 or value not in shown, value[:80]
+    # per-student variants (issue 33), in the same image: a bundle with a key; the student id is Gradescope's
+    # submitter (submission_metadata.json users[0]: its sid, here the roster id; its email is not on the roster)
+    vzip = _variants_bundle(tmp_path, six, lambda **kw: lms.gradescope_zip(tmp_path / "variants.zip", **kw))
+    assert "variants-key.json" in zipfile.ZipFile(vzip).namelist()
+    src = tmp_path / "ag" / "source"
+    shutil.rmtree(src)
+    zipfile.ZipFile(vzip).extractall(src)
+    meta = tmp_path / "ag" / "submission_metadata.json"
+
+    def grade_as(sid, notebooks):
+        user = {"email": f"{sid}@example.edu", "id": 1234, "name": "A Student", "sid": sid}
+        meta.write_text(json.dumps({"id": 1, "users": [user], "previous_submissions": []}))
+        r, d = grade(notebooks)
+        assert r.returncode == 0, r.stderr[-3000:]
+        return (*_totals(d, "score", "max_score"), d)
+
+    _check_variants(grade_as, lambda sid: sid)
 
 
 def _code_cell(src):
     return {"cell_type": "code", "metadata": {}, "source": src, "outputs": [], "execution_count": None}
+
+
+def _variants_bundle(tmp_path, six, build):
+    """A bundle of the variants fixture (tests/variants_fixture.py) with its key (issue 33), built by ``build``
+    (gradescope_zip or prairielearn_dir) with the run's secret, for the image the test already set up."""
+    import variants_fixture as vf
+    from kinlib.course.grader.secret import load_secret
+
+    nbs = tmp_path / "variants-notebooks"
+    nbs.mkdir()
+    (nbs / f"{vf.NID}.ipynb").write_text(json.dumps(vf.notebook()))
+    key = vf.make_key(load_secret(six["kw"]["secret"]), tmp_path / "variants-key.json")
+    return build(**(six["kw"] | {"notebooks": nbs, "variants": key}))
+
+
+def _check_variants(grade, sid_of):
+    """Issue 33's grading checks in a platform: each student's own workbook full marks; ada's right workbook
+    handed in as bob's zero, flagged; bob's untouched workbook zero, not flagged (``grade(sid, notebooks)`` ->
+    (score, its maximum, results); ``sid_of``: what the platform is told)."""
+    import variants_fixture as vf
+
+    for sid in ("ada", "bob"):
+        got, top, d = grade(sid_of(sid), {"ps": vf.notebook(vf.STUDENTS[sid])})
+        assert got == top > 0 and vf.FLAG not in json.dumps(d), d
+    got, top, d = grade(sid_of("bob"), {"ps": vf.notebook(vf.STUDENTS["ada"])})
+    assert got == 0 and top > 0, d
+    assert all(vf.FLAG in t["output"] or vf.FLAG in t.get("message", "") for t in d["tests"]), d["tests"]
+    assert "'bob'" in json.dumps(d)  # the results say which student's numbers were graded
+    got, top, d = grade(sid_of("bob"), {"ps": vf.notebook(5, r="r = ...", s="s = ...")})
+    assert got == 0 and top > 0 and vf.FLAG not in json.dumps(d), d
 
 
 @pytest.mark.slow
@@ -613,6 +660,32 @@ def test_prairielearn_bundle_in_its_own_image(tmp_path, six):
     d = json.loads(res.read_text())
     assert r.returncode == 0 and validate_prairielearn(d) == [] and d["gradable"] is False
     assert "not JSON" in d["format_errors"][0]
+    # per-student variants (issue 33), in the same image. PrairieLearn tells an external grader no student identity
+    # (data.json is server.py's data: params, submitted answers, ...): the id is the question's kinlib_student_id
+    # element value (data.json submitted_answers), else the submitted file's name; the student's own claim
+    vout = _variants_bundle(tmp_path, six, lambda **kw: lms.prairielearn_dir(tmp_path / "variants-pl", **kw))
+    assert (vout / "serverFilesCourse" / "kinlib_grader" / "variants-key.json").is_file()
+    assert not (vout / "image" / "variants-key.json").exists()
+    shutil.rmtree(tmp_path / "grade" / "serverFilesCourse")
+    shutil.copytree(vout / "serverFilesCourse", tmp_path / "grade" / "serverFilesCourse")
+    data = tmp_path / "grade" / "data" / "data.json"
+    data.parent.mkdir(parents=True, exist_ok=True)
+
+    def grade_as(sid, notebooks):
+        if sid is None:
+            data.unlink(missing_ok=True)
+        else:
+            data.write_text(json.dumps({"params": {}, "submitted_answers": {"kinlib_student_id": sid}}))
+        r, d = grade(notebooks)
+        assert r.returncode == 0 and d["gradable"] is True, (r.stderr[-3000:], d)
+        return (*_totals(d, "points", "max_points"), d)
+
+    _check_variants(grade_as, lambda sid: sid)
+    # no element value: the file's name, when it is a roster id
+    import variants_fixture as vf
+
+    got, top, d = grade_as(None, {"bob": vf.notebook(vf.STUDENTS["bob"])})
+    assert got == top > 0 and "file name bob.ipynb" in d["message"], d
 
 
 def test_the_platform_commands(tmp_path, capsys):

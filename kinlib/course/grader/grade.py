@@ -71,6 +71,18 @@ How it works
   that is a Set, a {symbol: Set} dict or a list of those is compared as a set; a bool or string as a
   choice; a dict with string keys entry by entry.
 
+Per-student variants (issue 33)
+-------------------------------
+With ``--variants KEY.json`` (the signed key of :mod:`kinlib.course.variants.key`, verified with the grader secret:
+a key whose tag does not verify is refused before anything is graded, :class:`VariantsKeyRefused`), each
+submission is judged against its student's own variant: the student id is the submission's identity
+(:func:`kinlib.course.grader.intake.student_id`: its path relative to the submissions root, ``--id-pattern``),
+never the notebook's metadata or its variant cell (the student controls those). A student not on the key's roster
+is not graded (error rows saying so, 0 points). For each answer that varies between variants, a wrong answer is
+judged again against the other variants' reference answers (and the instructor's original) that differ from the
+student's; one that is right for another variant scores zero and its feedback says "this looks like another
+variant's answer" (:data:`kinlib.course.grader.judging.OTHER_VARIANT`), never which variant or its numbers.
+
 Threat model
 ------------
 Each kernel runs in the sandbox: its own user, PID, network and IPC namespaces (no network, no view of
@@ -139,12 +151,97 @@ __all__ = [
     "GRADE_VERSION",
     "SandboxUnavailable",
     "NO_SANDBOX_NOTE",
+    "VariantsKeyRefused",
+    "read_variants_key",
+    "variant_plan",
 ]
 
 NO_SANDBOX_NOTE = (
     "graded WITHOUT the sandbox (--no-sandbox): the submission's code ran with the grader's files and network"
 )
 MAX_SUBMISSION_BYTES = intake.MAX_SUBMISSION_BYTES
+MAX_OTHERS = 64  # other variants' reference answers a wrong answer is judged against (each distinct one once)
+
+
+# ----------------------------------------------------------------------------------------- per-student variants
+
+
+class VariantsKeyRefused(ValueError):
+    """The variants key cannot be used (missing, damaged, or signed with another secret): nothing is graded."""
+
+
+def read_variants_key(path, secret: bytes):
+    """The :class:`kinlib.course.variants.key.Key` in ``path``, verified with ``secret``; raises
+    :class:`VariantsKeyRefused` (saying why) when its tag does not verify or it is not a key.
+
+    >>> read_variants_key("/nonexistent/key.json", b"s" * 32)
+    Traceback (most recent call last):
+    ...
+    kinlib.course.grader.grade.VariantsKeyRefused: the variants key /nonexistent/key.json does not exist: nothing graded
+    """
+    from ..variants.key import read_key
+
+    p = Path(path)
+    if not p.is_file():
+        raise VariantsKeyRefused(f"the variants key {p} does not exist: nothing graded")
+    key = read_key(p, secret)
+    if key is None:
+        raise VariantsKeyRefused(
+            f"the variants key {p} does not verify with the grader secret (damaged, edited, or built with another "
+            "secret): nothing graded; build it again with the secret this grader uses (--secret)"
+        )
+    return key
+
+
+def _canon(answer) -> str:
+    import json
+
+    return json.dumps(answer, sort_keys=True, separators=(",", ":"), default=str)
+
+
+def variant_plan(ref: Reference, key, student: str) -> dict | None:
+    """What grading needs to judge ``student``'s submission of ``ref``'s notebook against their own variant:
+    ``{"student", "variant", "answers": the variant's reference answers, "others": {answer: [the other variants'
+    reference answers (and the original's) that differ from the student's]}}``; ``{"student", "refused": why}``
+    for a student not on the key's roster; None for a notebook without variants (graded as before).
+
+    >>> from kinlib.course.variants.key import Key, NotebookKey, Variant
+    >>> a = lambda n: {"kind": "expr", "tree": ["Integer", str(n)], "symbols": {}}
+    >>> ref = Reference("05", "t", "p", "0" * 64, parts=[], answers={"r": a(2), "k": a(7)})
+    >>> nk = NotebookKey("05", "0" * 64, {}, {}, variants={"v1": Variant({}, {"r": a(1), "k": a(7)}, {}),
+    ...     "v3": Variant({}, {"r": a(3), "k": a(7)}, {})}, students={"ada": "v1", "bob": "v3"})
+    >>> p = variant_plan(ref, Key({"05": nk}), "ada")
+    >>> p["variant"], p["answers"]["r"]["tree"], [o["tree"] for o in p["others"]["r"]], sorted(p["others"])
+    ('v1', ['Integer', '1'], [['Integer', '2'], ['Integer', '3']], ['r'])
+    >>> variant_plan(ref, Key({"05": nk}), "eve")["refused"]
+    "student 'eve' is not on the roster of the variants key: not graded (the instructor must add them and build the key again)"
+    """
+    from ..variants.key import reference_for
+
+    nk = key.notebooks.get(ref.notebook)
+    if nk is None:
+        return None
+    try:
+        mine, vk = reference_for(ref, key, student)
+    except KeyError:
+        why = (
+            f"student {student!r} is not on the roster of the variants key: not graded (the instructor must add them "
+            "and build the key again)"
+            if student
+            else "no student id for this submission: not graded against a variant (its identity names nobody on the "
+            "roster of the variants key)"
+        )
+        return {"student": student, "refused": why}
+    others = {}
+    for name, own in mine.answers.items():
+        seen, alts = {_canon(own)}, []
+        for cand in [ref.answers.get(name)] + [v.answers.get(name) for v in nk.variants.values()]:
+            if isinstance(cand, dict) and "error" not in cand and _canon(cand) not in seen:
+                seen.add(_canon(cand))
+                alts.append(cand)
+        if alts:  # only an answer that varies
+            others[name] = alts[:MAX_OTHERS]
+    return {"student": student, "variant": vk, "answers": dict(mine.answers), "others": others}
 
 
 # ----------------------------------------------------------------------------------------- one submission
@@ -200,6 +297,10 @@ class Job:
     points: list = field(default_factory=list)  # the secret evaluation points (never sent to the kernel)
     seed: int = 0
     plan: dict | None = None  # the points chosen by a batch's supervisor (:func:`plan`); then no secret here
+    variant: dict | None = None  # the student's variant (:func:`variant_plan`), per-student variants only
+    vkey: object = None  # the variants Key (the student's variant is chosen from it by ``student``)
+    student: str = ""  # the submission's student id (its identity: intake.student_id), for the variants key
+    others: dict = field(default_factory=dict)  # answer -> the other variants' reference answers
 
     @property
     def sub(self) -> str:
@@ -245,6 +346,25 @@ def _identify(job: Job) -> bool:
     if job.ref.error:
         why = f"the reference for {nid} is broken: {job.ref.error}"
         return job.stop(_error_rows(job.sub, nid, job.ref.parts, why))
+    return _own_variant(job)
+
+
+def _own_variant(job: Job) -> bool:
+    """Per-student variants: the student's own reference (:func:`variant_plan`, chosen from the submission's
+    identity, never from the notebook), or error rows for a student not on the key's roster."""
+    if job.variant is None and job.vkey is not None:
+        job.variant = variant_plan(job.ref, job.vkey, job.student)
+    v = job.variant
+    if v is None:
+        return True
+    if v.get("refused"):
+        job.out["variant"] = ""
+        return job.stop(_error_rows(job.sub, job.nid, job.ref.parts, v["refused"]))
+    from dataclasses import replace
+
+    job.ref = replace(job.ref, answers={**job.ref.answers, **v["answers"]})
+    job.others = v.get("others") or {}
+    job.out["variant"], job.out["student"] = v.get("variant") or "", v.get("student", "")
     return True
 
 
@@ -281,19 +401,25 @@ def _points(ref: Reference, key: bytes, data: bytes) -> tuple[int, list]:
     return seed, make_points(symbols, seed, N_POINTS)
 
 
-def plan(path, refs: dict, key: bytes) -> dict | None:
+def plan(path, refs: dict, key: bytes, variants=None, student: str = "") -> dict | None:
     """What a grading worker needs from the secret to grade the file ``path``, chosen by the supervisor (which
     alone holds the secret): {"seed", "points", "sha"} (sha: of the bytes the points are for), or None when the
-    file is not gradable (the worker's own steps then say why).
+    file is not gradable (the worker's own steps then say why). ``variants`` (a variants Key) and ``student``: the
+    plan also carries the student's variant (:func:`variant_plan`).
 
     >>> plan("no-such-file.ipynb", {}, b"k" * 32) is None
     True
     """
-    job = Job(Path(path), refs, {"submission": str(path)})
+    job = Job(Path(path), refs, {"submission": str(path)}, vkey=variants, student=student)
     if not (_read(job) and _identify(job)):
+        if job.variant and job.variant.get("refused"):  # not on the roster: the worker writes the rows saying so
+            return {"seed": 0, "points": [], "sha": hashlib.sha256(job.data).hexdigest(), "variant": job.variant}
         return None
     seed, points = _points(job.ref, key, job.data)
-    return {"seed": seed, "points": points, "sha": hashlib.sha256(job.data).hexdigest()}
+    out = {"seed": seed, "points": points, "sha": hashlib.sha256(job.data).hexdigest()}
+    if job.variant is not None:
+        out["variant"] = job.variant
+    return out
 
 
 def _grade(job: Job) -> bool:
@@ -323,7 +449,7 @@ def _run_and_judge(job: Job, enc: Enclosure) -> list:
     # the judge of this submission's answers: its own process (judging.JudgeProcess), in the sandbox started now,
     # so that it imports SymPy while the kernel runs; as the student's user (no sandbox) only once every process
     # of that user is gone (the kernel's could reach a process of their own user)
-    judge = JudgeProcess(job.ref, job.points, job.seed, sandbox=job.sandbox or None, user=job.user)
+    judge = JudgeProcess(job.ref, job.points, job.seed, sandbox=job.sandbox or None, user=job.user, others=job.others)
     try:
         if job.user is None:
             judge.start()
@@ -400,6 +526,8 @@ def grade_submission(
     limits: Limits | None = None,
     user=None,
     plan: dict | None = None,
+    variants=None,
+    student: str = "",
 ) -> dict:
     """Grade one file; returns {"rows": [Row], "cells": [...], "seconds": float, ...} (never raises), by the
     named steps of :data:`SUBMISSION_STEPS` (read, identify, prepare, grade: the last runs
@@ -409,7 +537,9 @@ def grade_submission(
     said in the result's ``notes``); ``secret``: the grader secret (bytes) or its file (default
     :func:`~kinlib.course.grader.secret.default_secret_path`), which chooses the evaluation points; ``user``:
     without the sandbox, a :class:`~kinlib.course.grader.isolation.unprivileged.StudentUser` the kernel runs as;
-    ``plan``: the points a batch's supervisor chose (:func:`plan`; then ``secret`` is not used).
+    ``plan``: the points a batch's supervisor chose (:func:`plan`; then ``secret`` is not used, and the plan
+    carries the student's variant); ``variants``: the per-student variants Key and ``student`` the submission's
+    student id (its identity, never the notebook's metadata): judged against that student's variant.
 
     A file that is not one of the notebooks gets one ``error`` row, without starting a kernel:
 
@@ -429,7 +559,8 @@ def grade_submission(
     t0 = time.monotonic()
     out = _new_result(path, display_name, sandbox, relpath, root, user)
     job = Job(Path(path), refs, out, cell_timeout, total_timeout, sandbox, secret, limits, user)
-    job.plan = plan
+    job.plan, job.vkey, job.student = plan, variants, student
+    job.variant = (plan or {}).get("variant")
     for _, step in SUBMISSION_STEPS:
         if not step(job):
             break
@@ -528,6 +659,7 @@ def grade_batch(
     on_event=None,
     root=None,
     limits: Limits | None = None,
+    variants=None,
 ) -> dict:
     """Grade every submission in ``paths`` (files or folders) into ``out``; returns a summary dict.
 
@@ -546,7 +678,9 @@ def grade_batch(
     processes, 512 MiB written). ``root``: the folder student ids are read relative to, for files given by
     themselves (default: the one remembered in ``out/class.json``). grades.csv, totals.csv and the feedback are
     written for everyone graded, even when the batch is interrupted, and only after every kernel of the batch
-    (and every process a submission started) is gone.
+    (and every process a submission started) is gone. ``variants``: the per-student variants key's file (verified
+    with the secret; :class:`VariantsKeyRefused` before anything runs when it does not verify): each submission is
+    judged against the variant of its student id (``id_pattern``, else the one remembered in ``out``).
 
     It runs the solution notebooks and every submission in Jupyter kernels (seconds to minutes;
     tests/course/test_grade.py exercises it), hence not run here:
@@ -566,7 +700,19 @@ def grade_batch(
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
     key = secret if isinstance(secret, bytes) else load_secret(secret)
+    vkey = read_variants_key(variants, key) if variants is not None else None
+    if vkey is not None:
+        from .report import remembered_pattern
+
+        pattern = id_pattern if id_pattern is not None else remembered_pattern(out)
+        students = {s.path: intake.student_id(s.relpath, pattern)[0] for s in subs}
+        log(
+            f"variants: {variants} ({', '.join(sorted(vkey.notebooks)) or 'no notebook'}): each submission judged "
+            "against its student's own variant"
+        )
     hidden = [notebooks, out, cache or "", "" if isinstance(secret, bytes) else secret or default_secret_path()]
+    if variants is not None:
+        hidden.append(variants)
     sb = _batch_sandbox(hidden, subs) if sandbox else None
     if sb is None:
         log(f"WARNING: {NO_SANDBOX_NOTE}")
@@ -576,6 +722,8 @@ def grade_batch(
     results: list = []  # filled as submissions are graded: an interrupted batch still writes what it graded
     try:
         opts = dict(timeout=timeout, cell_timeout=cell_timeout, sandbox=sb or False, secret=key, limits=limits)
+        if vkey is not None:
+            opts["variants"], opts["students"] = vkey, students
         _grade_all(results, subs, refs, jobs, opts, batch_timeout, on_event, log)
     finally:
         # every kernel is stopped by now; make sure no process of any sandbox survives before writing results
@@ -633,7 +781,8 @@ def _grade_all(done, subs, refs, jobs, opts, batch_timeout, on_event, log) -> No
             for k, s in enumerate(subs, 1):
                 o = opts
                 args = (o["cell_timeout"], o["timeout"], s.relpath, o["sandbox"], o["secret"], s.relpath, s.root)
-                done.append(grade_submission(s.path, refs, *args, limits=o["limits"]))
+                vk, sid = o.get("variants"), o.get("students", {}).get(s.path, "")
+                done.append(grade_submission(s.path, refs, *args, limits=o["limits"], variants=vk, student=sid))
                 _progress(log, k, n, done[-1])
         except KeyboardInterrupt:
             log(f"interrupted: writing the {len(done)} result(s) graded so far")
@@ -642,11 +791,11 @@ def _grade_all(done, subs, refs, jobs, opts, batch_timeout, on_event, log) -> No
     # the supervisor alone holds the secret: it chooses each submission's points; a worker gets only those
     tasks = [
         {"i": k, "path": str(s.path), "name": s.relpath, "relpath": s.relpath, "root": s.root}
-        | {"plan": plan(s.path, refs, opts["secret"])}
+        | {"plan": plan(s.path, refs, opts["secret"], opts.get("variants"), opts.get("students", {}).get(s.path, ""))}
         for k, s in enumerate(subs)
     ]
     init = {"handler": f"{__name__}:worker_handler", "refs": {k: asdict(v) for k, v in refs.items()}}
-    init.update({k: v for k, v in opts.items() if k != "secret"})
+    init.update({k: v for k, v in opts.items() if k not in ("secret", "variants", "students")})
 
     def event(kind, pid, i):
         if kind in ("died", "stuck", "retry", "gave-up") and i is not None:

@@ -8,7 +8,10 @@ runs in the grading worker (which runs the kernel, sends heartbeats and reads th
   the submission's kernel runs, so that importing SymPy overlaps the kernel's work. It gets, over a pipe, as JSON,
   only what judging needs: the notebook's reference answers (:class:`kinlib.course.grader.refdata.Reference`),
   the submission's evaluation points and their seed. Never the grader secret: it cannot sign a reference cache
-  or compute another submission's points.
+  or compute another submission's points. With per-student variants (issue 33) it also gets, for each answer that
+  varies, the other variants' reference answers (``others``): a wrong answer is then judged against them too
+  (:data:`OTHER_SECONDS` in all), and one that is right for another variant says :data:`OTHER_VARIANT` (never
+  which variant, nor its numbers).
 * **Ended, not interrupted.** Each answer has :data:`~kinlib.course.grader.judge.JUDGE_SECONDS` (the advisory
   exact check :data:`~kinlib.course.grader.judge.EXACT_SECONDS`, asked separately); past it the process is killed
   (SIGKILL to its process group) and the answer is wrong ("too large to grade"); the next answer gets a fresh
@@ -40,7 +43,19 @@ from .isolation.limits import launch_prelude
 from .isolation.reap import kill_group
 from .judge import EXACT_SECONDS, JUDGE_SECONDS, Verdict
 
-__all__ = ["JudgeProcess", "MEMORY_BYTES", "MAX_FILES", "START_SECONDS", "judge_command"]
+__all__ = [
+    "JudgeProcess",
+    "MEMORY_BYTES",
+    "MAX_FILES",
+    "START_SECONDS",
+    "judge_command",
+    "OTHER_VARIANT",
+    "OTHER_SECONDS",
+]
+
+#: the feedback on a wrong answer that is another variant's right answer (issue 33's wording, exactly)
+OTHER_VARIANT = "this looks like another variant's answer"
+OTHER_SECONDS = 30.0  # for judging one wrong answer against every other variant's reference answer
 
 MEMORY_BYTES = 3 * 2**30  # address space of a judge process (SymPy + NumPy map ~0.5 GiB before any answer)
 MAX_FILES = 64  # open files of a judge process
@@ -116,7 +131,9 @@ def _child() -> int:
 
     ref = Reference(**init["ref"])
     points, seed = init["points"], init["seed"]
+    others = init.get("others") or {}
     values: dict = {}
+    last: dict = {}
     _send(out, {"ready": True})
     while True:
         msg = _recv_blocking(inp, 2**31 - 1)
@@ -127,12 +144,31 @@ def _child() -> int:
                 msg["name"], msg["kind"], msg["exported"], ref, points, seed, exact=False, keep_value=True
             )
             values = {msg["name"]: value}  # only the last answer's: kept for its exact check
+            last = {"name": msg["name"], "kind": msg["kind"], "exported": msg["exported"]}
             _send(out, {"status": v.status, "message": v.message, "exact": v.exact, "wants_exact": v.exact == "?"})
+        elif msg.get("op") == "other":
+            _send(out, {"other": _matches_other(last, msg.get("name"), others, ref, points, seed)})
         elif msg.get("op") == "exact":
             word = exact_check(values.get(msg["name"]), reference_value(ref, msg["name"]), float(msg["seconds"]))
             _send(out, {"exact": word})
         else:
             return 0
+
+
+def _matches_other(last: dict, name, others: dict, ref, points, seed) -> bool:
+    """Whether the last answer judged (``name``) is right for one of the other variants' reference answers."""
+    from dataclasses import replace
+
+    from .judge import judge_answer
+
+    if last.get("name") != name:
+        return False
+    for alt in others.get(name) or []:
+        other = replace(ref, answers={**ref.answers, name: alt})
+        v = judge_answer(name, last["kind"], last["exported"], other, points, seed, exact=False)
+        if v.status == "pass":
+            return True
+    return False
 
 
 # ----------------------------------------------------------------------------------------- the parent
@@ -144,7 +180,8 @@ class JudgeProcess:
 
     ``sandbox``: a :class:`~.isolation.sandbox.Sandbox` to run it in (None: none); ``user``: a
     :class:`~.isolation.unprivileged.StudentUser` to run it as (without a sandbox); ``argv``: the command
-    (tests). Nothing starts until :meth:`start` (or the first :meth:`judge`):
+    (tests); ``others``: {answer: [the other variants' reference answers that differ from this student's]}
+    (per-student variants). Nothing starts until :meth:`start` (or the first :meth:`judge`):
 
     >>> from kinlib.course.grader.refdata import Reference
     >>> jp = JudgeProcess(Reference("n", "t", "p", "0" * 64, [], {}), [], 0)
@@ -152,8 +189,11 @@ class JudgeProcess:
     (True, 0)
     """
 
-    def __init__(self, ref, points, seed, sandbox=None, user=None, argv=None, memory=MEMORY_BYTES):
+    def __init__(self, ref, points, seed, sandbox=None, user=None, argv=None, memory=MEMORY_BYTES, others=None):
         self.init = {"ref": asdict(ref) if is_dataclass(ref) else dict(ref), "points": points, "seed": int(seed)}
+        self.others = {k: v for k, v in (others or {}).items() if v}
+        if self.others:
+            self.init["others"] = self.others
         self.sandbox, self.user, self.argv, self.memory = sandbox, user, argv, memory
         self.proc: subprocess.Popen | None = None
         self.ready = False
@@ -277,8 +317,18 @@ class JudgeProcess:
             v = Verdict(name, got["status"], str(got.get("message", ""))[:1000])
             if got.get("wants_exact") is True and exact:
                 v.exact = self._exact(name, min(EXACT_SECONDS, seconds / 3))
+            elif v.status == "fail" and name in self.others and self._other(name):
+                v = Verdict(name, "fail", f"{name}: {OTHER_VARIANT}")
         v.seconds = round(time.monotonic() - t0, 3)
         return v
+
+    def _other(self, name) -> bool:
+        """Whether the answer just judged wrong is right for another variant (False when that takes too long)."""
+        try:
+            got = self._ask({"op": "other", "name": name}, OTHER_SECONDS + 1.0)
+        except (RuntimeError, OSError):
+            return False
+        return isinstance(got, dict) and got.get("other") is True
 
     def _exact(self, name, seconds) -> str:
         try:

@@ -465,6 +465,16 @@ def remembered_root(out: Path) -> list:
     return [str(r) for r in roots if isinstance(r, str)] if isinstance(roots, list) else []
 
 
+def remembered_pattern(out: Path):
+    """The ``--id-pattern`` remembered in ``out/class.json`` (None if none).
+
+    >>> remembered_pattern(Path("/nonexistent")) is None
+    True
+    """
+    p = _read_settings(out).get("id_pattern")
+    return p if isinstance(p, str) else None
+
+
 def _read_settings(out: Path) -> dict:
     try:
         d = json.loads((Path(out) / "class.json").read_text())

@@ -38,6 +38,27 @@ Everything here reuses the one grading core (:func:`kinlib.course.grader.grade.g
   Canvas gradebook export). Students with manual parts still pending are left blank (ungraded in Canvas)
   unless ``--include-pending``.
 
+Per-student variants (issue 33): ``--variants KEY.json`` puts the signed key (:mod:`kinlib.course.variants.key`,
+verified with the instructor's secret, then signed again with the bundle's derived secret; only the bundle's
+notebooks, the roster reduced to ids) into the bundle as ``variants-key.json``; each submission is judged against
+the variant of the platform's student id (:func:`kinlib.course.grader.grade.variant_plan`: a wrong answer right
+for another variant says "this looks like another variant's answer"; a student not on the roster is not graded).
+The student id, and how much it can be trusted:
+
+* **Gradescope** gives it: ``/autograder/submission_metadata.json`` ``users[0]`` (the submitter; in a group
+  submission its first member). The roster id is matched against that user's ``sid`` (the course roster's Student
+  ID, when the course has them), else their ``email``: build the roster with one or the other.
+* **PrairieLearn gives an external grader no student identity.** The grading job's files are the student's files
+  (``/grade/student``), the question's tests and ``/grade/data/data.json``, the ``data`` dict of ``server.py``'s
+  ``grade()`` (``params``, ``correct_answers``, ``submitted_answers``, ``raw_submitted_answers``, ``variant_seed``,
+  ``options``, ...: no user, no uid). So the id is what the student gives: the value of the question's element
+  ``<pl-string-input answers-name="kinlib_student_id">`` (``submitted_answers`` in data.json), else the submitted
+  notebook's file name (``ada.ipynb`` → ``ada``) when that is on the roster. Either is the student's own claim:
+  a student who types a classmate's id is graded against that classmate's variant (and gets the classmate's
+  numbers right only by copying them). The results' message says which id was graded ("graded as student …"),
+  so the instructor can compare it with PrairieLearn's own record of who submitted (the assessment's
+  submissions download has each submission's UID beside its submitted answers).
+
 Work graded by hand (``manual`` items, e.g. 5.2's drawing) is not part of the platforms' automatic score:
 the results' output lists it; grade it with the platform's own manual grading. Within the container the
 student's kernel runs in the sandbox when the bundle asks for it and bubblewrap can run there. Otherwise (a zip
@@ -110,12 +131,15 @@ def build_bundle(
     timeout: float = 300.0,
     cell_timeout: float = 60.0,
     log=None,
+    variants=None,
 ) -> dict:
     """Write the grader bundle into the folder ``dest``; returns its ``config.json`` as a dict.
 
     The references are computed here (the solution notebooks run in the instructor's grader) and kept as
     data; the bundle's secret is HMAC(instructor secret, "platform", random nonce), so the platform never
-    holds the instructor's own secret. Runs the solution notebooks (seconds), hence not run here:
+    holds the instructor's own secret. ``variants``: the per-student variants key (verified with the instructor's
+    secret, then written into the bundle signed with the bundle's). Runs the solution notebooks (seconds), hence
+    not run here:
 
     >>> cfg = build_bundle("/tmp/bundle", only=["05"])  # doctest: +SKIP
     >>> sorted(cfg)  # doctest: +SKIP
@@ -138,6 +162,7 @@ def build_bundle(
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
     master = secret_mod.load_secret(secret)
+    vkey = grade.read_variants_key(variants, master) if variants is not None else None  # refused before any work
     refs = grade.load_references(notebooks, Path(cache) if cache else None, ids, log=log, secret=master)
     broken = {k: r.error for k, r in refs.items() if r.error}
     if broken:
@@ -149,6 +174,8 @@ def build_bundle(
     key = dest / "grader-secret"
     key.write_text(derived + "\n")
     key.chmod(0o600)
+    if vkey is not None:
+        _bundle_key(dest / VARIANTS_KEY, vkey, set(refs), derived.encode(), log)
     _copy_package(dest / "kinlib-src")
     env = Path(grade.__file__).resolve().parents[3] / "environment.txt"
     if env.is_file():
@@ -176,9 +203,71 @@ def build_bundle(
         "timeout": float(timeout),
         "cell_timeout": float(cell_timeout),
     }
+    if vkey is not None:
+        cfg["variants"] = VARIANTS_KEY
     (dest / "config.json").write_text(json.dumps(cfg, indent=1, sort_keys=True) + "\n")
     log(f"bundle: {len(refs)} notebook(s): {', '.join(sorted(refs))}")
     return cfg
+
+
+VARIANTS_KEY = "variants-key.json"
+
+
+def _bundle_key(path: Path, vkey, notebooks: set, secret: bytes, log) -> None:
+    """The variants key of the bundle's notebooks, the roster reduced to ids, signed with the bundle's secret."""
+    from dataclasses import replace
+
+    from ..variants.key import write_key
+
+    nbs = {k: v for k, v in vkey.notebooks.items() if k in notebooks}
+    roster = [{"id": s["id"], "name": "", "email": ""} for s in vkey.roster]
+    write_key(path, replace(vkey, notebooks=nbs, roster=roster), secret)
+    path.chmod(0o600)
+    students = len({s for nk in nbs.values() for s in nk.students})
+    log(f"bundle: per-student variants of {', '.join(sorted(nbs)) or 'no notebook'} ({students} students)")
+
+
+def platform_student(platform: str, root: Path, students: set, files=()) -> tuple[str, str]:
+    """(student id, where it came from) of the submission being graded: Gradescope's submitter
+    (``submission_metadata.json`` users[0]: ``sid`` if on the roster, else ``email``); PrairieLearn's element value
+    ``kinlib_student_id`` (data.json ``submitted_answers``), else a submitted file's name on the roster (PrairieLearn
+    tells an external grader no identity: the student's claim). ("", why) when there is none.
+
+    >>> import tempfile
+    >>> with tempfile.TemporaryDirectory() as d:
+    ...     _ = (Path(d) / "submission_metadata.json").write_text(json.dumps({"users": [{"email": "a@x.edu", "sid": "S1"}]}))
+    ...     platform_student("gradescope", Path(d), {"a@x.edu"}), platform_student("gradescope", Path(d), {"S1"})
+    (('a@x.edu', "Gradescope's submitter (email)"), ('S1', "Gradescope's submitter (sid)"))
+    >>> platform_student("prairielearn", Path("/nonexistent"), {"ada"}, [Path("ada.ipynb")])
+    ('ada', 'the submitted file name ada.ipynb')
+    """
+
+    def read(p):
+        try:
+            with open(p, "rb") as f:
+                d = json.loads(f.read(2**22))
+            return d if isinstance(d, dict) else {}
+        except (OSError, ValueError):
+            return {}
+
+    if platform == "gradescope":
+        users = read(root / "submission_metadata.json").get("users")
+        user = users[0] if isinstance(users, list) and users and isinstance(users[0], dict) else {}
+        ids = [(str(user[k]), k) for k in ("sid", "email") if isinstance(user.get(k), (str, int)) and str(user[k])]
+        for sid, k in ids:
+            if sid in students:
+                return sid, f"Gradescope's submitter ({k})"
+        if ids:
+            return ids[0][0], f"Gradescope's submitter ({ids[0][1]})"
+        return "", "Gradescope's submission_metadata.json names no submitter"
+    answers = read(root / "data" / "data.json").get("submitted_answers")
+    typed = answers.get("kinlib_student_id") if isinstance(answers, dict) else None
+    if isinstance(typed, str) and typed.strip():
+        return typed.strip()[:64], "the id typed in the question (kinlib_student_id)"
+    for f in files:
+        if Path(f).stem in students:
+            return Path(f).stem, f"the submitted file name {Path(f).name}"
+    return "", "no student id: the question has no kinlib_student_id answer and no file is named by a roster id"
 
 
 def _exe(path: Path, text: str) -> None:
@@ -414,7 +503,7 @@ def _load_refs(bundle: Path) -> dict:
     return {k: Reference(**v) for k, v in data.items()}
 
 
-def _grade(path: Path, refs: dict, cfg: dict, bundle: Path, user=None) -> dict:
+def _grade(path: Path, refs: dict, cfg: dict, bundle: Path, user=None, variants=None, student: str = "") -> dict:
     import inspect
 
     from ..grader import grade
@@ -431,6 +520,8 @@ def _grade(path: Path, refs: dict, cfg: dict, bundle: Path, user=None) -> dict:
         kw["sandbox"] = user is None and bool(cfg.get("sandbox", True))
     if user is not None:
         kw["user"] = user
+    if variants is not None:
+        kw.update(variants=variants, student=student)
     res = grade.grade_submission(path, refs, **kw)
     ref = refs.get(res.get("notebook"))
     if ref is not None and res.get("credit") != "scored":
@@ -468,7 +559,7 @@ def _lock_down(root: Path, bundle: Path, subdir: Path, dest: Path, user) -> None
             os.chown(d, 0, 0)
             d.chmod(0o700)
     probe = "import sys\nfor p in sys.argv[1:]:\n    try:\n        open(p, 'rb').read(1); print(p)\n    except OSError:\n        pass"
-    secret = [bundle / "grader-secret", bundle / "references.json", bundle / "config.json"]
+    secret = [bundle / "grader-secret", bundle / "references.json", bundle / "config.json", bundle / VARIANTS_KEY]
     r = subprocess.run(
         [sys.executable, "-I", "-S", "-c", probe, *map(str, secret)],
         capture_output=True,
@@ -518,8 +609,9 @@ def run_platform(platform: str, root=None, bundle=None) -> dict:
     if user is not None:
         _lock_down(root, bundle, subdir, dest, user)
     subs = find_submissions([subdir]) if subdir.is_dir() else []
+    vkey, student, whence = _variants(platform, root, bundle, cfg, subs)
     try:
-        results = [_grade(p, refs, cfg, bundle, user) for p in subs]
+        results = [_grade(p, refs, cfg, bundle, user, vkey, student) for p in subs]
     finally:
         left = user.end_all() if user is not None else []
     if left:
@@ -537,8 +629,27 @@ def run_platform(platform: str, root=None, bundle=None) -> dict:
     if user is not None:
         note = f"The code ran as the unprivileged user {user.name} (no bubblewrap in this container)."
         out["output" if platform == "gradescope" else "message"] += "\n" + note
+    if vkey is not None and results:
+        note = f"Graded against the numbers of student {student!r} ({whence})." if student else whence
+        out["output" if platform == "gradescope" else "message"] += "\n" + report.printable(note)
     report.atomic_write(dest, json.dumps(out, indent=1, ensure_ascii=False) + "\n")
     return out
+
+
+def _variants(platform: str, root: Path, bundle: Path, cfg: dict, subs: list):
+    """(variants Key or None, student id, where the id came from) for this run; a bundle key that does not verify
+    with the bundle's secret stops the run (never graded against the original's answers)."""
+    if not cfg.get("variants"):
+        return None, "", ""
+    from ..variants.key import read_key
+
+    vkey = read_key(bundle / VARIANTS_KEY, (bundle / "grader-secret").read_bytes().strip())
+    if vkey is None:
+        raise RuntimeError(f"the bundle's {VARIANTS_KEY} does not verify with its secret: build the bundle again")
+    students = {s for nk in vkey.notebooks.values() for s in nk.students}
+    student, whence = platform_student(platform, root, students, list(subs))
+    print(f"variants: graded as student {student!r} ({whence})", flush=True)
+    return vkey, student, whence
 
 
 # ----------------------------------------------------------------------------------------- Canvas

@@ -24,6 +24,7 @@ import io
 import json
 import re
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
@@ -283,11 +284,13 @@ def build_key(
     max_attempts: int = 50,
     timeout: float = 120.0,
     previous: Key | None = None,
+    jobs: int = 2,
     log=print,
 ) -> Key:
     """Each student's proved variant of every notebook (``NN_*.ipynb`` in ``notebooks``) that declares variants.
 
     ``previous`` (a key read back with :func:`read_key`) lends the proofs of notebooks whose bytes are unchanged.
+    ``jobs`` notebooks are proved at once (each in its own kernel).
     Raises VariantError when a student gets no well-posed variant in ``max_attempts`` draws.
 
     It runs notebooks in a Jupyter kernel (tests/course/test_variants.py exercises it), hence not run here:
@@ -302,12 +305,20 @@ def build_key(
     paths = sorted(Path(notebooks).glob("[0-9][0-9]_*.ipynb"))
     if only:
         paths = [p for p in paths if any(p.stem.startswith(o) for o in only)]
+    todo = []
     for path in paths:
         nb = json.loads(path.read_bytes())
         spec = Spec.from_notebook(nb)
-        if spec is None:
-            continue
-        nk = _key_for_notebook(path, nb, spec, roster, secret, previous, max_attempts, timeout, log)
+        if spec is not None:
+            todo.append((path, nb, spec))
+
+    def one(item):
+        path, nb, spec = item
+        return _key_for_notebook(path, nb, spec, roster, secret, previous, max_attempts, timeout, log)
+
+    with ThreadPoolExecutor(max_workers=max(1, min(jobs, len(todo) or 1))) as pool:  # a kernel per notebook
+        done = list(pool.map(one, todo))
+    for nk in done:
         key.notebooks[nk.notebook] = nk
         st = key.stats()[nk.notebook]
         log(

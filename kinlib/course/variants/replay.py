@@ -52,9 +52,9 @@ import nbformat
 from ..grader.isolation.kernel import setup_code
 from ..grader.refdata import reference_answers
 from ..publish.aids import show_students_version
-from ..publish.analysis import cell_names
+from ..publish.analysis import answer_dependents, cell_names
 from ..publish.execute import notebook_client
-from ..schema import CHECK, answer_groups, cell_reveals, cell_tags, parse_parts, stash_points
+from ..schema import CHECK, SOLUTION, answer_groups, cell_reveals, cell_tags, parse_parts, stash_points
 from ..workbook.selfcheck import FINGERPRINT_MARK, emit_fingerprints
 from .spec import Spec, assignment_source, variant_cell_index
 
@@ -213,7 +213,7 @@ def plan(nb) -> Plan:
     cells = nb["cells"]
     code = [i for i, c in enumerate(cells) if c.get("cell_type") == "code" and _source(c).strip()]
     info = {i: _analyse(cells[i]) for i in code}
-    dependent, skipped, tainted = _dependents(info, code, v)
+    dependent, skipped, tainted = _dependents(nb, info, code, v)
     reads = _Reads(nb, info, code, skipped)
     rerun = {v, *dependent}
     restore: set = set()
@@ -250,7 +250,7 @@ def plan(nb) -> Plan:
     return Plan(v, dependent, sorted(restore), dict(sorted(skipped.items())), restash, recapture, needed)
 
 
-def _dependents(info: dict, code: list, v: int) -> tuple[list, dict, set]:
+def _dependents(nb, info: dict, code: list, v: int) -> tuple[list, dict, set]:
     """(dependent cells, skipped {cell: why}, tainted names) for the variant cell ``v``."""
     tainted = _taint(info[v], set(), everything=True)  # the names it assigns (not its imports)
     dependent, skipped = [], {}
@@ -265,12 +265,22 @@ def _dependents(info: dict, code: list, v: int) -> tuple[list, dict, set]:
             continue
         dependent.append(i)
         tainted |= _taint(c, tainted)
-    for w in reversed(list(dependent)):  # a widget no later re-run cell reads is not re-run
-        if info[w].widget and not any(
-            info[c].loads is None or info[c].loads & info[w].bound for c in dependent if c > w
+    # a widget, or a cell no student's page shows (a worked step, a picture of the answers), that no later re-run
+    # cell reads and that binds no answer is not re-run: its output is the instructor's only
+    cells = nb["cells"]
+    answers = {n for p in parse_parts(nb) for n in p.kinds}
+    hidden = set(answer_dependents(nbformat.reads(json.dumps(nb), as_version=4))) | {
+        i for i in code if {SOLUTION, CHECK} & set(cell_tags(cells[i]))
+    }
+    for w in reversed(list(dependent)):
+        why = "widget" if info[w].widget else "not shown" if w in hidden else None
+        if (
+            why
+            and not (info[w].bound & answers)
+            and not any(info[c].loads is None or info[c].loads & info[w].bound for c in dependent if c > w)
         ):
             dependent.remove(w)
-            skipped[w] = "widget"
+            skipped[w] = why
     return dependent, skipped, tainted
 
 
