@@ -8,7 +8,9 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+import modern_robotics as mr
 import nbformat
+import numpy as np
 import pytest
 import sympy as sp
 from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
@@ -90,6 +92,8 @@ def test_plan_reruns_dependents_restores_overwritten_values_and_skips_checks_and
     assert p.skipped == {5: "check", 13: "widget"}
     assert 7 not in p.rerun  # y does not depend on the numbers
     assert p.recapture == [4, 10]
+    assert p.needed == [3, 4, 10]  # the failing cell and the picture are not needed for an answer
+    assert p.answers_only == [1, 3, 4, 8, 10]
 
 
 def test_plan_needs_a_variant_cell():
@@ -110,6 +114,22 @@ def test_plan_of_a_cell_that_rebinds_from_untainted_names_does_not_spread():
     ]
     p = plan(new_notebook(cells=cells))
     assert p.dependent == [2, 4]
+
+
+def test_session_arguments_are_checked_before_any_kernel(tmp_path):
+    nb, spec = synthetic()
+    path = tmp_path / "01_synthetic.ipynb"
+    nbformat.write(nb, path)
+    with pytest.raises(TypeError, match="spec"):
+        Session(path, SPEC_META)
+    with pytest.raises(ValueError, match="timeout"):
+        Session(path, spec, timeout=0)
+    with pytest.raises(FileNotFoundError, match="path"):
+        Session(tmp_path / "missing.ipynb", spec)
+    nb.cells[1].metadata = {}
+    nbformat.write(nb, path)
+    with pytest.raises(ValueError, match="no variant cell"):
+        Session(path, spec)
 
 
 def test_replay_synthetic(tmp_path):
@@ -149,13 +169,32 @@ def test_replay_synthetic(tmp_path):
     assert 5 not in first.outputs and 13 not in first.outputs and 7 not in first.outputs
 
 
+def test_answers_only_gives_the_answers_of_a_full_run(tmp_path):
+    nb, spec = synthetic()
+    path = tmp_path / "01_synthetic.ipynb"
+    nbformat.write(nb, path)
+    v2, v3 = {"a": "2", "t": "1/2"}, {"a": "3", "t": "1/2"}
+    with Session(path, spec) as s:
+        lean = s.run(v2, pictures=False)
+        full = s.run(v3)
+        lean3 = s.run(v3, pictures=False)  # cell 11 (1 / 0 for a = 3) is not needed for an answer
+        full2 = s.run(v2)
+    assert lean.error == "" and lean3.error == "" and full.error.startswith("cell 11: ZeroDivisionError")
+    assert lean.answers == full2.answers and lean.fingerprints == full2.fingerprints
+    assert _value(lean3.answers["z"]) == 13
+    assert 12 in full2.outputs and 12 not in lean.outputs
+
+
 def test_replay_function_and_a_value_outside_the_spec(tmp_path):
     nb, spec = synthetic()
     path = tmp_path / "01_synthetic.ipynb"
     nbformat.write(nb, path)
-    orig, runs = replay(path, spec, [{"a": "5", "t": "1/2"}])
-    assert orig.error == "" and runs[0].error == ""
-    assert _value(runs[0].answers["z"]) == 15
+    draws = [{"a": "5", "t": "1/2"}, {"a": "2", "t": "0"}, {"a": "3", "t": "1/2"}]
+    orig, runs = replay(path, spec, draws, jobs=2)  # two kernels, the draws shared out between them
+    assert orig.error == "" and runs[0].error == "" and runs[1].error == ""
+    assert [r.values for r in runs] == draws
+    assert [_value(r.answers["z"]) for r in runs[:2]] == [15, 12]
+    assert runs[2].error.startswith("cell 11: ZeroDivisionError")
     with Session(path, spec) as s, pytest.raises(ValueError, match="values.a"):
         s.run({"a": "4", "t": "0"})
 
@@ -175,7 +214,7 @@ def test_a_cell_that_times_out_ends_the_kernel_and_the_next_variant_gets_a_fresh
 
 
 # ---------------------------------------------------------------------------------------------------
-# The real notebook 05 with a variant cell for 5.3's configuration (until the notebooks carry theirs)
+# The real notebook 05: 5.3's configuration comes from its variant cell (metadata.kinlib.variants)
 
 Q53 = {"type": "angle", "choices": [["1/4", "1/6"], ["-1/4", "3/4", "1/4", "-1/2"], ["1/4", "0"]]}
 
@@ -193,42 +232,58 @@ def notebook_05_with_q53_variant(folder: Path):
     return path, spec, specmod.variant_cell_index(nb)
 
 
-def _rank_by_hand(q):
-    """Rank of 05's task rows at q: det J = L²(sin θ2 + cos θ2) (5.1), so 2 on the singular family, else 3."""
-    t2 = sp.pi * sp.Rational(q[1])
-    return 2 if sp.simplify(sp.sin(t2) + sp.cos(t2)) == 0 else 3
+def _subspace_numeric(answer):
+    """A subspace answer's spanning columns as floats (L = 1, as 05's pictures)."""
+    m = _value(answer)
+    m = m.subs({s: 1 for s in m.free_symbols if s.name == "L"})
+    return np.array(m, dtype=float)
+
+
+def _task_svd(values):
+    """Independent oracle: NumPy's SVD of modern_robotics' space Jacobian of 05's arm (L = 1), task rows."""
+    q = [float(sp.pi * sp.Rational(t)) for t in values["q53"]]
+    # 05's planar offset 3R arm (L = 1): joints about z_s through (0, 0), (1, 0), (2, 1); S_i = [ω; −ω × q_i]
+    z = np.array([0.0, 0.0, 1.0])
+    screws = np.array([np.r_[z, -np.cross(z, q_i)] for q_i in ([0, 0, 0], [1, 0, 0], [2, 1, 0])]).T
+    return np.linalg.svd(mr.JacobianSpace(screws, q)[[2, 3, 4]])
 
 
 @pytest.mark.slow
 def test_replay_05_q53(tmp_path, capsys):
     path, spec, at = notebook_05_with_q53_variant(tmp_path)
     p = plan(nbformat.read(path, as_version=4))
-    assert p.dependent and min(p.dependent) > at and p.restore == []
-    singular = {"q53": ["1/6", "3/4", "0"]}
-    regular = {"q53": ["1/4", "1/4", "1/4"]}
-    other = {"q53": ["1/6", "-1/2", "1/4"]}
+    assert p.dependent and min(p.dependent) > at and p.restore == [] and p.needed
+    # on the singular family (rank 2) and off it (rank 3: a draw the build's proof would reject)
+    draws = [{"q53": ["1/6", "3/4", "0"]}, {"q53": ["1/4", "1/4", "1/4"]}, {"q53": ["1/6", "-1/2", "1/4"]}]
     t0 = time.monotonic()
     with Session(path, spec, timeout=300) as s:
         t_orig = time.monotonic() - t0
         orig = s.original
         assert orig.error == "", orig.error
-        runs = [s.run(v) for v in (regular, singular, other, regular)]
+        runs = [s.run(v) for v in (*draws, draws[0])]
+        lean = [s.run(v, pictures=False) for v in draws[1:]]
+    assert runs[0].answers == runs[3].answers  # the first draw after the others as before them
+    assert [r.answers for r in lean] == [r.answers for r in runs[1:3]]
+    changed = set()
     for run in runs:
         assert run.error == "", run.error
-        rank = _rank_by_hand(run.values["q53"])
+        U, sv, _ = _task_svd(run.values)
+        rank = int(np.sum(sv > 1e-9))
         assert _value(run.answers["rank53"]) == rank
-        # the subspaces: range J has dimension rank, null Jᵀ the rest (as matrices of spanning columns)
-        assert run.answers["can_move"]["kind"] == "subspace"
-        # every answer outside 5.3 is the original's
-        for name, a in orig.answers.items():
-            if name not in ("rank53", "can_move", "cannot_move"):
-                assert run.answers[name] == a, name
-        # the figure of 5.3 shows its answers (the directions): the students' pages never show it, so it is
-        # not re-run (the instructor's solution page keeps the original's)
+        C = _subspace_numeric(run.answers["can_move"])
+        assert C.shape == (3, rank) and np.allclose(U[:, :rank] @ U[:, :rank].T @ C, C)
+        if rank < 3:
+            N = _subspace_numeric(run.answers["cannot_move"])
+            assert N.shape == (3, 3 - rank) and np.allclose(U[:, :rank].T @ N, 0)  # null Jᵀ ⟂ range J
+        changed |= {n for n, a in orig.answers.items() if run.answers[n] != a}
+        # the figure of 5.3 shows its answers (the directions): no student's page shows it, so it is not re-run
         assert set(run.outputs) <= set(p.dependent)
-    assert runs[0].answers == runs[3].answers  # "regular" after "singular" and "other" as before them
-    assert _value(orig.answers["rank53"]) == 2 and runs[1].answers["rank53"] == orig.answers["rank53"]
-    assert runs[0].answers["can_move"] != orig.answers["can_move"]
+    assert [_value(r.answers["rank53"]) for r in runs] == [2, 3, 3, 2]
+    assert changed <= {"rank53", "can_move", "cannot_move"} and "can_move" in changed
     per = [round(r.seconds, 2) for r in runs]
+    per_lean = [round(r.seconds, 2) for r in lean]
     with capsys.disabled():
-        print(f"\n05 replay: original {t_orig:.1f} s, per variant {per} s, cells re-run {p.rerun}")
+        print(
+            f"\n05 replay: original {t_orig:.1f} s, per variant {per} s (cells {p.rerun}), "
+            f"answers only {per_lean} s (cells {p.answers_only})"
+        )

@@ -167,9 +167,9 @@ class Plan:
     ``dependent``: cells that depend on the numbers (their outputs are the variant's); ``restore``: cells re-run
     only to put back a value a dependent cell overwrote; ``skipped``: dependent cells not re-run ({cell: "check" |
     "widget"}); ``restash``: {cell: answer names kept again when the part ends there}; ``recapture``: answer cells
-    whose fingerprints are taken again.
+    whose fingerprints are taken again; ``needed``: the dependent cells the answers need (the others only draw).
 
-    >>> Plan(2, [4, 5], [1], {6: "check"}, {}, []).rerun
+    >>> Plan(2, [4, 5], [1], {6: "check"}, {}, [], needed=[4]).rerun
     [1, 2, 4, 5]
     """
 
@@ -179,11 +179,17 @@ class Plan:
     skipped: dict
     restash: dict
     recapture: list
+    needed: list = field(default_factory=list)
 
     @property
     def rerun(self) -> list:
         """Every cell a variant runs, in order (the variant cell included)."""
         return sorted({self.variant, *self.dependent, *self.restore})
+
+    @property
+    def answers_only(self) -> list:
+        """The cells a variant runs for its answers and fingerprints alone (no picture that no answer needs)."""
+        return sorted({self.variant, *self.needed, *self.restore})
 
 
 def plan(nb) -> Plan:
@@ -207,6 +213,45 @@ def plan(nb) -> Plan:
     cells = nb["cells"]
     code = [i for i, c in enumerate(cells) if c.get("cell_type") == "code" and _source(c).strip()]
     info = {i: _analyse(cells[i]) for i in code}
+    dependent, skipped, tainted = _dependents(nb, info, code, v)
+    reads = _Reads(nb, info, code, skipped)
+    rerun = {v, *dependent}
+    restore: set = set()
+    changed = True
+    while changed:  # every tainted name read again must be what a fresh run would read there
+        changed = False
+        events = [(c, x) for c in sorted(rerun | restore) for x in info[c].free & tainted]
+        for pos, x in reads.events():
+            if x in tainted:
+                events.append((pos, x))
+        for pos, x in events:
+            for w in reads.writers(x, pos):
+                if w not in rerun and w not in restore:
+                    restore.add(w)
+                    changed = True
+    ran = rerun | restore
+
+    def fresh(name, pos):
+        return any(w in ran for w in reads.writers(name, pos))
+
+    restash = {p: [x for x in names if fresh(x, p + 0.5)] for p, names in reads.stash.items()}
+    restash = {p: names for p, names in restash.items() if names}
+    recapture = sorted(a for a, names in reads.capture.items() if any(fresh(x, a + 0.5) for x in names))
+    # the dependent cells the answers need (the rest only draw): what the answers are read from, and its inputs
+    needed: set = set()
+    todo = reads.events()
+    while todo:
+        pos, x = todo.pop()
+        for w in reads.writers(x, pos):
+            if w in ran and w not in needed:
+                needed.add(w)
+                todo += [(w, y) for y in info[w].free]
+    needed = sorted(needed & set(dependent))
+    return Plan(v, dependent, sorted(restore), dict(sorted(skipped.items())), restash, recapture, needed)
+
+
+def _dependents(nb, info: dict, code: list, v: int) -> tuple[list, dict, set]:
+    """(dependent cells, skipped {cell: why}, tainted names) for the variant cell ``v``."""
     tainted = _taint(info[v], set(), everything=True)  # the names it assigns (not its imports)
     dependent, skipped = [], {}
     for i in code:
@@ -222,6 +267,7 @@ def plan(nb) -> Plan:
         tainted |= _taint(c, tainted)
     # a widget, or a cell no student's page shows (a worked step, a picture of the answers), that no later re-run
     # cell reads and that binds no answer is not re-run: its output is the instructor's only
+    cells = nb["cells"]
     answers = {n for p in parse_parts(nb) for n in p.kinds}
     hidden = set(answer_dependents(nbformat.reads(json.dumps(nb), as_version=4))) | {
         i for i in code if {SOLUTION, CHECK} & set(cell_tags(cells[i]))
@@ -235,53 +281,42 @@ def plan(nb) -> Plan:
         ):
             dependent.remove(w)
             skipped[w] = why
-    rerun = {v, *dependent}
+    return dependent, skipped, tainted
 
-    # the names read again: by re-run cells, when a part ends (stash), the fingerprints, the export at the end
-    code_cells = [i for i, c in enumerate(cells) if c.get("cell_type") == "code"]
-    stash = {code_cells[k]: list(names) for k, names in stash_points(nb).items() if k < len(code_cells)}
-    stashed = {n for names in stash.values() for n in names}
-    capture: dict = {}
-    for g in answer_groups(nb):
-        for _part, name, _kind, idx in g.answers:
-            capture.setdefault(idx, []).append(name)
-    final = {n for p in parse_parts(nb) for n in p.kinds} - stashed
 
-    def writers(name, before):
-        """The cells a fresh run's value of ``name`` just before index ``before`` comes from: the last cell that
+class _Reads:
+    """Where a notebook's answers are read (a part's end, the fingerprints, the export at the end), and which
+    cells a value read at a point comes from."""
+
+    def __init__(self, nb, info: dict, code: list, skipped: dict):
+        self.info, self.code, self.skipped, self.end = info, code, skipped, len(nb["cells"])
+        code_cells = [i for i, c in enumerate(nb["cells"]) if c.get("cell_type") == "code"]
+        self.stash = {code_cells[k]: list(names) for k, names in stash_points(nb).items() if k < len(code_cells)}
+        stashed = {n for names in self.stash.values() for n in names}
+        self.capture: dict = {}
+        for g in answer_groups(nb):
+            for _part, name, _kind, idx in g.answers:
+                self.capture.setdefault(idx, []).append(name)
+        self.final = sorted({n for p in parse_parts(nb) for n in p.kinds} - stashed)
+
+    def events(self) -> list:
+        """[(position, name)]: each answer read right after a cell (index + 0.5) or at the end."""
+        out = [(p + 0.5, x) for p, names in self.stash.items() for x in names]
+        out += [(a + 0.5, x) for a, names in self.capture.items() for x in names]
+        return out + [(self.end, x) for x in self.final]
+
+    def writers(self, name: str, before: float) -> list:
+        """The cells a fresh run's value of ``name`` just before position ``before`` comes from: the last cell that
         binds it, and those that change it in place after that one."""
         out = []
-        for i in reversed([k for k in code if k < before and k not in skipped]):
-            c = info[i]
+        for i in reversed([k for k in self.code if k < before and k not in self.skipped]):
+            c = self.info[i]
             if name in c.mutated:
                 out.append(i)
             if name in c.bound or c.loads is None:
                 out.append(i)
                 break
         return out
-
-    restore: set = set()
-    changed = True
-    while changed:
-        changed = False
-        events = [(c, x) for c in sorted(rerun | restore) for x in info[c].free & tainted]
-        events += [(p + 0.5, x) for p, names in stash.items() for x in names if x in tainted]
-        events += [(a + 0.5, x) for a, names in capture.items() for x in names if x in tainted]
-        events += [(len(cells), x) for x in final & tainted]
-        for pos, x in events:
-            for w in writers(x, pos):
-                if w not in rerun and w not in restore:
-                    restore.add(w)
-                    changed = True
-    ran = rerun | restore
-
-    def fresh(name, pos):
-        return any(w in ran for w in writers(name, pos))
-
-    restash = {p: [x for x in names if fresh(x, p + 0.5)] for p, names in stash.items()}
-    restash = {p: names for p, names in restash.items() if names}
-    recapture = sorted(a for a, names in capture.items() if any(fresh(x, a + 0.5) for x in names))
-    return Plan(v, dependent, sorted(restore), dict(sorted(skipped.items())), restash, recapture)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -332,6 +367,12 @@ class Session:
     """
 
     def __init__(self, path, spec: Spec, timeout: float = 120):
+        if not isinstance(spec, Spec):
+            raise TypeError(f"spec: expected a variants Spec, got {type(spec).__name__}")
+        if isinstance(timeout, bool) or not isinstance(timeout, (int, float)) or not 0 < timeout <= 86400:
+            raise ValueError(f"timeout: expected seconds per cell in (0, 86400], got {timeout!r}")
+        if not Path(path).is_file():
+            raise FileNotFoundError(f"path: no notebook {path}")
         self.path = Path(path)
         self.spec = spec
         self.timeout = timeout
@@ -476,7 +517,7 @@ class Session:
             return Run(values, {}, fps, {}, str(e), time.monotonic() - t0)
         return Run(values, answers, fps, {}, self._missing(answers), time.monotonic() - t0)
 
-    async def _variant(self, values: dict) -> Run:
+    async def _variant(self, values: dict, pictures: bool = True) -> Run:
         t0 = time.monotonic()
         if self.client is None:  # the last variant ended the kernel: start again from the original
             orig = await self._original()
@@ -485,7 +526,7 @@ class Session:
         p = self.plan
         fps = dict(self.original.fingerprints)
         outputs, students = {}, {}
-        rerun = set(p.rerun)
+        rerun = set(p.rerun if pictures else p.answers_only)
         try:
             source = assignment_source(self.spec, values)
             for i in range(min(rerun), len(self.nb.cells)):
@@ -510,13 +551,15 @@ class Session:
             return Run(values, {}, {}, outputs, str(e), time.monotonic() - t0, students)
         return Run(values, answers, fps, outputs, self._missing(answers), time.monotonic() - t0, students)
 
-    def run(self, values: dict) -> Run:
+    def run(self, values: dict, pictures: bool = True) -> Run:
         """The notebook's answers, fingerprints and re-run outputs for ``values`` (a :class:`Run`; its ``error``
-        says what failed). Raises ValueError when ``values`` are not one of the spec's draws."""
+        says what failed). Raises ValueError when ``values`` are not one of the spec's draws. Without ``pictures``
+        only the cells the answers need run (:attr:`Plan.answers_only`; the outputs are theirs): a proof that
+        needs no figure."""
         assignment_source(self.spec, values)  # ValueError naming the parameter
         if self.original.error:
             return Run(dict(values), {}, {}, {}, f"the original does not run: {self.original.error}")
-        run = self._call(self._variant(dict(values)))
+        run = self._call(self._variant(dict(values), pictures))
         run.values = dict(values)
         return run
 
@@ -539,13 +582,36 @@ class Session:
         self.close()
 
 
-def replay(path, spec: Spec, variants: list, timeout: float = 120) -> tuple[Run, list]:
-    """(the original's :class:`Run`, one Run per variant in ``variants``): the notebook ``path`` executed once in a
-    kernel, then per variant the cells that depend on the numbers (:class:`Session`).
+def replay(path, spec: Spec, variants: list, timeout: float = 120, jobs: int = 1) -> tuple[Run, list]:
+    """(the original's :class:`Run`, one Run per variant in ``variants``, in order): the notebook ``path`` executed
+    once in a kernel, then per variant the cells that depend on the numbers (:class:`Session`). With ``jobs`` > 1
+    the variants are shared out round-robin between that many kernels (each runs the original once first).
+
+    >>> replay("nb.ipynb", None, [], jobs=0)
+    Traceback (most recent call last):
+        ...
+    ValueError: jobs: expected a whole number of kernels >= 1, got 0
 
     It runs a Jupyter kernel (tests/course/test_variants_replay.py exercises it), hence not run here:
 
     >>> original, runs = replay(Path("notebooks/05_singularities_planar.ipynb"), spec, [values])  # doctest: +SKIP
     """
-    with Session(path, spec, timeout=timeout) as s:
-        return s.original, [s.run(v) for v in variants]
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise ValueError(f"jobs: expected a whole number of kernels >= 1, got {jobs!r}")
+    variants = list(variants)
+    jobs = min(jobs, max(len(variants), 1))
+
+    def work(share):
+        with Session(path, spec, timeout=timeout) as s:
+            return s.original, [s.run(v) for v in share]
+
+    if jobs == 1:
+        return work(variants)
+    from concurrent.futures import ThreadPoolExecutor
+
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        results = list(pool.map(work, [variants[k::jobs] for k in range(jobs)]))
+    runs: list = [None] * len(variants)
+    for k, (_orig, share) in enumerate(results):
+        runs[k::jobs] = share
+    return results[0][0], runs
