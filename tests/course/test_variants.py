@@ -219,14 +219,19 @@ def test_families_count_and_variables_decide_the_set_structure():
     assert structure.differences(one, other_var)
 
 
-def test_a_zero_that_appears_changes_the_structure_and_undecided_rejects():
+def test_a_zero_in_symbols_changes_the_structure_a_zero_number_does_not():
+    th = sp.Symbol("theta2", real=True)
     a = structure.signature({"c": _expr(sp.Matrix([[sp.sqrt(2) / 2, 1, -1]]))})
-    b = structure.signature({"c": _expr(sp.Matrix([[sp.cos(sp.pi / 5), -2, sp.sqrt(3)]]))})
-    c = structure.signature({"c": _expr(sp.Matrix([[sp.sqrt(2) / 2, 1, sp.sqrt(2) - 2 * sp.cos(sp.pi / 4)]]))})
-    assert structure.differences(a, b) == []
-    assert structure.differences(a, c) == [
-        "c: a 1×3 matrix with 0 zero entries in the original, a 1×3 matrix with 1 zero entry here"
+    b = structure.signature({"c": _expr(sp.Matrix([[sp.cos(sp.pi / 5), 0, sp.sqrt(2) - 2 * sp.cos(sp.pi / 4)]]))})
+    assert structure.differences(a, b) == []  # a joint that does not move the tool: still a row of 3 numbers
+    s1 = structure.signature({"J": _expr(sp.Matrix([[sp.sin(th), 1]]))})
+    s0 = structure.signature({"J": _expr(sp.Matrix([[sp.sin(th) ** 2 + sp.cos(th) ** 2 - 1, 1]]))})
+    assert structure.differences(s1, s0) == [
+        "J: a 1×2 matrix with 0 zero entries in the original, a 1×2 matrix with 1 zero entry here"
     ]
+    n1 = structure.signature({"w": _expr(sp.sqrt(2) - 2 * sp.cos(sp.pi / 4) + 1)})
+    n0 = structure.signature({"w": _expr(sp.sqrt(2) - 2 * sp.cos(sp.pi / 4))})
+    assert structure.differences(n1, n0)  # the answer itself becoming 0 is a different answer
 
 
 # ---------------------------------------------------------------------------------------------------
