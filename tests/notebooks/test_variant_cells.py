@@ -178,6 +178,7 @@ def test_another_variant_rewrites_the_question_and_the_variant_cell(path):
     wb, wb0 = _workbook(out), _workbook(nb)
     by_id, by_id0 = {c.get("id"): c for c in wb.cells}, {c.get("id"): c for c in wb0.cells}
     vid = nb.cells[idx].get("id")
+
     # (the workbook trims the imports a student's cell does not use: compare the assignments)
     def assignments(src):
         return [line for line in src.splitlines() if not line.startswith(("from ", "import "))]
@@ -236,3 +237,29 @@ def test_the_code_oracle_finds_what_it_must():
     for s in ("[pi / 8, pi / 4, 3 * pi / 4, 0]", "[-pi / 8, pi / 4, 3 * pi / 40, 0]", "[-pi / 8, pi / 4, pi / 4, 0]"):
         assert not rx.search(s), s
     assert _text_form("angle", "-3/8") == "−3π/8" and _text_form("angle", "1") == "π"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("path", VARYING, ids=[p.stem for p in VARYING])
+def test_the_notebook_runs_for_another_variant(path, tmp_path):
+    """Every cell runs for a variant that differs from the original everywhere it can: the checks compare the
+    printed numbers only at the printed configuration, and an independent computation at every one (a check that
+    failed for other numbers would make the build reject every draw)."""
+    nb, spec = _spec(path)
+    values = _other(spec)
+    out = tmp_path / path.name
+    nbformat.write(vs.apply(nb, spec, values), out)
+    executed, _groups, fps = handouts.execute_notebook(out, timeout=600)
+    errors = [
+        o for c in executed.cells if c.cell_type == "code" for o in c.get("outputs", []) if o.output_type == "error"
+    ]
+    assert not errors
+    printed = [
+        "".join(o.get("text", ""))
+        for c in executed.cells
+        if "check" in schema.cell_tags(c)
+        for o in c.get("outputs", [])
+        if o.output_type == "stream"
+    ]
+    assert any("this variant" in t for t in printed), printed
+    assert fps
