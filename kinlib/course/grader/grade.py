@@ -167,7 +167,13 @@ MAX_OTHERS = 64  # other variants' reference answers a wrong answer is judged ag
 
 
 class VariantsKeyRefused(ValueError):
-    """The variants key cannot be used (missing, damaged, or signed with another secret): nothing is graded."""
+    """The variants key cannot be used (missing, damaged, or signed with another secret): nothing is graded.
+
+    >>> read_variants_key("/nonexistent/key.json", b"s" * 32)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+        ...
+    kinlib.course.grader.grade.VariantsKeyRefused: ...
+    """
 
 
 def read_variants_key(path, secret: bytes):
@@ -641,6 +647,22 @@ def not_graded(sub: intake.Submission, refs: dict, why: str, name: str | None = 
     return _done(out, t0)
 
 
+def _variants_of(variants, key: bytes, subs: list, id_pattern, out: Path, log):
+    """(the verified variants key or None, {submission path: student id}) for :func:`grade_batch`."""
+    if variants is None:
+        return None, {}
+    from .report import remembered_pattern
+
+    vkey = read_variants_key(variants, key)
+    pattern = id_pattern if id_pattern is not None else remembered_pattern(out)
+    students = {s.path: intake.student_id(s.relpath, pattern)[0] for s in subs}
+    log(
+        f"variants: {variants} ({', '.join(sorted(vkey.notebooks)) or 'no notebook'}): each submission judged "
+        "against its student's own variant"
+    )
+    return vkey, students
+
+
 def grade_batch(
     paths,
     out,
@@ -700,16 +722,7 @@ def grade_batch(
     if cache == "default":
         cache = notebooks.resolve().parent / "build" / "grade-cache"
     key = secret if isinstance(secret, bytes) else load_secret(secret)
-    vkey = read_variants_key(variants, key) if variants is not None else None
-    if vkey is not None:
-        from .report import remembered_pattern
-
-        pattern = id_pattern if id_pattern is not None else remembered_pattern(out)
-        students = {s.path: intake.student_id(s.relpath, pattern)[0] for s in subs}
-        log(
-            f"variants: {variants} ({', '.join(sorted(vkey.notebooks)) or 'no notebook'}): each submission judged "
-            "against its student's own variant"
-        )
+    vkey, students = _variants_of(variants, key, subs, id_pattern, out, log)
     hidden = [notebooks, out, cache or "", "" if isinstance(secret, bytes) else secret or default_secret_path()]
     if variants is not None:
         hidden.append(variants)

@@ -739,7 +739,18 @@ def build(
         from ..grader.secret import load_secret
         from .perstudent import build_variants
 
-        build_variants(notebooks, out, variants, load_secret(secret), entries, urls, lite=site, fresh=fresh, log=log)
+        build_variants(
+            notebooks,
+            out,
+            variants,
+            load_secret(secret),
+            entries,
+            urls,
+            lite=site,
+            make_workbook=make_workbook,
+            fresh=fresh,
+            log=log,
+        )
     sheet = notebooks / CHEATSHEET
     if sheet.exists():
         write_cheatsheet(sheet, out / "reference" / "cheatsheet.html", urls, links=links)

@@ -137,11 +137,20 @@ def build_variants(
     urls: dict,
     *,
     lite: bool,
+    make_workbook,
     fresh: bool = False,
     log=print,
 ) -> keymod.Key:
-    """Prove each student's variants and write their pages, workbooks and links (see the module docstring)."""
-    from .handouts import make_workbook
+    """Prove each student's variants and write their pages, workbooks and links (see the module docstring).
+
+    It runs the notebooks' variants in kernels (tests/course/test_handouts_variants.py exercises it through
+    :func:`kinlib.course.publish.handouts.build`, which passes its ``make_workbook``), hence not run here:
+
+    >>> key = build_variants(Path("notebooks"), Path("build/handouts"), "roster.csv", secret, entries, urls,
+    ...                      lite=True, make_workbook=make_workbook)  # doctest: +SKIP
+    >>> sorted(key.notebooks)  # doctest: +SKIP
+    ['04_interpreting_the_jacobian', '05_singularities_planar']
+    """
     from .pages import export_html
 
     t0 = time.perf_counter()
