@@ -224,6 +224,8 @@ def build_variants(
         )
         report += [f"  rejected {n}x: {why}" for why, n in sorted(st["reasons"].items(), key=lambda kv: -kv[1])]
     (inst / "report.txt").write_text("\n".join(report) + "\n")
-    log(f"  variants: {len(roster)} students' pages and workbooks in {time.perf_counter() - t0:.1f} s; the key, ")
-    log(f"    report, links and answer sheets in {inst}")
+    log(
+        f"  variants: {len(roster)} students' pages and workbooks in {time.perf_counter() - t0:.1f} s "
+        f"(key, report, links and answer sheets in {inst})"
+    )
     return key
