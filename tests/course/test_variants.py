@@ -281,3 +281,16 @@ def test_a_damaged_or_edited_key_is_refused_not_trusted(tmp_path):
 def test_a_bad_roster_row_is_named(text, match):
     with pytest.raises(ValueError, match=match):
         keymod.read_roster_text(text)
+
+
+def test_a_variants_pictures_of_a_cell_that_states_an_answer_are_only_its_students_version():
+    """A re-run cell marked "reveals" (its picture states a graded answer) keeps, in the proved variant the
+    per-student pages are made from, only the students' version the replay probed, never the full picture."""
+    from kinlib.course.variants.key import _variant_from_run
+    from kinlib.course.variants.replay import Run
+
+    run = Run(
+        {"q": "1"}, {}, {(3, "x"): {"spec": "s"}}, {5: ["marked singular"], 6: ["arm"]}, "", 0.0, {5: ["arm only"]}
+    )
+    v = _variant_from_run(run)
+    assert v.outputs == {5: ["arm only"], 6: ["arm"]} and v.fingerprints == {"3|x": {"spec": "s"}}

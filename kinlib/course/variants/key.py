@@ -199,8 +199,12 @@ class Key:
 
 
 def _variant_from_run(run) -> Variant:
+    """The proved variant of a replay run. Its pictures are what students may see: a cell that states a graded
+    answer keeps only its students' version (``run.students``), never the instructor's picture."""
     fps = {f"{i}|{name}": fp for (i, name), fp in run.fingerprints.items()}
-    return Variant(dict(run.values), run.answers, fps, dict(run.outputs))
+    students = getattr(run, "students", {}) or {}
+    outputs = {i: students[i] if i in students else o for i, o in run.outputs.items()}
+    return Variant(dict(run.values), run.answers, fps, outputs)
 
 
 class _Prover:
