@@ -128,6 +128,31 @@ def _student_index(student, title_of, pages, workbooks, lite: bool) -> str:
     )
 
 
+def _lendable(previous, outputs: dict):
+    """The last key's proofs that can be lent, with their pictures: a notebook whose pictures are missing or
+    damaged in ``outputs.json`` (untrusted, never a crash) is left out, so its variants are proved and drawn
+    again rather than shown with the original's figures.
+
+    >>> nk = keymod.NotebookKey("05", "0" * 64, {}, {}, variants={"v1": keymod.Variant({}, {}, {})})
+    >>> sorted(_lendable(keymod.Key({"05": nk}), {"05": {"v1": {"8": []}}}).notebooks)
+    ['05']
+    >>> [sorted(_lendable(keymod.Key({"05": nk}), bad).notebooks) for bad in ({}, {"05": []}, {"05": {"v2": {}}})]
+    [[], [], []]
+    """
+    if previous is None:
+        return None
+
+    def pictured(nid, nk):
+        got = outputs.get(nid)
+        return isinstance(got, dict) and all(isinstance(got.get(vk), dict) for vk in nk.variants)
+
+    previous.notebooks = {nid: nk for nid, nk in previous.notebooks.items() if pictured(nid, nk)}
+    for nid, nk in previous.notebooks.items():
+        for vk, v in nk.variants.items():
+            v.outputs = outputs[nid][vk]
+    return previous
+
+
 def build_variants(
     notebooks: Path,
     out: Path,
@@ -159,10 +184,7 @@ def build_variants(
     inst = instructor_dir(out)
     previous = None if fresh else keymod.read_key(inst / "key.json", secret)
     outputs = keymod.read_outputs(inst / "outputs.json")
-    if previous is not None:  # the pictures of proofs lent by the last key
-        for nid, nk in previous.notebooks.items():
-            for vk, v in nk.variants.items():
-                v.outputs = outputs.get(nid, {}).get(vk, {})
+    previous = _lendable(previous, outputs)
     stems = [e["stem"] for e in entries]
     key = keymod.build_key(notebooks, roster, secret, previous=previous, log=log, only=stems)
     keymod.write_key(inst / "key.json", key, secret)
