@@ -123,7 +123,7 @@ def _student_index(student, title_of, pages, workbooks, lite: bool) -> str:
     return (
         "<!doctype html><meta charset=utf-8><title>Your problem set</title>"
         f"<h1>Your problem set, {html.escape(student.name or student.id)}</h1>"
-        "<p>Your numbers are your own: a classmate's problem set has others, and is graded against its own.</p>"
+        "<p>Your numbers were drawn for you (most classmates have others): your answers are graded against your own numbers.</p>"
         f"<ul>{''.join(items)}</ul>"
     )
 
