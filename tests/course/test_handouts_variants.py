@@ -135,3 +135,29 @@ def test_the_instructors_files_are_beside_the_published_folder_never_in_it(built
     assert {p.name for p in (out / "students").iterdir()} == tokens
     # a token is not the id, and cannot be made without the secret
     assert not tokens & {"ada", "bob", "cyd"}
+
+
+def test_no_variant_page_or_workbook_states_its_own_graded_answers(built):
+    """test_leaks' search (every form of every graded answer), run on each variant's own page and workbook with
+    that variant's own answers: a student's page gives none of *their* answers away."""
+    from test_leaks import allowed, find_hits, forms, students_files
+
+    from kinlib.course.schema import parse_parts
+
+    out, inst, secret, _ = built
+    key = keymod.read_key(inst / "key.json", secret)
+    stems = sorted(p.stem for p in NOTEBOOKS.glob("[0-9][0-9]_*.ipynb"))
+    files = students_files(out)
+    searched = 0
+    for nid, nk in key.notebooks.items():
+        part_of = {
+            n: p.part for p in parse_parts(json.loads((NOTEBOOKS / f"{nid}.ipynb").read_bytes())) for n in p.kinds
+        }
+        for vk, v in nk.variants.items():
+            mine = {rel: text for rel, text in files.items() if f"{nid}-{vk}" in rel}
+            assert len(mine) == 2, sorted(mine)  # its page and its workbook
+            all_forms = [f for name, ans in v.answers.items() for f in forms(nid, part_of[name], name, ans)]
+            searched += len(all_forms)
+            hits = [h for h in find_hits(all_forms, mine, stems) if not allowed(h)]
+            assert not hits, [(h.form.part, h.form.name, h.form.label, h.file, h.context) for h in hits]
+    assert searched > 50

@@ -294,3 +294,19 @@ def test_a_variants_pictures_of_a_cell_that_states_an_answer_are_only_its_studen
     )
     v = _variant_from_run(run)
     assert v.outputs == {5: ["arm only"], 6: ["arm"]} and v.fingerprints == {"3|x": {"spec": "s"}}
+
+
+@given(st.integers(-11, 12))
+@settings(max_examples=24, deadline=None)
+def test_a_subspace_that_lines_up_with_the_axes_is_another_form(k):
+    """5.3's range J at θ1 = kπ/12 (a rotation of the original's tilted plane, θ1 = π/4): the same structure
+    unless the lost direction (−sin, cos) lines up with an axis (θ1 a multiple of π/2), which NumPy sees as a
+    zero component of it."""
+    t = sp.pi * k / 12
+    lost = sp.Matrix([0, -sp.sin(t + sp.pi / 4), sp.cos(t + sp.pi / 4)])  # the original's (0, 1, 1) direction turned
+    rng = sp.Matrix.hstack(sp.Matrix([1, 0, 0]), sp.Matrix([0, lost[2], -lost[1]]))
+    orig = structure.signature({"c": _expr(sp.Matrix([[1, 0], [0, 1], [0, -1]]), "subspace")})
+    got = structure.signature({"c": _expr(rng, "subspace")})
+    numeric = np.array(lost[1:, 0].evalf(30), dtype=float).ravel()
+    aligned = bool(np.any(np.abs(numeric) < 1e-12))
+    assert (structure.differences(orig, got) != []) == aligned

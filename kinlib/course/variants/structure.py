@@ -9,7 +9,8 @@ code, in the replay kernel) have the same *structure* as the original's:
   its shape (an entry that is 0 is still a number: a joint that does not help);
 - integers and booleans are equal (a rank, "removes every singularity");
 - a set of configurations keeps its number of singular families, per variable;
-- a subspace keeps its dimension;
+- a subspace keeps its dimension, and (one of numbers) the zero pattern of its reduced basis: one that lines up
+  with the axes where the original's does not is another form;
 - a choice keeps its form: one winner stays one winner, a tie stays a tie of as many joints.
 
 Zero is decided exactly: SymPy's own ``is_zero``, then simplification, then (for a constant) its minimal
@@ -65,6 +66,17 @@ def _set_shape(s):
     return (type(s).__name__,)
 
 
+def _subspace_shape(m):
+    """A subspace's dimension and, for one of numbers, the zero pattern of its reduced basis (the rows of rref
+    of the spanning columns): a subspace that happens to line up with an axis (the x-y plane instead of a tilted
+    one) is a special case the student would be asked about, and it reads like a worked example."""
+    if m.free_symbols:
+        return ("subspace", m.rank())
+    basis = [r for r in (m.T.rref()[0].tolist()) if any(x != 0 for x in r)]
+    pattern = tuple(tuple(_is_zero(sp.sympify(x)) for x in r) for r in basis)
+    return ("subspace", len(basis), pattern)
+
+
 def shape(obj, kind: str = "expr", top: bool = True):
     """The structure of one loaded answer value (what :func:`differences` compares). An integer or a boolean
     that *is* the answer (a rank) is kept as its value; inside a matrix or a dict a number is only zero or not.
@@ -75,10 +87,10 @@ def shape(obj, kind: str = "expr", top: bool = True):
     >>> shape(sp.Matrix([[sp.sin(th) ** 2 + sp.cos(th) ** 2 - 1, sp.sin(th)]]))
     ('matrix', (1, 2), (('zero',), ('expr', ('theta2',))))
     >>> shape(sp.Integer(2)), shape(sp.Matrix([[1, 0], [0, 1], [0, 0]]), "subspace")
-    (('int', 2), ('subspace', 2))
+    (('int', 2), ('subspace', 2, ((False, True, True), (True, False, True))))
     """
     if kind == "subspace" and isinstance(obj, sp.MatrixBase):
-        return ("subspace", obj.rank())
+        return _subspace_shape(obj)
     if isinstance(obj, dict):
         keys = [str(k) for k in obj]
         return ("dict", tuple(sorted(zip(keys, (shape(v, kind, False) for v in obj.values())))))
@@ -157,7 +169,7 @@ def _say(s) -> str:
     if inner[0] in ("int", "bool"):
         return str(inner[1])
     if inner[0] == "subspace":
-        return f"a subspace of dimension {inner[1]}"
+        return f"a subspace of dimension {inner[1]}" + (", along the axes" if _axis_aligned(inner) else "")
     if _contains(inner, UNDECIDED):
         return "an entry whose zero could not be decided exactly"
     if inner[0] == "dict" and s[0] == "set":
@@ -167,6 +179,10 @@ def _say(s) -> str:
         zeros = _count(inner, ("zero",))
         return f"a {inner[1][0]}×{inner[1][1]} matrix with {zeros} zero entr{'y' if zeros == 1 else 'ies'}"
     return "another form"
+
+
+def _axis_aligned(inner) -> bool:
+    return len(inner) > 2 and all(sum(not z for z in row) == 1 for row in inner[2])
 
 
 def _count(s, target) -> int:
