@@ -138,3 +138,21 @@ def test_a_second_build_with_the_same_notebooks_runs_no_kernel(built, monkeypatc
     again = keymod.build_key(NOTEBOOKS, roster, SECRET, only=["04", "05"], previous=key, log=lambda *_: None)
     for nid in (N04, N05):
         assert again.notebooks[nid].students == key.notebooks[nid].students
+
+
+def test_proofs_made_with_other_code_are_not_lent(built, monkeypatch):
+    """A key whose proofs were made by other kinlib code (another engine, other proof rules) lends nothing: the
+    notebook's variants are proved again (here the kernel that would prove them refuses, so the build stops)."""
+    import copy
+
+    key, roster, _ = built
+    old = copy.deepcopy(key)
+    for nk in old.notebooks.values():
+        nk.code = "0" * 64
+
+    def no_kernel(*a, **k):
+        raise RuntimeError("proving again")
+
+    monkeypatch.setattr(replay, "Session", no_kernel)
+    with pytest.raises(RuntimeError, match="proving again"):
+        keymod.build_key(NOTEBOOKS, roster, SECRET, only=["05"], previous=old, log=lambda *_: None)

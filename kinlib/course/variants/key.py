@@ -4,8 +4,8 @@
 (:func:`~kinlib.course.variants.draw.draw`), proves it (the notebook's own code re-run for it in a kernel,
 :mod:`~kinlib.course.variants.replay`; its answers compared with the original's,
 :mod:`~kinlib.course.variants.structure`), and redraws a rejected draw (attempt 1, 2, …), recording why.
-Each distinct variant is proved once, whoever draws it; a key built before for the same notebook bytes lends
-its proofs (a second build with the same roster runs no kernel).
+Each distinct variant is proved once, whoever draws it; a key built before for the same notebook bytes and the
+same kinlib code lends its proofs (a second build with the same roster runs no kernel).
 
 The key is JSON signed with the course secret (:func:`write_key`); :func:`read_key` returns None for a file whose
 tag does not verify or that is not a key, so a damaged or edited key is refused, never trusted and never a crash.
@@ -162,6 +162,7 @@ class NotebookKey:
     rejected: dict = field(default_factory=dict)  # vkey -> why (each distinct rejected draw, proved once)
     rejections: list = field(default_factory=list)  # [{"student", "attempt", "variant", "why"}]
     seconds: float = 0.0
+    code: str = ""  # the kinlib code and pins the proofs were made with (a proof is lent only to the same code)
 
 
 @dataclass
@@ -243,8 +244,11 @@ def _key_for_notebook(path, nb, spec, roster, secret, previous, max_attempts, ti
     nid = notebook_id(nb) or path.stem
     sha = hashlib.sha256(path.read_bytes()).hexdigest()
     nk = NotebookKey(nid, sha, nb["metadata"]["kinlib"]["variants"], dict(spec.original))
+    from ..publish.incremental import code_key
+
+    nk.code = code_key()
     old = previous.notebooks.get(nid) if previous is not None else None
-    if old is not None and old.sha == sha:  # the same notebook: its proofs still hold
+    if old is not None and old.sha == sha and old.code == nk.code:  # same notebook, same engine: the proofs hold
         nk.variants, nk.rejected = dict(old.variants), dict(old.rejected)
     prover = _Prover(path, spec, timeout)
     try:
@@ -293,7 +297,8 @@ def build_key(
 ) -> Key:
     """Each student's proved variant of every notebook (``NN_*.ipynb`` in ``notebooks``) that declares variants.
 
-    ``previous`` (a key read back with :func:`read_key`) lends the proofs of notebooks whose bytes are unchanged.
+    ``previous`` (a key read back with :func:`read_key`) lends the proofs of notebooks whose bytes are unchanged,
+    made with the same kinlib code and pins (a change to the engine or to the proof's rules proves them again).
     ``jobs`` notebooks are proved at once (each in its own kernel).
     Raises VariantError when a student gets no well-posed variant in ``max_attempts`` draws.
 
