@@ -354,6 +354,10 @@ def _error_text(exc) -> str:
     return f"{ename}: {evalue}"
 
 
+#: serialises the name analysis: concurrent ast.parse in 3.11 raises "AST constructor recursion depth mismatch"
+_PARSE_LOCK = threading.Lock()
+
+
 class Session:
     """The instructor's notebook ``path`` run once in a kernel (:attr:`original`, a :class:`Run` of the spec's
     original values, ready when the constructor returns), then :meth:`run` per variant in the same kernel;
@@ -377,7 +381,8 @@ class Session:
         self.spec = spec
         self.timeout = timeout
         self.nb = nbformat.read(self.path, as_version=4)
-        self.plan = plan(self.nb)
+        with _PARSE_LOCK:  # CPython 3.11's ast.parse is not thread-safe (build_key proves notebooks in threads)
+            self.plan = plan(self.nb)
         self.kinds = {n: k for p in parse_parts(self.nb) for n, k in p.kinds.items()}
         self.capture: dict = {}
         for g in answer_groups(self.nb):
